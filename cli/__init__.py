@@ -1,0 +1,1 @@
+"""The ``meshvis`` command line: parse, call the library, report.  No algorithms here."""

@@ -1,0 +1,325 @@
+"""The in-memory model: a triangle soup with per-face attributes.
+
+A :class:`Soup` is what every meshvis algorithm consumes.  It never assumes connectivity:
+faces index a vertex array, but two faces that touch may well use different vertex
+indices.  Attributes are stored per face (part, material, source polygon) or per face
+corner (UVs, colours), so that flipping, subsetting or duplicating faces never needs a
+re-weld.
+
+Conventions (DESIGN.md §5): float64 vertices, int64 faces, side 0 of a face is the side its
+counter-clockwise normal points to.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import dataclass, field, replace
+from functools import cached_property
+from typing import Any, Sequence
+
+import numpy as np
+
+from .errors import ModelError
+
+
+@dataclass(eq=False)
+class Material:
+    """A material as read from a file, kept opaque so that it can be written back.
+
+    Parameters
+    ----------
+    name : str
+        Material name (``usemtl`` name in OBJ, material name in glTF).
+    source : object, optional
+        What the reader produced (e.g. the MTL lines and folder, or a trimesh material);
+        only the writers interpret it.
+    """
+
+    name: str
+    source: Any = None
+
+
+@dataclass(eq=False)
+class Soup:
+    """A triangle soup with per-face attributes.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float64
+    faces : (m, 3) int64, indices into ``vertices``
+    part_id : (m,) int64, index into ``part_names``; defaults to 0
+    part_names : list of str
+    source_face : (m,) int64, index of the polygon of the source file each triangle came from
+    material_id : (m,) int64, index into ``materials`` or -1
+    materials : list of :class:`Material`
+    uv : (m, 3, 2) float64 or None, per-corner texture coordinates
+    colors : (m, 3, 4) uint8 or None, per-corner RGBA vertex colours
+    path : str or None, the file the soup was read from (for messages)
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> s = Soup(np.eye(3), np.array([[0, 1, 2]]))
+    >>> s.n_faces, round(float(s.areas[0]), 4)
+    (1, 0.866)
+    """
+
+    vertices: np.ndarray
+    faces: np.ndarray
+    part_id: np.ndarray | None = None
+    part_names: list[str] = field(default_factory=list)
+    source_face: np.ndarray | None = None
+    material_id: np.ndarray | None = None
+    materials: list[Material] = field(default_factory=list)
+    uv: np.ndarray | None = None
+    colors: np.ndarray | None = None
+    path: str | None = None
+
+    def __post_init__(self) -> None:
+        self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
+        self.faces = np.ascontiguousarray(self.faces, dtype=np.int64).reshape(-1, 3)
+        m = len(self.faces)
+        if self.part_id is None:
+            self.part_id = np.zeros(m, np.int64)
+        self.part_id = np.asarray(self.part_id, np.int64).reshape(m)
+        if not self.part_names:
+            n_parts = int(self.part_id.max()) + 1 if m else 1
+            self.part_names = [f"part{i}" for i in range(n_parts)]
+        if self.source_face is None:
+            self.source_face = np.arange(m, dtype=np.int64)
+        self.source_face = np.asarray(self.source_face, np.int64).reshape(m)
+        if self.material_id is None:
+            self.material_id = np.full(m, -1, np.int64)
+        self.material_id = np.asarray(self.material_id, np.int64).reshape(m)
+        if self.uv is not None:
+            self.uv = np.asarray(self.uv, np.float64).reshape(m, 3, 2)
+        if self.colors is not None:
+            self.colors = np.asarray(self.colors, np.uint8).reshape(m, 3, 4)
+
+    # ------------------------------------------------------------------ basic sizes
+    @property
+    def n_faces(self) -> int:
+        return len(self.faces)
+
+    @property
+    def n_vertices(self) -> int:
+        return len(self.vertices)
+
+    @property
+    def n_parts(self) -> int:
+        return len(self.part_names)
+
+    # ------------------------------------------------------------------ geometry (cached)
+    @cached_property
+    def triangles(self) -> np.ndarray:
+        """(m, 3, 3) float64 corner coordinates."""
+        return self.vertices[self.faces]
+
+    @cached_property
+    def _cross(self) -> np.ndarray:
+        t = self.triangles
+        return np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+
+    @cached_property
+    def areas(self) -> np.ndarray:
+        """(m,) triangle areas."""
+        return 0.5 * np.linalg.norm(self._cross, axis=1)
+
+    @cached_property
+    def normals(self) -> np.ndarray:
+        """(m, 3) unit normals of side 0 (counter-clockwise); zero rows for degenerate faces."""
+        c = self._cross
+        length = np.linalg.norm(c, axis=1)
+        out = np.zeros_like(c)
+        ok = length > 0
+        out[ok] = c[ok] / length[ok, None]
+        return out
+
+    @cached_property
+    def bounds(self) -> np.ndarray:
+        """(2, 3) min and max corner of the bounding box of the *used* vertices."""
+        if self.n_faces == 0:
+            return np.zeros((2, 3))
+        used = self.vertices[np.unique(self.faces)]
+        return np.stack([used.min(axis=0), used.max(axis=0)])
+
+    @cached_property
+    def diagonal(self) -> float:
+        """Length of the bounding-box diagonal: the unit of every size-relative epsilon."""
+        return float(np.linalg.norm(self.bounds[1] - self.bounds[0]))
+
+    @property
+    def total_area(self) -> float:
+        return float(self.areas.sum())
+
+    # ------------------------------------------------------------------ derived soups
+    def subset(self, index: np.ndarray) -> "Soup":
+        """The soup made of the faces ``index`` (boolean mask or integer array), attributes kept.
+
+        Vertices are not compacted: the new soup shares the vertex array.
+        """
+        index = np.asarray(index)
+        if index.dtype == bool:
+            index = np.flatnonzero(index)
+        return replace(
+            self,
+            faces=self.faces[index],
+            part_id=self.part_id[index],
+            source_face=self.source_face[index],
+            material_id=self.material_id[index],
+            uv=None if self.uv is None else self.uv[index],
+            colors=None if self.colors is None else self.colors[index],
+        )
+
+    def flipped(self, flip: np.ndarray) -> "Soup":
+        """The soup with the faces where ``flip`` is True turned over (corners 1 and 2 swapped)."""
+        flip = np.asarray(flip, bool).reshape(self.n_faces)
+        order = np.where(flip[:, None], [0, 2, 1], [0, 1, 2])
+        rows = np.arange(self.n_faces)[:, None]
+        return replace(
+            self,
+            faces=self.faces[rows, order],
+            uv=None if self.uv is None else self.uv[rows, order],
+            colors=None if self.colors is None else self.colors[rows, order],
+            part_id=self.part_id.copy(),
+            source_face=self.source_face.copy(),
+            material_id=self.material_id.copy(),
+        )
+
+    def transformed(self, matrix: np.ndarray) -> "Soup":
+        """The soup with its vertices mapped by a 4x4 homogeneous matrix (attributes kept).
+
+        A transform with negative determinant would turn every face over, so the faces are
+        flipped back to keep each side's meaning.
+        """
+        matrix = np.asarray(matrix, np.float64)
+        v = self.vertices @ matrix[:3, :3].T + matrix[:3, 3]
+        out = replace(self, vertices=v)
+        if np.linalg.det(matrix[:3, :3]) < 0:
+            out = out.flipped(np.ones(self.n_faces, bool))
+            out.vertices = v
+        return out
+
+    def copy(self) -> "Soup":
+        return replace(
+            self,
+            vertices=self.vertices.copy(),
+            faces=self.faces.copy(),
+            part_id=self.part_id.copy(),
+            source_face=self.source_face.copy(),
+            material_id=self.material_id.copy(),
+            uv=None if self.uv is None else self.uv.copy(),
+            colors=None if self.colors is None else self.colors.copy(),
+            part_names=list(self.part_names),
+            materials=list(self.materials),
+        )
+
+    @classmethod
+    def concatenate(cls, soups: Sequence["Soup"]) -> "Soup":
+        """One soup from several; part and material indices are shifted, names kept."""
+        soups = list(soups)
+        if not soups:
+            raise ModelError("nothing to concatenate")
+        v_off = np.cumsum([0] + [s.n_vertices for s in soups[:-1]])
+        p_off = np.cumsum([0] + [s.n_parts for s in soups[:-1]])
+        m_off = np.cumsum([0] + [len(s.materials) for s in soups[:-1]])
+        s_off = np.cumsum([0] + [int(s.source_face.max()) + 1 if s.n_faces else 0 for s in soups[:-1]])
+        has_uv = any(s.uv is not None for s in soups)
+        has_col = any(s.colors is not None for s in soups)
+        return cls(
+            vertices=np.concatenate([s.vertices for s in soups]),
+            faces=np.concatenate([s.faces + o for s, o in zip(soups, v_off)]),
+            part_id=np.concatenate([s.part_id + o for s, o in zip(soups, p_off)]),
+            part_names=[n for s in soups for n in s.part_names],
+            source_face=np.concatenate([s.source_face + o for s, o in zip(soups, s_off)]),
+            material_id=np.concatenate(
+                [np.where(s.material_id >= 0, s.material_id + o, -1) for s, o in zip(soups, m_off)]
+            ),
+            materials=[m for s in soups for m in s.materials],
+            uv=np.concatenate([s.uv if s.uv is not None else np.zeros((s.n_faces, 3, 2)) for s in soups])
+            if has_uv
+            else None,
+            colors=np.concatenate(
+                [s.colors if s.colors is not None else np.full((s.n_faces, 3, 4), 255, np.uint8) for s in soups]
+            )
+            if has_col
+            else None,
+            path=soups[0].path,
+        )
+
+    def to_trimesh(self):
+        """A ``trimesh.Trimesh`` of the geometry only (no processing, no merging)."""
+        import trimesh
+
+        return trimesh.Trimesh(self.vertices, self.faces, process=False, validate=False)
+
+    def __repr__(self) -> str:
+        name = f" {os.path.basename(self.path)!r}" if self.path else ""
+        return f"<Soup{name}: {self.n_faces} faces, {self.n_vertices} vertices, {self.n_parts} parts>"
+
+
+def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -> None:
+    """Raise :class:`ModelError` unless (vertices, faces) is a usable triangle soup.
+
+    Checks shape, emptiness, finite coordinates and index range.  ``path`` names the file
+    in the message.
+    """
+    vertices = np.asarray(vertices)
+    faces = np.asarray(faces)
+    if vertices.ndim != 2 or vertices.shape[1] != 3:
+        raise ModelError(f"vertices must have shape (n, 3), got {vertices.shape}", path)
+    if faces.ndim != 2 or faces.shape[1] != 3:
+        raise ModelError(f"faces must have shape (m, 3), got {faces.shape}", path)
+    if len(faces) == 0:
+        raise ModelError("the model has no faces", path)
+    if not np.issubdtype(faces.dtype, np.integer):
+        if not np.all(np.isfinite(faces)) or np.any(faces != np.round(faces)):
+            raise ModelError("face indices are not integers", path)
+    bad = ~np.isfinite(vertices).all(axis=1)
+    if bad.any():
+        used_bad = np.intersect1d(np.flatnonzero(bad), faces.ravel())
+        if len(used_bad):
+            raise ModelError(
+                f"{len(used_bad)} vertices used by faces have NaN or infinite coordinates "
+                f"(first: vertex {int(used_bad[0])})",
+                path,
+            )
+    lo, hi = int(faces.min()), int(faces.max())
+    if lo < 0:
+        raise ModelError(f"negative vertex index {lo} in the faces", path)
+    if hi >= len(vertices):
+        raise ModelError(f"vertex index {hi} is out of range (the model has {len(vertices)} vertices)", path)
+    used = vertices[np.unique(faces)]
+    if np.abs(used).max() > 1e300:
+        raise ModelError("coordinates too large to compute with (above 1e300)", path)
+
+
+def as_soup(model: Any, *, name: str | None = None) -> Soup:
+    """Coerce what users have into a validated :class:`Soup`.
+
+    Accepts a :class:`Soup`, a ``trimesh.Trimesh``, a ``trimesh.Scene``, a
+    ``(vertices, faces)`` pair, or a path (loaded with :func:`meshvis.io.load`).
+    """
+    if isinstance(model, Soup):
+        validate(model.vertices, model.faces, model.path)
+        return model
+    if isinstance(model, (str, os.PathLike)):
+        from .io import load
+
+        return load(model)
+    try:
+        import trimesh
+    except ImportError:  # pragma: no cover - trimesh is a dependency
+        trimesh = None
+    if trimesh is not None and isinstance(model, trimesh.Scene):
+        from .io import soup_from_scene
+
+        return soup_from_scene(model, path=name)
+    if trimesh is not None and isinstance(model, trimesh.Trimesh):
+        validate(model.vertices, model.faces, name)
+        return Soup(np.asarray(model.vertices), np.asarray(model.faces), path=name)
+    if isinstance(model, (tuple, list)) and len(model) == 2:
+        v, f = model
+        v, f = np.asarray(v), np.asarray(f)
+        validate(v, f, name)
+        return Soup(v, f.astype(np.int64), path=name)
+    raise ModelError(f"cannot use a {type(model).__name__} as a model", name)
