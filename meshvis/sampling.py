@@ -1,0 +1,113 @@
+"""Random and structured samples on triangles and hemispheres (pure numpy functions).
+
+All functions take an explicit ``numpy.random.Generator`` so that results depend only on
+the caller's seed.
+"""
+from __future__ import annotations
+
+import numpy as np
+
+
+def uniform_in_triangles(triangles: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """One uniform random point in each triangle.
+
+    Parameters
+    ----------
+    triangles : (n, 3, 3) corner coordinates
+    rng : numpy Generator
+
+    Returns
+    -------
+    (n, 3) points.  Uses the square-root warp: ``p = (1-√u) a + √u (1-v) b + √u v c``.
+    """
+    n = len(triangles)
+    u = np.sqrt(rng.random(n))
+    v = rng.random(n)
+    w0, w1, w2 = 1 - u, u * (1 - v), u * v
+    return w0[:, None] * triangles[:, 0] + w1[:, None] * triangles[:, 1] + w2[:, None] * triangles[:, 2]
+
+
+def cosine_hemisphere(normals: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+    """Cosine-distributed unit directions around each unit normal.
+
+    ``θ = arccos √ξ₁``, ``φ = 2π ξ₂`` (DESIGN.md §4): the density is ``cos θ / π``, so the
+    probability that a ray from a patch lands on another patch is their form factor
+    (appendix H, Eq. 2–4).
+
+    Parameters
+    ----------
+    normals : (n, 3) unit vectors
+    rng : numpy Generator
+
+    Returns
+    -------
+    (n, 3) unit directions with ``dot(d, normal) > 0``.
+    """
+    n = len(normals)
+    xi1, xi2 = rng.random(n), rng.random(n)
+    cos_t = np.sqrt(1.0 - xi1)  # same distribution as sqrt(xi1), but never exactly 0 at xi1=0
+    sin_t = np.sqrt(xi1)
+    phi = 2 * np.pi * xi2
+    t1, t2 = tangent_frames(normals)
+    d = (sin_t * np.cos(phi))[:, None] * t1 + (sin_t * np.sin(phi))[:, None] * t2 + cos_t[:, None] * normals
+    return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+
+def tangent_frames(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Two unit tangents per unit normal, forming a right-handed frame (branch-free).
+
+    Uses the construction of Duff et al. (2017), stable for every normal direction.
+    """
+    x, y, z = normals[:, 0], normals[:, 1], normals[:, 2]
+    sign = np.where(z >= 0, 1.0, -1.0)
+    a = -1.0 / (sign + z)
+    b = x * y * a
+    t1 = np.stack([1 + sign * x * x * a, sign * b, -sign * x], axis=1)
+    t2 = np.stack([b, sign + y * y * a, -y], axis=1)
+    return t1, t2
+
+
+def uniform_sphere(n: int, rng: np.random.Generator) -> np.ndarray:
+    """``n`` uniform unit directions."""
+    d = rng.normal(size=(n, 3))
+    return d / np.linalg.norm(d, axis=1, keepdims=True)
+
+
+def sample_scheme_barycentric(n_samples: int, scheme: int = 2, rng: np.random.Generator | None = None) -> np.ndarray:
+    """Barycentric coordinates of the sample points placed on each flagged triangle.
+
+    Appendix H §3.1 lists three schemes; the first two are implemented:
+
+    1. uniform samples over the triangle;
+    2. (default) uniform samples plus samples along the edges: the three edge midpoints
+       are always included, the rest is spread over the interior.
+
+    The pattern is the same for every triangle (deterministic, stratified), which keeps
+    the sample points of adjacent triangles apart from each other.
+
+    Returns
+    -------
+    (n_samples, 3) barycentric weights, each row summing to 1.
+    """
+    if n_samples < 1:
+        raise ValueError("n_samples must be at least 1")
+    if scheme not in (1, 2):
+        raise ValueError(f"sampling scheme must be 1 or 2, got {scheme}")
+    pts: list[np.ndarray] = []
+    inner = n_samples
+    if scheme == 2 and n_samples >= 4:
+        # edge samples, slightly inside so that they belong to this triangle only
+        e = 0.05
+        pts += [np.array([0.5 - e / 2, 0.5 - e / 2, e]), np.array([e, 0.5 - e / 2, 0.5 - e / 2]),
+                np.array([0.5 - e / 2, e, 0.5 - e / 2])]
+        inner = n_samples - 3
+    # interior: a low-discrepancy (Kronecker) sequence warped to the triangle
+    k = np.arange(inner) + 0.5
+    u = (k / inner) % 1.0
+    v = (k * 0.6180339887498949) % 1.0
+    su = np.sqrt(u)
+    inner_pts = np.stack([1 - su, su * (1 - v), su * v], axis=1)
+    if inner == 1:
+        inner_pts = np.array([[1 / 3, 1 / 3, 1 / 3]])
+    pts = pts + list(inner_pts)
+    return np.array(pts[:n_samples])

@@ -1,0 +1,127 @@
+"""Edge and terminal weights of the visibility graph (appendix H, Eq. 5–9).
+
+Notation: node *i* has area ``A_i`` and ``n_i`` counted rays, ``n_ij`` of which landed on
+node *j*.  ``T_ij = A_i n_ij / n_i`` is the power-exchange estimate from *i*'s rays.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+
+@dataclass
+class Weights:
+    """Symmetric edge weights and terminal weights, before and after filtering.
+
+    Attributes
+    ----------
+    edges_i, edges_j : (k,) int64, each undirected edge once (i < j)
+    w : (k,) float64, edge weight w(i, j) (Eq. 5)
+    w_out : (n,) float64, link to OUTSIDE (Eq. 7)
+    w_in : (n,) float64, link to INSIDE (``w_in(opp(i)) = w_o(i)`` plus hints)
+    cap_ij, cap_ji : (k,) float64, directed capacities after the cosine filter (Eq. 8–9)
+    cap_out, cap_in : (n,) float64, filtered terminal capacities
+    """
+
+    edges_i: np.ndarray
+    edges_j: np.ndarray
+    w: np.ndarray
+    w_out: np.ndarray
+    w_in: np.ndarray
+    cap_ij: np.ndarray
+    cap_ji: np.ndarray
+    cap_out: np.ndarray
+    cap_in: np.ndarray
+
+
+def edge_weights(hits: sp.spmatrix, counted: np.ndarray, area: np.ndarray, is_point: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Eq. 5: ``w(i,j) = ½ (A_i n_ij/n_i + A_j n_ji/n_j)``.
+
+    When exactly one end is a point node (a hit snapped to a sample point of an
+    intersected/coplanar triangle), only the term estimated from the other end's rays is
+    used: those rays start uniformly over their node, whereas a point node's rays all
+    start at one point (appendix H §3.2.2).  Self-links are dropped.
+
+    Returns
+    -------
+    i, j, w : each undirected edge once, with i < j
+    """
+    coo = sp.coo_matrix(hits)
+    r, c, n_ij = coo.row.astype(np.int64), coo.col.astype(np.int64), coo.data
+    off = r != c
+    r, c, n_ij = r[off], c[off], n_ij[off]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        t = np.where(counted[r] > 0, area[r] * n_ij / np.maximum(counted[r], 1), 0.0)
+    mixed = is_point[r] != is_point[c]
+    # a term from a point node towards a cluster node is dropped; the other one counts fully
+    factor = np.where(mixed, np.where(is_point[r], 0.0, 1.0), 0.5)
+    t = t * factor
+    lo, hi = np.minimum(r, c), np.maximum(r, c)
+    n = len(area)
+    key = lo * np.int64(n) + hi
+    uniq, inv = np.unique(key, return_inverse=True)
+    w = np.bincount(inv, t, minlength=len(uniq))
+    keep = w > 0
+    return (uniq // n)[keep], (uniq % n)[keep], w[keep]
+
+
+def outside_weights(escaped: np.ndarray, counted: np.ndarray, area: np.ndarray) -> np.ndarray:
+    """Eq. 7: ``w_o(i) = A_i (1 − Σ_j n_ij / n_i)`` = ``A_i × escaped_i / n_i``."""
+    return np.where(counted > 0, area * escaped / np.maximum(counted, 1), 0.0)
+
+
+def cosine_filter(w: np.ndarray, w_max: np.ndarray) -> np.ndarray:
+    """Eq. 9: ``½ (1 + cos(π − π w / w_max)) · w`` (0 where ``w_max`` is 0)."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(w_max > 0, w / w_max, 0.0)
+    return 0.5 * (1.0 + np.cos(np.pi - np.pi * np.clip(ratio, 0.0, 1.0))) * w
+
+
+def graph_weights(
+    hits: sp.spmatrix,
+    counted: np.ndarray,
+    escaped: np.ndarray,
+    area: np.ndarray,
+    opposite: np.ndarray,
+    is_point: np.ndarray,
+    *,
+    hint_out: np.ndarray | None = None,
+    hint_in: np.ndarray | None = None,
+    use_filter: bool = True,
+) -> Weights:
+    """All weights of the graph: Eq. 5, Eq. 7, ``w_in(opp(i)) = w_o(i)``, and the filter.
+
+    Parameters
+    ----------
+    hits : (n, n) sparse n_ij; counted : (n,) n_i; escaped : (n,) misses per node
+    area : (n,) A_i; opposite : (n,) opp(i); is_point : (n,) bool
+    hint_out, hint_in : (n,) extra terminal weights from user hints (appendix H §3.2.1)
+    use_filter : apply the directed cosine filter of Eq. 8–9
+
+    The filter is directed: node *i* scales every link it has by its own
+    ``w_max(i) = max(max_j w(i,j), w_o(i), w_in(i))`` (Eq. 8), so ``cap(i→j)`` and
+    ``cap(j→i)`` may differ.  Terminal links are filtered with the same ``w_max(i)``.
+    """
+    n = len(area)
+    i, j, w = edge_weights(hits, counted, area, is_point)
+    w_out = outside_weights(escaped, counted, area)
+    w_in = w_out[opposite].copy()
+    if hint_out is not None:
+        w_out = w_out + hint_out
+    if hint_in is not None:
+        w_in = w_in + hint_in
+    if not use_filter:
+        return Weights(i, j, w, w_out, w_in, w.copy(), w.copy(), w_out.copy(), w_in.copy())
+    w_max = np.maximum(w_out, w_in)
+    if len(w):
+        np.maximum.at(w_max, i, w)
+        np.maximum.at(w_max, j, w)
+    return Weights(
+        i, j, w, w_out, w_in,
+        cap_ij=cosine_filter(w, w_max[i]),
+        cap_ji=cosine_filter(w, w_max[j]),
+        cap_out=cosine_filter(w_out, w_max),
+        cap_in=cosine_filter(w_in, w_max),
+    )
