@@ -20,9 +20,11 @@ _LAZY = {
     "diagnose": "meshvis.diagnostics",
     "render": "meshvis.render",
     "classify": "meshvis.classify",
-    "orient": "meshvis.repair",
-    "remove_interior": "meshvis.repair",
-    "layers": "meshvis.repair",
+    "orient": "meshvis.orient",
+    "remove_interior": "meshvis.removal",
+    "layers": "meshvis.layers",
+    "Camera": "meshvis.camera",
+    "Hints": "meshvis.hints",
 }
 
 __all__ = [

@@ -12,6 +12,9 @@ import numpy as np
 
 from .errors import ParameterError
 
+#: unit vectors of the axis names accepted as "up"
+AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
 
 def _unit(v: np.ndarray) -> np.ndarray:
     n = np.linalg.norm(v)
@@ -27,7 +30,7 @@ class Camera:
     Parameters
     ----------
     position, target : (3,) float
-    up : (3,) float, approximate up direction (default +z)
+    up : (3,) float, approximate up direction (default +y, as in glTF and most OBJ files)
     fov : float, vertical field of view in degrees (perspective)
     orthographic : bool
     ortho_height : float, height of the view in model units (orthographic)
@@ -42,7 +45,7 @@ class Camera:
 
     position: Any
     target: Any
-    up: Any = field(default=(0.0, 0.0, 1.0))
+    up: Any = field(default=(0.0, 1.0, 0.0))
     fov: float = 35.0
     orthographic: bool = False
     ortho_height: float | None = None
@@ -123,23 +126,24 @@ class Camera:
         distance: float | None = None,
         fov: float = 35.0,
         orthographic: bool = False,
-        margin: float = 1.1,
-        up: Any = (0.0, 0.0, 1.0),
+        margin: float = 1.0,
+        up: Any = (0.0, 1.0, 0.0),
     ) -> "Camera":
         """A camera framing the model's bounding sphere.
 
-        ``azimuth`` turns around the up axis (0 looks along +y from -y), ``elevation`` lifts
-        the camera above the horizon; both in degrees.  ``distance`` defaults to the distance
+        ``azimuth`` turns around the up axis, ``elevation`` lifts the camera above the
+        horizon; both in degrees.  ``distance`` defaults to the distance
         at which the bounding sphere (times ``margin``) fills the view.
         """
         bounds = _bounds_of(model)
         center = bounds.mean(axis=0)
         radius = 0.5 * float(np.linalg.norm(bounds[1] - bounds[0])) or 1.0
         up = _unit(np.asarray(up, np.float64))
-        # a horizontal frame orthogonal to up
-        ref = np.array([0.0, 1.0, 0.0]) if abs(up[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+        # a horizontal frame orthogonal to up; azimuth 0 views the model's "front": from +z
+        # for y-up models (glTF, most OBJ), from -y for z-up models (CAD, STL)
+        ref = np.array([0.0, 0.0, 1.0]) if abs(up[2]) < 0.9 else np.array([0.0, -1.0, 0.0])
         e1 = _unit(ref - np.dot(ref, up) * up)
-        e2 = np.cross(e1, up)
+        e2 = np.cross(up, e1)
         az, el = np.radians(azimuth), np.radians(elevation)
         view = np.cos(el) * (np.cos(az) * e1 + np.sin(az) * e2) + np.sin(el) * up  # from target to camera
         if distance is None:

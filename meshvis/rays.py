@@ -115,14 +115,16 @@ class RayCaster:
     @staticmethod
     def _unit_dirs(directions: np.ndarray) -> np.ndarray:
         d = np.asarray(directions, np.float64)
-        return d / np.linalg.norm(d, axis=1, keepdims=True)
+        return d / np.sqrt(np.einsum("ij,ij->i", d, d))[:, None]
 
     # ------------------------------------------------------------------ raw calls
     def _run(self, o32: np.ndarray, d32: np.ndarray, query: str, dists: np.ndarray | None = None) -> Any:
         """One Embree query over a batch, split over threads when it is large."""
         n = len(o32)
         if n == 0:
-            return {"primID": np.zeros(0, np.int32), "tfar": np.zeros(0, np.float32)} if query == "INTERSECT" else np.zeros(0, np.int32)
+            if query == "INTERSECT":
+                return {"primID": np.zeros(0, np.int32), "tfar": np.zeros(0, np.float32), "Ng": np.zeros((0, 3), np.float32)}
+            return np.zeros(0, np.int32)
 
         def call(sl: slice) -> Any:
             kw = {} if dists is None else {"dists": np.ascontiguousarray(dists[sl])}
@@ -131,28 +133,31 @@ class RayCaster:
             return self._scene.run(np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), query=query, **kw)
 
         if self.threads == 1 or n < 2 * CHUNK:
-            parts = [call(slice(0, n))]
-        else:
-            k = max(self.threads, -(-n // (4 * CHUNK)) * self.threads)
-            bounds = np.linspace(0, n, k + 1).astype(int)
-            slices = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
-            with ThreadPoolExecutor(self.threads) as pool:
-                parts = list(pool.map(call, slices))
+            return call(slice(0, n))
+        k = max(self.threads, -(-n // (4 * CHUNK)) * self.threads)
+        bounds = np.linspace(0, n, k + 1).astype(int)
+        slices = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+        with ThreadPoolExecutor(self.threads) as pool:
+            parts = list(pool.map(call, slices))
         if query == "INTERSECT":
             return {
                 "primID": np.concatenate([p["primID"] for p in parts]),
                 "tfar": np.concatenate([p["tfar"] for p in parts]),
+                "Ng": np.concatenate([p["Ng"] for p in parts]),
             }
         return np.concatenate(parts)
 
     # ------------------------------------------------------------------ public queries
-    def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: np.ndarray | float | None = None) -> Hits:
+    def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: np.ndarray | float | None = None,
+                  *, exact_distance: bool = False) -> Hits:
         """First hit of every ray ``origins + t * directions``, ``0 <= t <= max_distance``.
 
         Parameters
         ----------
         origins, directions : (n, 3) float arrays in input coordinates (directions need not be unit)
         max_distance : optional float or (n,) array, in input units
+        exact_distance : recompute each distance in float64 on the hit triangle's plane
+            (otherwise it carries float32 round-off, about 1e-7 of the diagonal)
 
         Returns
         -------
@@ -167,19 +172,19 @@ class RayCaster:
         r = self._run(self.to_unit(origins), d.astype(np.float32), "INTERSECT", dists)
         face = r["primID"].astype(np.int64)
         hit = face >= 0
-        distance = np.full(len(face), np.inf)
-        distance[hit] = r["tfar"][hit].astype(np.float64) / self.scale
-        side = np.full(len(face), -1, np.int8)
-        n_hit = self.normals[face[hit]]
-        dots = np.einsum("ij,ij->i", d[hit], n_hit)
-        side[hit] = (dots >= 0).astype(np.int8)
-        # Refine the float32 distance in float64 on the hit triangle's plane, so distances
-        # are as exact in input units as the input itself (not grazing hits: keep Embree's).
-        v0 = self.soup.vertices[self.soup.faces[face[hit], 0]]
-        steep = np.abs(dots) > 1e-3
-        t_plane = np.einsum("ij,ij->i", n_hit, v0 - origins[hit])[steep] / dots[steep]
-        idx = np.flatnonzero(hit)[steep]
-        distance[idx] = np.maximum(t_plane, 0.0)
+        distance = np.where(hit, r["tfar"] / self.scale, np.inf)
+        # side from Embree's geometric normal, which points like ours (counter-clockwise)
+        dots = np.einsum("ij,ij->i", d, r["Ng"])
+        side = np.where(hit, dots >= 0, -1).astype(np.int8)
+        if exact_distance and hit.any():
+            # Refine in float64 on the hit triangle's plane (not for grazing hits).
+            idx = np.flatnonzero(hit)
+            n_hit = self.normals[face[idx]]
+            cosine = np.einsum("ij,ij->i", d[idx], n_hit)
+            v0 = self.soup.vertices[self.soup.faces[face[idx], 0]]
+            steep = np.abs(cosine) > 1e-3
+            t_plane = np.einsum("ij,ij->i", n_hit[steep], v0[steep] - origins[idx[steep]]) / cosine[steep]
+            distance[idx[steep]] = np.maximum(t_plane, 0.0)
         return Hits(face, distance, side)
 
     def occluded(self, origins: np.ndarray, targets: np.ndarray) -> np.ndarray:

@@ -1,0 +1,59 @@
+"""``meshvis bench rays|classify|accuracy|stability|labeling``: reproducible measurements."""
+from __future__ import annotations
+
+import argparse
+import json
+
+from cli.common import positive_int, say, write_json
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("bench", help="benchmarks (speed as ratios measured in one run)")
+    bs = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
+
+    r = bs.add_parser("rays", help="ray backend throughput next to raw embreex, threads vs processes")
+    r.add_argument("model")
+    r.add_argument("--rays", type=positive_int, default=1_000_000)
+    r.add_argument("--repeat", type=positive_int, default=3)
+    r.add_argument("--json", metavar="FILE", help="also write the numbers as JSON")
+    r.set_defaults(func=run_rays)
+
+    c = bs.add_parser("classify", help="per-stage times of the classification on large models")
+    c.add_argument("models", nargs="*", help="models (default: the monastery and the skin + ribcage)")
+    c.add_argument("--rays-per-node", type=positive_int, default=32)
+    c.add_argument("--seed", type=int, default=0)
+    c.add_argument("--json", metavar="FILE")
+    c.set_defaults(func=run_classify)
+
+    for name in ("accuracy", "stability", "labeling", "compare"):
+        try:
+            mod = __import__(f"meshvis.bench.{name}", fromlist=["add_arguments"]) if name != "labeling" \
+                else __import__("labeling.bench", fromlist=["add_arguments"])
+        except ModuleNotFoundError:
+            continue
+        if hasattr(mod, "add_arguments"):
+            q = bs.add_parser(name, help=(mod.__doc__ or "").strip().splitlines()[0])
+            mod.add_arguments(q)
+            q.set_defaults(func=lambda a, m=mod: m.main(a))
+    p.set_defaults(func=lambda a: (p.print_help(), 2)[1])
+
+
+def run_rays(args: argparse.Namespace) -> int:
+    from meshvis.bench import rays
+    from meshvis.io import load
+
+    r = rays.run(load(args.model), n_rays=args.rays, repeat=args.repeat)
+    print(rays.format(r))
+    if args.json:
+        write_json(args.json, r)
+    return 0
+
+
+def run_classify(args: argparse.Namespace) -> int:
+    from meshvis.bench import classify as bc
+
+    results = bc.run(args.models or None, rays_per_node=args.rays_per_node, seed=args.seed)
+    print(bc.format(results))
+    if args.json:
+        write_json(args.json, results)
+    return 0

@@ -1,0 +1,42 @@
+"""``meshvis render MODEL -o PICTURE.png``: a shaded preview through the ray backend."""
+from __future__ import annotations
+
+import argparse
+
+from cli.common import check_output, positive_int, say
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("render", help="render a shaded preview image (front sides blue, back sides orange)")
+    p.add_argument("input", help="input model")
+    p.add_argument("-o", "--output", required=True, help="PNG file to write")
+    p.add_argument("--color-by", choices=("side", "part", "layer", "none"), default="side",
+                   help="side: front blue / back orange (default); part; layer (runs the layer peeling)")
+    p.add_argument("--azimuth", type=float, default=30.0, help="degrees around the up axis (default 30)")
+    p.add_argument("--elevation", type=float, default=20.0, help="degrees above the horizon (default 20)")
+    p.add_argument("--up", choices=("x", "y", "z"), default="y", help="the model's up axis (default y)")
+    p.add_argument("--size", type=positive_int, nargs=2, default=(512, 512), metavar=("W", "H"))
+    p.add_argument("--seed", type=int, default=0, help="seed of the layer peeling (--color-by layer)")
+    p.add_argument("--force", action="store_true", help="overwrite an existing output")
+    p.add_argument("--quiet", "-q", action="store_true")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from meshvis.camera import AXES, Camera
+    from meshvis.io import load
+    from meshvis.render import render, save_png
+
+    check_output(args.output, [args.input], args.force)
+    soup = load(args.input)
+    values = None
+    color_by = None if args.color_by == "none" else args.color_by
+    if color_by == "layer":
+        from meshvis.layers import layers
+
+        values = layers(soup, seed=args.seed).layer
+    camera = Camera.fit(soup, azimuth=args.azimuth, elevation=args.elevation, up=AXES[args.up])
+    r = render(soup, camera, size=tuple(args.size), color_by=color_by, face_values=values)
+    save_png(r.image, args.output)
+    say(args, f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {int((r.face >= 0).sum())} model pixels)")
+    return 0

@@ -1,0 +1,2 @@
+"""Benchmarks behind ``meshvis bench``: each module has a ``run(...)`` returning a dict and a
+``format(result)`` returning text.  Times are compared as ratios measured in one run."""

@@ -1,0 +1,172 @@
+"""Normal orientation (appendix H §5, "Normal Orientation").
+
+Every face whose sides got exactly one outside label (or whose sample points agree) is
+turned so that its front faces the outside.  The other cases are decided by options:
+
+* two-sided faces (both sides outside: sheets, leaves): ``keep`` as they are (default),
+  ``duplicate`` (emit both orientations) or ``strongest`` (the side with the larger
+  escaping ray share, i.e. outside weight per area, Eq. 7, wins);
+* hidden faces (both sides inside): oriented by the layer they belong to — layer
+  semantics (DESIGN.md §4): each shell faces outward with respect to its layer; with
+  ``semantics="cavity"``, shells of even layers face inward instead (a solid with voids);
+* flagged faces whose sample points disagree: by area ``majority`` (default) or
+  ``duplicate``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from .classify import Classification, classify
+from .errors import ParameterError
+from .layers import LayerResult, layers
+from .soup import Soup
+
+# status codes per input face
+ONE_SIDED, TWO_SIDED, HIDDEN, CONFLICT, DEGENERATE = 0, 1, 2, 3, 4
+STATUS_NAMES = ("one-sided", "two-sided", "hidden", "conflict", "degenerate")
+
+
+@dataclass
+class OrientResult:
+    """Result of :func:`orient`.
+
+    Attributes
+    ----------
+    soup : the oriented output soup (input faces, some flipped, plus any duplicates)
+    source : (k,) int64, input face of every output face
+    flipped : (m,) bool, input faces written turned over
+    duplicated : (m,) bool, input faces written in both orientations
+    status : (m,) int8, one of ``STATUS_NAMES`` per input face
+    """
+
+    soup: Soup
+    source: np.ndarray
+    flipped: np.ndarray
+    duplicated: np.ndarray
+    status: np.ndarray
+    classification: Classification
+    layers: LayerResult | None
+
+    def report(self, per_face: bool = True) -> dict:
+        counts = np.bincount(self.status, minlength=len(STATUS_NAMES))
+        d = {
+            "input_faces": int(len(self.status)),
+            "output_faces": int(self.soup.n_faces),
+            "flipped": int(self.flipped.sum()),
+            "duplicated": int(self.duplicated.sum()),
+            "status_counts": {n: int(c) for n, c in zip(STATUS_NAMES, counts)},
+            "classification": self.classification.report(per_face=False),
+        }
+        if self.layers is not None:
+            d["layers"] = self.layers.report(per_face=False)
+        else:
+            d["layers"] = "skipped: no hidden faces"
+        if per_face:
+            d["per_face"] = {"flipped": self.flipped, "duplicated": self.duplicated, "status": self.status,
+                             "outside_front": self.classification.outside[:, 0],
+                             "outside_back": self.classification.outside[:, 1]}
+        return d
+
+
+def _check(name: str, value: str, allowed: tuple[str, ...]) -> None:
+    if value not in allowed:
+        raise ParameterError(f"{name} must be one of {', '.join(allowed)}; got {value!r}")
+
+
+def strongest_side(c: Classification) -> np.ndarray:
+    """(m,) side (0/1) with the larger escaping share ``w_o / A`` (Eq. 7), per face."""
+    w = c.graph.weights.w_out / np.maximum(c.nodes.area, 1e-300)
+    return (c.face_labels_from(w)[:, 1] > c.face_labels_from(w)[:, 0]).astype(np.int8)
+
+
+def orient(
+    model: Any,
+    *,
+    front: str = "ccw",
+    two_sided: str = "keep",
+    semantics: str = "layer",
+    conflicts: str = "majority",
+    classification: Classification | None = None,
+    **classify_kw: Any,
+) -> OrientResult:
+    """Turn every face so that its front side faces the outside.
+
+    Parameters
+    ----------
+    model : anything :func:`meshvis.classify` accepts
+    front : "ccw" (counter-clockwise front, the usual convention) or "cw"
+    two_sided : "keep", "duplicate" or "strongest" (see module docstring)
+    semantics : "layer" (default) or "cavity" for hidden shells
+    conflicts : "majority" or "duplicate" for flagged faces whose sample points disagree
+    classification : reuse an existing classification of the same model
+    **classify_kw : passed to :func:`meshvis.classify`
+
+    Returns
+    -------
+    OrientResult
+
+    Examples
+    --------
+    >>> import trimesh, numpy as np
+    >>> m = trimesh.creation.icosphere(2); f = m.faces.copy(); f[::3] = f[::3, ::-1]
+    >>> r = orient((m.vertices, f), seed=0)
+    >>> int(r.flipped.sum()) == len(f[::3])
+    True
+    """
+    _check("front", front, ("ccw", "cw"))
+    _check("two_sided", two_sided, ("keep", "duplicate", "strongest"))
+    _check("semantics", semantics, ("layer", "cavity"))
+    _check("conflicts", conflicts, ("majority", "duplicate"))
+    c = classification or classify(model, **classify_kw)
+    soup = c.soup
+    m = soup.n_faces
+    o = c.outside
+    out0, out1 = o[:, 0] > 0, o[:, 1] > 0
+    full0, full1 = o[:, 0] >= 1, o[:, 1] >= 1
+    agree = (np.isin(o[:, 0], (0.0, 1.0))) & (np.isin(o[:, 1], (0.0, 1.0)))
+
+    status = np.full(m, ONE_SIDED, np.int8)
+    status[agree & full0 & full1] = TWO_SIDED
+    status[~out0 & ~out1] = HIDDEN
+    status[~agree & (out0 | out1)] = CONFLICT
+    status[c.degenerate] = DEGENERATE
+
+    outer = np.zeros(m, np.int8)  # side that should become the front
+    outer[(status == ONE_SIDED) & full1] = 1
+    conflict = status == CONFLICT
+    outer[conflict] = (o[conflict, 1] > o[conflict, 0]).astype(np.int8)
+    if two_sided == "strongest":
+        ts = status == TWO_SIDED
+        outer[ts] = strongest_side(c)[ts]
+
+    lay = None
+    hidden = status == HIDDEN
+    if hidden.any():
+        lay = layers(soup, classification=c)
+        side = lay.outer_side[hidden]
+        side = np.where(side == 2, 0, side)  # two-sided at its layer: keep
+        side = np.where(side < 0, 0, side)  # unreached: keep
+        outer[hidden] = side
+        if semantics == "cavity":
+            even = hidden & (lay.layer % 2 == 0)
+            outer[even] = 1 - outer[even]
+
+    flip = outer == 1
+    if front == "cw":
+        flip = ~flip
+    dup = np.zeros(m, bool)
+    if two_sided == "duplicate":
+        dup |= status == TWO_SIDED
+    if conflicts == "duplicate":
+        dup |= conflict
+    keep_as_is = (status == TWO_SIDED) & (two_sided == "keep") | (status == DEGENERATE)
+    flip[keep_as_is] = False  # kept two-sided and degenerate faces are written untouched
+
+    extra = np.flatnonzero(dup)
+    source = np.concatenate([np.arange(m), extra])
+    out_flip = np.concatenate([flip, ~flip[extra]])
+    out = soup.subset(source).flipped(out_flip)
+    return OrientResult(out, source, flip, dup, status, c, lay)
