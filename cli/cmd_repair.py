@@ -19,8 +19,8 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     p.add_argument("--preview", metavar="PICTURE.png", help="write a ray-cast preview image")
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--rays-per-node", type=positive_int, default=32, help="ray budget per node (default 32)")
-    p.add_argument("--samples-per-face", type=positive_int, default=7,
-                   help="sample points per intersecting/coplanar face (default 7)")
+    p.add_argument("--samples-per-face", type=positive_int, default=4,
+                   help="sample points per intersecting/coplanar face (default 4)")
     p.add_argument("--no-filter", action="store_true", help="switch off the cosine filter (Eq. 8-9)")
     p.add_argument("--no-progressive", action="store_true", help="cast the whole ray budget in one round")
     p.add_argument("--solver", choices=("pymaxflow", "scipy"), default="pymaxflow")

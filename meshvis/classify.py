@@ -5,10 +5,12 @@ Pipeline (DESIGN.md §4)::
     soup → preprocess (flags, welding, clusters) → half-space nodes → visibility sampling
          → weights (Eq. 5–9) → s-t min cut → per-(face, side) labels
 
-Sampling is *progressive*: rays are cast in rounds (each round doubles the rays per node)
-and the loop stops as soon as a round changes the labels of less than ``tolerance`` of the
-total area, or when the ray budget ``rays_per_node`` is spent.  A clean closed model
-stops after two small rounds.  Stages a model does not need (point nodes when nothing is
+Sampling is *progressive*: rays are cast in rounds and the loop stops as soon as a round
+changes the labels of less than ``tolerance`` of the total area, or when the ray budget
+``rays_per_node`` is spent.  The first two rounds sample every node; later rounds double
+the rays of the undecided nodes only — those whose label changed in the last round and
+those on the cut (linked to a node of the other label) — in the spirit of adaptive
+global visibility sampling (AGVS).  A clean closed model stops after two small rounds.  Stages a model does not need (point nodes when nothing is
 flagged, hint rays without hints) are skipped, and the result says so.
 """
 from __future__ import annotations
@@ -189,7 +191,7 @@ def classify(
     rays_per_node: int = 32,
     seed: int = 0,
     hints: Hints | dict | None = None,
-    samples_per_face: int = 7,
+    samples_per_face: int = 4,
     sampling_scheme: int = 2,
     use_filter: bool = True,
     progressive: bool = True,
@@ -275,17 +277,17 @@ def classify(
     counts = VisibilityCounts(nodes.n)
     is_point = nodes.is_point
     rounds: list[dict] = []
-    prev = None
-    per_round = min(FIRST_ROUND_RAYS, rays_per_node) if progressive else rays_per_node
-    spent = 0
+    budget = ray_allocation(nodes, rays_per_node)
+    cast = np.zeros(nodes.n, np.int64)
+    give = ray_allocation(nodes, min(FIRST_ROUND_RAYS, rays_per_node) if progressive else rays_per_node)
+    prev = prev_nodes = None
     t_sample = t_cut = 0.0
     stop_reason = "single round"
     while True:
         t = time.perf_counter()
-        report("sampling", spent / rays_per_node)
-        alloc = ray_allocation(nodes, per_round)
-        sample_round(caster, nodes, alloc, rng, counts)
-        spent += per_round
+        report("sampling", float(cast.sum()) / max(float(budget.sum()), 1.0))
+        sample_round(caster, nodes, give, rng, counts)
+        cast += give
         t_sample += time.perf_counter() - t
 
         t = time.perf_counter()
@@ -297,21 +299,32 @@ def classify(
         labels = face_labels(nodes, cut.outside, soup.n_faces, pre.degenerate)
         t_cut += time.perf_counter() - t
 
-        changed = np.nan if prev is None else float(
+        changed = None if prev is None else float(
             (np.abs(labels - prev).sum(axis=1) * soup.areas).sum() / max(2 * soup.total_area, 1e-300)
         )
-        rounds.append({"rays_per_node": spent, "rays": int(counts.rays), "edges": graph.n_edges,
-                       "changed_area_fraction": None if prev is None else changed})
-        prev = labels
+        rounds.append({"rays": int(counts.rays), "nodes_sampled": int((give > 0).sum()),
+                       "edges": graph.n_edges, "changed_area_fraction": changed})
         if not progressive:
             break
-        if len(rounds) > 1 and changed <= tolerance:
+        if changed is not None and changed <= tolerance:
             stop_reason = f"converged after {len(rounds)} rounds (change {changed:.2e} <= {tolerance:g})"
             break
-        if spent >= rays_per_node:
+        # Next round: double the rays of the nodes that are still undecided.  After the
+        # first round every node is undecided; later only nodes whose label changed and
+        # nodes on the cut (an edge to a node of the other label) get more rays.
+        if prev_nodes is None:
+            active = np.ones(nodes.n, bool)
+        else:
+            active = cut.outside != prev_nodes
+            w = graph.weights
+            across = cut.outside[w.edges_i] != cut.outside[w.edges_j]
+            active[w.edges_i[across]] = True
+            active[w.edges_j[across]] = True
+        give = np.where(active, np.minimum(cast, budget - cast), 0)
+        prev, prev_nodes = labels, cut.outside
+        if give.sum() == 0:
             stop_reason = f"ray budget reached after {len(rounds)} rounds"
             break
-        per_round = min(spent, rays_per_node - spent)  # doubles the total each round
 
     stages.append(Stage("sampling", True, t_sample, f"{counts.rays} rays + {counts.reverse_rays} reverse; {stop_reason}"))
     stages.append(Stage("cut", True, t_cut, f"{graph.n_edges} edges, solver {cut.solver}, filter {'on' if use_filter else 'off'}"))

@@ -67,13 +67,15 @@ def manifold_face_pairs(table: EdgeTable) -> tuple[np.ndarray, np.ndarray, np.nd
     return f[keep], g[keep], consistent[keep]
 
 
-def cluster_sides(table: EdgeTable, clusterable: np.ndarray) -> Clustering:
+def cluster_sides(table: EdgeTable, clusterable: np.ndarray, joinable: np.ndarray | None = None) -> Clustering:
     """Cluster the sides of the clusterable faces into half-space nodes.
 
     Parameters
     ----------
     table : EdgeTable of the welded faces (adjacency only; the model is not changed)
-    clusterable : (m,) bool, faces that may join clusters (not flagged, not degenerate)
+    clusterable : (m,) bool, faces that get cluster nodes (not flagged, not degenerate)
+    joinable : (m,) bool, faces that may be joined to others across an edge (default: all
+        clusterable ones); a clusterable face that is not joinable is a single-face cluster
 
     Returns
     -------
@@ -81,7 +83,8 @@ def cluster_sides(table: EdgeTable, clusterable: np.ndarray) -> Clustering:
     """
     m = len(clusterable)
     f, g, consistent = manifold_face_pairs(table)
-    ok = clusterable[f] & clusterable[g]
+    join = clusterable if joinable is None else clusterable & joinable
+    ok = join[f] & join[g]
     f, g, consistent = f[ok], g[ok], consistent[ok]
 
     def components(f: np.ndarray, g: np.ndarray, consistent: np.ndarray) -> np.ndarray:

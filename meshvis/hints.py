@@ -91,8 +91,7 @@ def hint_weights(caster: RayCaster, nodes: NodeSet, hints: Hints, rng: np.random
             dst = nodes.side_node[f, s]
             flag = dst < 0
             if flag.any():
-                pts = origins[hit][flag] + dirs[hit][flag] * h.distance[hit][flag, None]
-                dst[flag] = nodes.point_node(snap_to_points(nodes, f[flag], pts), s[flag])
+                dst[flag] = nodes.point_node(snap_to_points(nodes, f[flag], h.bary[hit][flag]), s[flag])
             w = np.bincount(dst, minlength=nodes.n) * (hints.strength * total_area / hints.rays)
         out.append(w)
     return out[0], out[1], n_cast

@@ -40,6 +40,9 @@ class NodeSet:
     point_pos : (P, 3) float64, sample point on its face
     point_origin : (P, 2, 3) float64, ray origin of each side, pushed off the surface
     flagged_index : (m,) int64, position of a face in ``flagged`` or -1
+    sample_bary : (samples, 3) barycentric pattern of the sample points (same on every face)
+    flagged_metric : (k, 3) float64, per flagged face ``(e1·e1, e1·e2, e2·e2)`` with
+        ``e1 = b - a``, ``e2 = c - a``: the metric of its barycentric coordinates
     """
 
     n: int
@@ -59,6 +62,8 @@ class NodeSet:
     point_pos: np.ndarray
     point_origin: np.ndarray
     flagged_index: np.ndarray
+    sample_bary: np.ndarray
+    flagged_metric: np.ndarray
 
     @property
     def n_points(self) -> int:
@@ -87,7 +92,7 @@ def build_nodes(
     flagged: np.ndarray,
     partner_pairs: np.ndarray,
     *,
-    samples: int = 7,
+    samples: int = 4,
     scheme: int = 2,
     offset: float,
     proximity: float,
@@ -133,6 +138,10 @@ def build_nodes(
         origin[:, s] = _pushed_origins(pos, point_face, s, triangles, normals, flagged_index,
                                        partner_pairs, samples, offset, proximity)
 
+    tf = triangles[flagged_faces]
+    e1, e2 = tf[:, 1] - tf[:, 0], tf[:, 2] - tf[:, 0]
+    metric = np.stack([np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2),
+                       np.einsum("ij,ij->i", e2, e2)], axis=1)
     p_area = np.repeat(areas[flagged_faces] / samples, samples)
     n_points = len(point_face)
     n = n_cluster + 2 * n_points
@@ -143,7 +152,8 @@ def build_nodes(
         n=n, n_cluster=n_cluster, area=area, opposite=opposite, n_faces=n_faces, side_node=side_node,
         entry_node=e_node, entry_face=e_face, entry_side=e_side, entry_cumarea=np.cumsum(areas[e_face]),
         node_start=node_start, flagged=flagged_faces, samples=samples, point_face=point_face,
-        point_pos=pos, point_origin=origin, flagged_index=flagged_index,
+        point_pos=pos, point_origin=origin, flagged_index=flagged_index, sample_bary=bary,
+        flagged_metric=metric,
     )
 
 

@@ -26,8 +26,9 @@ class Preprocessed:
     Attributes
     ----------
     intersects, coplanar, too_close, degenerate, flagged : (m,) bool
-        ``flagged`` = (intersects | coplanar | too_close) and not degenerate: these faces
-        get sample-point nodes instead of joining a cluster.
+        ``flagged`` = (intersects | coplanar) and not degenerate: these faces get
+        sample-point nodes.  ``too_close`` faces only may not join a cluster across an
+        edge (appendix H §2, edge flag rule 4): each is its own single-face cluster.
     partner_pairs : (k, 2) int64, the face pairs behind the flags
     clustering : Clustering
     faces_welded : (m, 3) int64
@@ -55,9 +56,9 @@ def preprocess(soup: Soup, *, eps: float | None = None, weld_tol: float = WELD_T
     _, faces_welded = weld(soup.vertices, soup.faces, weld_tol)
     flags = intersection_flags(soup.vertices, soup.faces, eps, faces_welded=faces_welded)
     degenerate = degenerate_faces(soup.vertices, soup.faces, tol=DEGENERATE_TOL) | (soup.areas <= 0)
-    flagged = (flags["intersects"] | flags["coplanar"] | flags["too_close"]) & ~degenerate
+    flagged = (flags["intersects"] | flags["coplanar"]) & ~degenerate
     pairs = np.concatenate([flags["intersect_pairs"], flags["coplanar_pairs"], flags["close_pairs"]]).astype(np.int64)
-    clustering = cluster_sides(edges(faces_welded), ~flagged & ~degenerate)
+    clustering = cluster_sides(edges(faces_welded), ~flagged & ~degenerate, ~flags["too_close"])
     return Preprocessed(
         intersects=flags["intersects"], coplanar=flags["coplanar"], too_close=flags["too_close"],
         degenerate=degenerate, flagged=flagged, partner_pairs=pairs.reshape(-1, 2),

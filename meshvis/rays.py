@@ -48,11 +48,14 @@ class Hits:
     face : (n,) int64, index of the face hit, -1 for a miss
     distance : (n,) float64, distance along the (unit) direction, ``inf`` for a miss
     side : (n,) int8, 0 when the ray hit the front (counter-clockwise) side, 1 the back, -1 miss
+    bary : (n, 2) float32, barycentric coordinates (u, v) of the hit on its face: the point
+        is ``(1-u-v) a + u b + v c`` for the face's corners (a, b, c)
     """
 
     face: np.ndarray
     distance: np.ndarray
     side: np.ndarray
+    bary: np.ndarray | None = None
 
     @property
     def hit(self) -> np.ndarray:
@@ -123,7 +126,8 @@ class RayCaster:
         n = len(o32)
         if n == 0:
             if query == "INTERSECT":
-                return {"primID": np.zeros(0, np.int32), "tfar": np.zeros(0, np.float32), "Ng": np.zeros((0, 3), np.float32)}
+                return {"primID": np.zeros(0, np.int32), "tfar": np.zeros(0, np.float32), "Ng": np.zeros((0, 3), np.float32),
+                        "u": np.zeros(0, np.float32), "v": np.zeros(0, np.float32)}
             return np.zeros(0, np.int32)
 
         def call(sl: slice) -> Any:
@@ -144,6 +148,8 @@ class RayCaster:
                 "primID": np.concatenate([p["primID"] for p in parts]),
                 "tfar": np.concatenate([p["tfar"] for p in parts]),
                 "Ng": np.concatenate([p["Ng"] for p in parts]),
+                "u": np.concatenate([p["u"] for p in parts]),
+                "v": np.concatenate([p["v"] for p in parts]),
             }
         return np.concatenate(parts)
 
@@ -172,7 +178,8 @@ class RayCaster:
         r = self._run(self.to_unit(origins), d.astype(np.float32), "INTERSECT", dists)
         face = r["primID"].astype(np.int64)
         hit = face >= 0
-        distance = np.where(hit, r["tfar"] / self.scale, np.inf)
+        distance = np.full(len(face), np.inf)
+        distance[hit] = r["tfar"][hit] / self.scale
         # side from Embree's geometric normal, which points like ours (counter-clockwise)
         dots = np.einsum("ij,ij->i", d, r["Ng"])
         side = np.where(hit, dots >= 0, -1).astype(np.int8)
@@ -185,7 +192,7 @@ class RayCaster:
             steep = np.abs(cosine) > 1e-3
             t_plane = np.einsum("ij,ij->i", n_hit[steep], v0[steep] - origins[idx[steep]]) / cosine[steep]
             distance[idx[steep]] = np.maximum(t_plane, 0.0)
-        return Hits(face, distance, side)
+        return Hits(face, distance, side, np.stack([r["u"], r["v"]], axis=1))
 
     def occluded(self, origins: np.ndarray, targets: np.ndarray) -> np.ndarray:
         """True where the open segment ``origins -> targets`` meets geometry.

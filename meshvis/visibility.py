@@ -41,12 +41,22 @@ class VisibilityCounts:
             self.discarded = np.zeros(self.n, np.int64)
 
 
-def snap_to_points(nodes: NodeSet, face: np.ndarray, points: np.ndarray) -> np.ndarray:
-    """Index of the sample point of ``face`` (a flagged face) nearest to each hit point."""
+def snap_to_points(nodes: NodeSet, face: np.ndarray, bary: np.ndarray) -> np.ndarray:
+    """Index of the sample point of ``face`` (a flagged face) nearest to each hit.
+
+    Hits are given by their barycentric coordinates ``(u, v)`` on the face.  Every flagged
+    face carries the same barycentric sample pattern, so the squared 3D distance to sample
+    *k* is the quadratic form ``Δᵀ G Δ`` of the barycentric difference Δ = (u-u_k, v-v_k)
+    with the face's metric tensor ``G`` (dot products of its two edge vectors): no 3D
+    coordinates need to be gathered.
+    """
     q = nodes.flagged_index[face]
-    cand = q[:, None] * nodes.samples + np.arange(nodes.samples)  # (n, K)
-    d2 = ((nodes.point_pos[cand] - points[:, None, :]) ** 2).sum(axis=2)
-    return cand[np.arange(len(face)), np.argmin(d2, axis=1)]
+    g = nodes.flagged_metric[q]  # (n, 3): e1·e1, e1·e2, e2·e2
+    pattern = nodes.sample_bary[:, 1:]  # (K, 2): weights of corners b and c
+    du = bary[:, 0:1] - pattern[None, :, 0]
+    dv = bary[:, 1:2] - pattern[None, :, 1]
+    d2 = g[:, 0:1] * du * du + 2 * g[:, 1:2] * du * dv + g[:, 2:3] * dv * dv
+    return q * nodes.samples + np.argmin(d2, axis=1)
 
 
 def sample_round(
@@ -92,8 +102,7 @@ def sample_round(
         on_flagged = dst < 0
         if on_flagged.any():
             idx = np.flatnonzero(on_flagged)
-            pts = origins[hit][idx] + dirs[hit][idx] * h.distance[hit][idx, None]
-            p = snap_to_points(nodes, f[idx], pts)
+            p = snap_to_points(nodes, f[idx], h.bary[hit][idx])
             t0 = time.perf_counter()
             blocked = caster.occluded(nodes.point_origin[p, s[idx]], origins[hit][idx])
             counts.time_embree += time.perf_counter() - t0
