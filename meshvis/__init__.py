@@ -10,6 +10,7 @@ __version__ = "0.1.0"
 
 from .errors import MeshvisError, ModelError, ModelFormatError, OutputError, ParameterError  # noqa: E402
 from .soup import Soup, as_soup  # noqa: E402
+from .render import render  # noqa: E402  (eager: the function shadows its module's name)
 
 # name -> module that defines it
 _LAZY = {
@@ -18,17 +19,16 @@ _LAZY = {
     "RayCaster": "meshvis.rays",
     "Hits": "meshvis.rays",
     "diagnose": "meshvis.diagnostics",
-    "render": "meshvis.render",
-    "classify": "meshvis.classify",
+    "classify": "meshvis.classification",
     "orient": "meshvis.orient",
     "remove_interior": "meshvis.removal",
-    "layers": "meshvis.layers",
+    "layers": "meshvis.layering",
     "Camera": "meshvis.camera",
     "Hints": "meshvis.hints",
 }
 
 __all__ = [
-    "__version__", "MeshvisError", "ModelError", "ModelFormatError", "OutputError",
+    "__version__", "render", "MeshvisError", "ModelError", "ModelFormatError", "OutputError",
     "ParameterError", "Soup", "as_soup", *_LAZY,
 ]
 

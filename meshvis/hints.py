@@ -27,7 +27,8 @@ class Hints:
     inside_points, outside_points : (k, 3) arrays
     inside_boxes, outside_boxes : (k, 2, 3) arrays of (min corner, max corner)
     rays : rays cast per hint point (boxes: in total, from random points in the box)
-    strength : multiplier of the hint links
+    strength : multiplier of the hint links (default 10: a hint should win over the
+        ray evidence of a side that escapes freely, whose outside link is at most its area)
     """
 
     inside_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
@@ -35,7 +36,7 @@ class Hints:
     inside_boxes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 3)))
     outside_boxes: np.ndarray = field(default_factory=lambda: np.zeros((0, 2, 3)))
     rays: int = 4096
-    strength: float = 1.0
+    strength: float = 10.0
 
     def __post_init__(self) -> None:
         for name in ("inside_points", "outside_points"):

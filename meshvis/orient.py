@@ -19,9 +19,9 @@ from typing import Any
 
 import numpy as np
 
-from .classify import Classification, classify
+from .classification import Classification, classify
 from .errors import ParameterError
-from .layers import LayerResult, layers
+from .layering import LayerResult, layers
 from .soup import Soup
 
 # status codes per input face

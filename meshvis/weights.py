@@ -72,6 +72,31 @@ def outside_weights(escaped: np.ndarray, counted: np.ndarray, area: np.ndarray) 
     return np.where(counted > 0, area * escaped / np.maximum(counted, 1), 0.0)
 
 
+def inside_prior(w_out: np.ndarray, escaped: np.ndarray, counted: np.ndarray, opposite: np.ndarray,
+                 opening: float | None = 0.05) -> np.ndarray:
+    """Inside links without hints: ``w_in(opp(i)) = w_o(i)`` (appendix H §3.2.1), faded by
+    the node's own escape share.
+
+    The paper's prior says "if the other side of this geometry escapes, this side is the
+    inside of a thin object".  That is right for closed shells and for shells with small
+    cracks, but it also declares the inside of a cup or of a room with a large doorway
+    inside, although it is reachable from far away (the object-based definition, DESIGN.md
+    §4).  For a convex enclosure the share of a side's cosine rays that escape equals
+    ``A_opening / A_enclosure``, so a threshold on that share is exactly the line between a
+    crack and an opening.  We therefore scale the prior of node *j* by
+    ``max(0, 1 − e_j / opening)`` with ``e_j = escaped_j / n_j``: a side that escapes less
+    than ``opening`` keeps (most of) the paper's prior, one that escapes more is not pulled
+    inside.  ``opening=None`` reproduces the paper exactly.
+    """
+    w_in = w_out[opposite].copy()
+    if opening is None:
+        return w_in
+    if opening <= 0:
+        raise ValueError("opening must be positive (or None)")
+    share = np.where(counted > 0, escaped / np.maximum(counted, 1), 0.0)
+    return w_in * np.clip(1.0 - share / opening, 0.0, 1.0)
+
+
 def cosine_filter(w: np.ndarray, w_max: np.ndarray) -> np.ndarray:
     """Eq. 9: ``½ (1 + cos(π − π w / w_max)) · w`` (0 where ``w_max`` is 0)."""
     with np.errstate(divide="ignore", invalid="ignore"):
@@ -90,6 +115,7 @@ def graph_weights(
     hint_out: np.ndarray | None = None,
     hint_in: np.ndarray | None = None,
     use_filter: bool = True,
+    opening: float | None = 0.05,
 ) -> Weights:
     """All weights of the graph: Eq. 5, Eq. 7, ``w_in(opp(i)) = w_o(i)``, and the filter.
 
@@ -99,6 +125,8 @@ def graph_weights(
     area : (n,) A_i; opposite : (n,) opp(i); is_point : (n,) bool
     hint_out, hint_in : (n,) extra terminal weights from user hints (appendix H §3.2.1)
     use_filter : apply the directed cosine filter of Eq. 8–9
+    opening : escape share above which a side counts as open (see :func:`inside_prior`);
+        None applies the paper's ``w_in(opp(i)) = w_o(i)`` unchanged
 
     The filter is directed: node *i* scales every link it has by its own
     ``w_max(i) = max(max_j w(i,j), w_o(i), w_in(i))`` (Eq. 8), so ``cap(i→j)`` and
@@ -107,7 +135,7 @@ def graph_weights(
     n = len(area)
     i, j, w = edge_weights(hits, counted, area, is_point)
     w_out = outside_weights(escaped, counted, area)
-    w_in = w_out[opposite].copy()
+    w_in = inside_prior(w_out, escaped, counted, opposite, opening)
     if hint_out is not None:
         w_out = w_out + hint_out
     if hint_in is not None:

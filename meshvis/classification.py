@@ -194,6 +194,7 @@ def classify(
     samples_per_face: int = 4,
     sampling_scheme: int = 2,
     use_filter: bool = True,
+    opening: float | None = 0.05,
     progressive: bool = True,
     tolerance: float = 1e-3,
     solver: str = "pymaxflow",
@@ -213,6 +214,9 @@ def classify(
     samples_per_face : sample points per intersecting/coplanar face (appendix H §3.1)
     sampling_scheme : 1 (uniform) or 2 (uniform + edges, default)
     use_filter : apply the directed cosine filter (Eq. 8–9)
+    opening : a side whose escaping ray share exceeds this is not pulled inside by the
+        prior of its opposite side (an opening, not a crack; see
+        :func:`meshvis.weights.inside_prior`); None follows the paper exactly
     progressive : sample in rounds and stop when labels settle (else one full round)
     tolerance : stop when a round changes less than this fraction of the total side area
     solver : "pymaxflow" or "scipy"
@@ -237,6 +241,8 @@ def classify(
         raise ParameterError(f"samples_per_face must be at least 1, got {samples_per_face}")
     if solver not in SOLVERS:
         raise ParameterError(f"unknown solver {solver!r}; choose one of {', '.join(SOLVERS)}")
+    if opening is not None and not 0 < opening <= 1:
+        raise ParameterError(f"opening must be in (0, 1] or None, got {opening}")
     if not 0 <= tolerance < 1:
         raise ParameterError("tolerance must be in [0, 1)")
     hints = Hints.coerce(hints)
@@ -293,7 +299,7 @@ def classify(
         t = time.perf_counter()
         counted = counts.cast - counts.discarded
         weights = graph_weights(counts.hits, counted, counts.escaped, nodes.area, nodes.opposite, is_point,
-                                hint_out=hint_out, hint_in=hint_in, use_filter=use_filter)
+                                hint_out=hint_out, hint_in=hint_in, use_filter=use_filter, opening=opening)
         graph = VisibilityGraph(nodes.n, weights)
         cut = graph.cut(solver)
         labels = face_labels(nodes, cut.outside, soup.n_faces, pre.degenerate)
@@ -331,7 +337,7 @@ def classify(
     report("done", 1.0)
     params = {
         "rays_per_node": rays_per_node, "seed": seed, "samples_per_face": samples_per_face,
-        "sampling_scheme": sampling_scheme, "use_filter": use_filter, "progressive": progressive,
+        "sampling_scheme": sampling_scheme, "use_filter": use_filter, "opening": opening, "progressive": progressive,
         "tolerance": tolerance, "solver": solver, "offset": caster.offset, "hint_rays": hint_rays,
     }
     return Classification(

@@ -13,7 +13,7 @@ from typing import Any
 
 import numpy as np
 
-from .classify import Classification, classify
+from .classification import Classification, classify
 from .soup import Soup
 
 

@@ -1,0 +1,274 @@
+"""Connectivity of a triangle soup: welding, edges, face adjacency, degenerate and duplicate faces.
+
+Everything here is a pure function over plain arrays ``(vertices, faces)`` so that the
+diagnostics and the graph-cut preprocessing (appendix H §2: intersection and coplanarity
+candidates, triangle clustering) can share it.
+
+Welding is for *adjacency only*: it decides which faces touch, it never changes the model.
+Tolerances are fractions of the bounding-box diagonal of the used vertices.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+from scipy.sparse.csgraph import connected_components
+
+#: default weld tolerance, as a fraction of the bounding-box diagonal
+WELD_TOL = 1e-7
+
+
+def _diagonal(vertices: np.ndarray, faces: np.ndarray) -> float:
+    if len(faces) == 0:
+        return 0.0
+    used = vertices[np.unique(faces)]
+    return float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+
+
+def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tuple[np.ndarray, np.ndarray]:
+    """Merge vertices that lie closer than ``tol`` times the bounding-box diagonal.
+
+    Exact duplicates are merged first (``np.unique`` on the coordinates); the remaining
+    distinct points are paired with a k-d tree (``cKDTree.query_pairs``) and merged by
+    connected components, so a chain of points each within ``tol`` of the next becomes one
+    vertex (harmless at the tiny default tolerance).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+    tol : float
+        Weld distance as a fraction of the diagonal of the used vertices' bounding box
+        (default :data:`WELD_TOL` = 1e-7).  ``0`` merges exact duplicates only.
+
+    Returns
+    -------
+    index : (n,) int64
+        Welded vertex id of every input vertex, numbered ``0 .. k-1`` in order of first
+        appearance in ``np.unique`` order; ``-1`` for vertices no face uses.
+    faces_welded : (m, 3) int64
+        ``index[faces]``.  A face whose corners merged has repeated ids.
+
+    Examples
+    --------
+    >>> v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1e-12, 0, 0]], float)
+    >>> weld(v, np.array([[0, 1, 2], [3, 2, 1]]))[1].tolist()
+    [[0, 2, 1], [0, 1, 2]]
+    """
+    vertices = np.asarray(vertices, np.float64)
+    faces = np.asarray(faces, np.int64).reshape(-1, 3)
+    index = np.full(len(vertices), -1, np.int64)
+    if len(faces) == 0:
+        return index, faces.copy()
+    used = np.unique(faces)
+    # + 0.0 turns -0.0 into 0.0 so that both weld exactly
+    pts = vertices[used] + 0.0
+    uniq, inverse = np.unique(pts, axis=0, return_inverse=True)
+    inverse = inverse.reshape(-1)
+    label = np.arange(len(uniq))
+    radius = tol * _diagonal(vertices, faces)
+    if radius > 0 and len(uniq) > 1:
+        from scipy.spatial import cKDTree
+
+        pairs = cKDTree(uniq).query_pairs(radius, output_type="ndarray")
+        if len(pairs):
+            g = sp.coo_matrix(
+                (np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(len(uniq), len(uniq))
+            )
+            _, label = connected_components(g, directed=False)
+    index[used] = label[inverse]
+    return index, index[faces]
+
+
+def collapsed(faces_welded: np.ndarray) -> np.ndarray:
+    """(m,) bool: faces with a repeated (welded) corner, i.e. collapsed to a segment or point."""
+    f = np.asarray(faces_welded)
+    return (f[:, 0] == f[:, 1]) | (f[:, 1] == f[:, 2]) | (f[:, 2] == f[:, 0])
+
+
+@dataclass(frozen=True)
+class EdgeTable:
+    """Undirected edges of a welded soup with their face incidence.
+
+    Side ``s`` of face ``f`` runs from corner ``s`` to corner ``(s + 1) % 3``.  Collapsed
+    faces (repeated welded corner) contribute no edges: their sides would pair the face
+    with itself.
+
+    Attributes
+    ----------
+    vertices : (k, 2) int64, welded end points of each edge, smaller id first
+    count : (k,) int64, number of face sides on the edge (1 boundary, 2 manifold, >2 non-manifold)
+    face_edge : (m, 3) int64, edge of each face side; -1 for collapsed faces
+    half_face : (h,) int64, face of each half-edge (face side), sorted by edge
+    half_edge : (h,) int64, edge of each half-edge, non-decreasing
+    half_forward : (h,) bool, the face traverses its edge from the smaller to the larger id
+    """
+
+    vertices: np.ndarray
+    count: np.ndarray
+    face_edge: np.ndarray
+    half_face: np.ndarray
+    half_edge: np.ndarray
+    half_forward: np.ndarray
+
+    @property
+    def boundary(self) -> np.ndarray:
+        """(k,) bool: edges used by one face."""
+        return self.count == 1
+
+    @property
+    def manifold(self) -> np.ndarray:
+        """(k,) bool: edges used by exactly two faces."""
+        return self.count == 2
+
+    @property
+    def nonmanifold(self) -> np.ndarray:
+        """(k,) bool: edges used by more than two faces."""
+        return self.count > 2
+
+    @property
+    def consistent(self) -> np.ndarray:
+        """(k,) bool: manifold edges whose two faces traverse them in opposite directions.
+
+        A manifold edge traversed twice in the same direction means one of its two faces is
+        wound the other way (a flipped face).  Boundary and non-manifold edges are ``True``.
+        """
+        out = np.ones(len(self.count), bool)
+        start = np.searchsorted(self.half_edge, np.flatnonzero(self.manifold))
+        out[self.half_edge[start]] = self.half_forward[start] != self.half_forward[start + 1]
+        return out
+
+
+def edges(faces_welded: np.ndarray) -> EdgeTable:
+    """Unique undirected edges of welded faces, their face counts and traversal directions.
+
+    Edge keys are ``lo * n + hi`` in int64 (``n`` = number of welded vertices), sorted
+    once; counts come from ``np.unique``.
+
+    Parameters
+    ----------
+    faces_welded : (m, 3) int array, the ``faces_welded`` output of :func:`weld`
+
+    Returns
+    -------
+    EdgeTable
+    """
+    f = np.asarray(faces_welded, np.int64).reshape(-1, 3)
+    m = len(f)
+    n = int(f.max()) + 1 if m else 1
+    ok = ~collapsed(f)
+    a = f[ok]
+    b = np.roll(a, -1, axis=1)
+    lo, hi = np.minimum(a, b).ravel(), np.maximum(a, b).ravel()
+    forward = (a < b).ravel()
+    face = np.repeat(np.flatnonzero(ok), 3)
+    keys = lo * np.int64(n) + hi
+    order = np.argsort(keys, kind="stable")
+    ukeys, edge_of, count = np.unique(keys[order], return_inverse=True, return_counts=True)
+    edge_of = edge_of.reshape(-1)
+    face_edge = np.full((m, 3), -1, np.int64)
+    per_half = np.empty(len(keys), np.int64)
+    per_half[order] = edge_of
+    face_edge[ok] = per_half.reshape(-1, 3)
+    return EdgeTable(
+        vertices=np.stack([ukeys // n, ukeys % n], axis=1),
+        count=count.astype(np.int64),
+        face_edge=face_edge,
+        half_face=face[order],
+        half_edge=edge_of,
+        half_forward=forward[order],
+    )
+
+
+def face_adjacency(table: EdgeTable, manifold_only: bool = True) -> np.ndarray:
+    """Pairs of faces that share an edge.
+
+    Parameters
+    ----------
+    table : EdgeTable, from :func:`edges`
+    manifold_only : bool
+        ``True``: one pair per manifold edge.  ``False``: also link the faces around every
+        non-manifold edge (as a chain, enough for connectivity).
+
+    Returns
+    -------
+    (p, 2) int64, face pairs with the smaller index first
+    """
+    he, hf = table.half_edge, table.half_face
+    same = he[1:] == he[:-1]  # consecutive half-edges on one edge
+    if manifold_only:
+        same &= table.count[he[1:]] == 2
+    i = np.flatnonzero(same)
+    pairs = np.stack([hf[i], hf[i + 1]], axis=1)
+    pairs = pairs[pairs[:, 0] != pairs[:, 1]]
+    return np.sort(pairs, axis=1)
+
+
+def components(n_faces: int, pairs: np.ndarray) -> tuple[int, np.ndarray]:
+    """Connected components of faces linked by ``pairs``.
+
+    Returns
+    -------
+    n_components : int
+    label : (n_faces,) int64, component of each face (numbered by smallest face index)
+    """
+    pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
+    g = sp.coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n_faces, n_faces))
+    n, label = connected_components(g.tocsr(), directed=False)
+    return int(n), label.astype(np.int64)
+
+
+def degenerate_faces(
+    vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL, faces_welded: np.ndarray | None = None
+) -> np.ndarray:
+    """(m,) bool: faces of (near-)zero area.
+
+    A face is degenerate when its smallest altitude ``2 A / l_max`` (``A`` area, ``l_max``
+    longest side) is at most ``tol`` times the bounding-box diagonal — the triangle is a
+    segment or a point up to the weld tolerance — or when welding collapsed two corners.
+    Using the altitude rather than the area keeps the test independent of the triangle's size
+    and of the model's scale.
+
+    Parameters
+    ----------
+    vertices, faces : the soup
+    tol : float, fraction of the bounding-box diagonal (default :data:`WELD_TOL`)
+    faces_welded : optional output of :func:`weld`, to also flag collapsed faces
+    """
+    v = np.asarray(vertices, np.float64)
+    f = np.asarray(faces, np.int64).reshape(-1, 3)
+    if len(f) == 0:
+        return np.zeros(0, bool)
+    t = v[f]
+    lo = t.reshape(-1, 3).min(axis=0)
+    t = t - lo  # keep magnitudes small before the cross product
+    e = np.roll(t, -1, axis=1) - t
+    twice_area = np.linalg.norm(np.cross(e[:, 0], e[:, 1]), axis=1)
+    longest = np.linalg.norm(e, axis=2).max(axis=1)
+    out = twice_area <= tol * _diagonal(v, f) * longest
+    if faces_welded is not None:
+        out |= collapsed(faces_welded)
+    return out
+
+
+def duplicate_faces(faces_welded: np.ndarray) -> np.ndarray:
+    """Index of the first face with the same welded vertex set, whatever the winding.
+
+    Returns
+    -------
+    first : (m,) int64
+        ``first[i] == i`` for a face seen for the first time; ``first[i] < i`` when face ``i``
+        repeats face ``first[i]`` (same corners, either winding).  ``first != arange(m)``
+        marks the redundant copies.
+    """
+    f = np.sort(np.asarray(faces_welded, np.int64).reshape(-1, 3), axis=1)
+    m = len(f)
+    order = np.lexsort((np.arange(m), f[:, 2], f[:, 1], f[:, 0]))
+    s = f[order]
+    new = np.ones(m, bool)
+    new[1:] = np.any(s[1:] != s[:-1], axis=1)
+    group_first = order[np.flatnonzero(new)]
+    first = np.empty(m, np.int64)
+    first[order] = group_first[np.cumsum(new) - 1]
+    return first
