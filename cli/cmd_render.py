@@ -32,7 +32,7 @@ def run(args: argparse.Namespace) -> int:
     values = None
     color_by = None if args.color_by == "none" else args.color_by
     if color_by == "layer":
-        from meshvis.layers import layers
+        from meshvis.layering import layers
 
         values = layers(soup, seed=args.seed).layer
     camera = Camera.fit(soup, azimuth=args.azimuth, elevation=args.elevation, up=AXES[args.up])

@@ -96,10 +96,10 @@ def run(args: argparse.Namespace) -> int:
 
 def run_op(op: str, soup, args: argparse.Namespace, progress=None) -> dict:
     """Run one operation on a loaded soup, write its outputs, return the report."""
-    from meshvis.classify import classify
+    from meshvis.classification import classify
     from meshvis.io import save
-    from meshvis.layers import layers
-    from meshvis.orient import orient
+    from meshvis.layering import layers
+    from meshvis.orientation import orient
     from meshvis.removal import remove_interior
     from meshvis.render import render, render_layers, save_png
 

@@ -20,7 +20,7 @@ _LAZY = {
     "Hits": "meshvis.rays",
     "diagnose": "meshvis.diagnostics",
     "classify": "meshvis.classification",
-    "orient": "meshvis.orient",
+    "orient": "meshvis.orientation",
     "remove_interior": "meshvis.removal",
     "layers": "meshvis.layering",
     "Camera": "meshvis.camera",

@@ -45,8 +45,9 @@ def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tupl
     Returns
     -------
     index : (n,) int64
-        Welded vertex id of every input vertex, numbered ``0 .. k-1`` in order of first
-        appearance in ``np.unique`` order; ``-1`` for vertices no face uses.
+        Welded vertex id of every input vertex, numbered ``0 .. k-1`` in lexicographic order
+        of the coordinates (a merged group takes the rank of its smallest point); ``-1``
+        for vertices no face uses.
     faces_welded : (m, 3) int64
         ``index[faces]``.  A face whose corners merged has repeated ids.
 

@@ -541,26 +541,27 @@ def _containment(pieces: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
     import igl
 
     wn = igl.fast_winding_number if fast else igl.winding_number
-    queries = []
-    for V, F in pieces:
+    boxes = np.array([[V[np.unique(F)].min(0), V[np.unique(F)].max(0)] for V, F in pieces])
+    depth, ambiguous = [], []
+    for p, (V, F) in enumerate(pieces):
         t = V[F]
         c = t.mean(axis=1)
         n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
         n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
         corners = (c[:, None] + 0.98 * (t - c[:, None]) + eps * n[:, None]).reshape(-1, 3)
-        queries.append(np.concatenate([c + eps * n, c - eps * n, corners]))
-    # winding numbers add up over pieces: evaluate all pieces at once, then take away each
-    # piece's own contribution (0 or 1 at points pushed off its own faces)
-    offsets = np.cumsum([0] + [len(V) for V, _ in pieces[:-1]])
-    V_all = np.concatenate([V for V, _ in pieces]).astype(np.float64)
-    F_all = np.concatenate([np.asarray(F, np.int64) + o for (_, F), o in zip(pieces, offsets)])
-    w_all = np.asarray(wn(V_all, F_all, np.concatenate(queries)))
-    bounds = np.cumsum([0] + [len(q) for q in queries])
-    depth, ambiguous = [], []
-    for p, (V, F) in enumerate(pieces):
-        Q = queries[p]
-        w = w_all[bounds[p]:bounds[p + 1]] - np.asarray(
-            wn(np.ascontiguousarray(V, np.float64), np.ascontiguousarray(F, np.int64), Q))
+        Q = np.concatenate([c + eps * n, c - eps * n, corners])
+        # a closed surface has winding number 0 outside its bounding box: only pieces whose
+        # boxes overlap count, evaluated together (winding numbers add up)
+        lo, hi = boxes[p, 0] - 2 * eps, boxes[p, 1] + 2 * eps
+        near = [q for q in range(len(pieces))
+                if q != p and not (np.any(boxes[q, 0] > hi) or np.any(boxes[q, 1] < lo))]
+        if near:
+            offsets = np.cumsum([0] + [len(pieces[q][0]) for q in near[:-1]])
+            Vn = np.concatenate([pieces[q][0] for q in near])
+            Fn = np.concatenate([np.asarray(pieces[q][1], np.int64) + o for q, o in zip(near, offsets)])
+            w = np.asarray(wn(np.ascontiguousarray(Vn, np.float64), np.ascontiguousarray(Fn), Q))
+        else:
+            w = np.zeros(len(Q))
         m = len(F)
         front, back, corner = w[:m], w[m:2 * m], w[2 * m:].reshape(m, 3)
         d = np.maximum(np.rint(front), 0).astype(np.int64)

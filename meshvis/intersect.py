@@ -14,32 +14,42 @@ Pipeline
    into a *hierarchical uniform grid*.  Level ``L`` has cells of size ``h0 * 2**L`` (``h0``
    the median box size); a triangle lives on the finest level where its box covers at most
    27 cells, whatever its size (a huge triangle cannot blow up memory, a flat wall stays on
-   a fine level).
-   Pairs on one level meet in a shared cell; a triangle meets the coarser levels by looking
-   up its own cells there.  Each pair is emitted once, from the cell that holds the lower
-   corner of the two boxes' overlap.  Cell keys are int64 (21 bits per axis), matched by
-   sorting and ``searchsorted``; large outputs are produced in bounded chunks.
-3. Narrow phase (vectorised over all candidate pairs, in chunks): a separating-axis test
-   on the 17 axes that separate two triangles — the two normals, the 9 edge x edge
-   directions and the 6 in-plane edge normals.  Each axis gives a gap between the two
-   projected intervals; a gap along a unit axis is a lower bound of the true distance, so
-   "no axis shows a gap above ``eps``" is true for every pair closer than ``eps``
-   (conservative).  Axes that are numerically unreliable (a cross product of nearly
-   parallel edges) are skipped, which can only add reports, never drop one.
+   a fine level).  Pairs on one level meet in a shared cell, where entries are also swept
+   along x; a triangle meets the coarser levels by looking up its own cells there.  Each
+   pair is emitted once, from the cell that holds the lower corner of the two boxes'
+   overlap.  Cell keys are int64 (21 bits per axis), matched by sorting and
+   ``searchsorted``; large outputs are produced in bounded chunks.
+3. Narrow phase (:func:`classify_pairs`, vectorised over chunks of pairs): a
+   separating-axis test on the 17 axes that separate two triangles — the two normals, the
+   six in-plane edge normals (precomputed per face) and the 9 edge x edge directions.  Each
+   axis gives a gap between the two projected intervals; a gap along a unit axis is a lower
+   bound of the true distance, so "no axis shows a gap above ``eps``" holds for every pair
+   closer than ``eps`` (conservative).  Axes that are numerically unreliable (a cross
+   product of nearly parallel edges) are skipped, which can only add reports, never drop one.
 4. Coplanarity: normals parallel within ``angle_eps`` (either orientation), every corner of
    each triangle within ``eps`` of the other's plane, and the two triangles overlap in that
-   plane by more than ``eps`` on all six in-plane edge-normal axes (a 2D separating-axis
-   test with a negative margin).  Two faces lying side by side — sharing an edge or only
-   touching — therefore do not count; duplicates and folded-over faces do.
+   plane by more than ``eps`` along each of the six in-plane edge normals (a 2D
+   separating-axis test with a negative margin).  Two faces lying side by side — sharing
+   an edge or only touching — therefore do not count; duplicates and folded-over faces do.
 
 Adjacency
 ---------
-Triangles sharing a (welded) vertex or edge are *never* reported as intersecting or too
-close (appendix H: "explicitly excluded").  This also hides a pair that shares one vertex
-and crosses elsewhere — a deliberate simplification.  Coplanar overlap, however, is tested
-for adjacent pairs too, since duplicates and folded faces share their corners.
-Pairs that lie in one plane (coplanar geometry) are reported as coplanar or not at all,
-never as intersecting; in-plane touching is reported through ``too_close`` only.
+Appendix H excludes triangles sharing a vertex or an edge from the intersection test.  Here
+(after welding, :func:`meshvis.adjacency.weld`):
+
+* pairs sharing an edge (two corners) are never intersecting nor too close: two triangles
+  on one edge can only overlap by folding into one plane, which the coplanarity test sees;
+* pairs sharing exactly one corner are intersecting only when they cross *beyond* it (their
+  tangent wedges at the shared corner share a direction, :func:`_cross_beyond_vertex`) —
+  MeshLab counts these too; the plain exclusion of the paper would miss them;
+* coplanar overlap is tested for adjacent pairs as well (duplicates and folded faces
+  share their corners).
+
+Pairs that lie in one plane are reported as coplanar or not at all, never as
+intersecting; two faces touching side by side in one plane without a shared corner show up
+in ``too_close`` only.  Faces without a reliable normal (degenerate: collapsed or
+collinear) are never coplanar and never cross a neighbour beyond a shared corner; they can
+still be flagged against non-adjacent faces.
 
 Tolerances (fractions of the bounding-box diagonal unless stated)
 ------------------------------------------------------------------
@@ -64,7 +74,7 @@ ANGLE_EPS = 1e-3
 #: candidate pairs per narrow-phase chunk (bounds the temporary memory to ~100 MB)
 NARROW_CHUNK = 1 << 15
 #: pairs expanded at once in the broad phase
-BROAD_CHUNK = 1 << 22
+BROAD_CHUNK = 1 << 20
 _BITS = 21  # bits per axis of a cell key
 #: most grid cells one box may cover; larger boxes move to a coarser level
 MAX_CELLS = 27

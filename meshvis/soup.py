@@ -278,9 +278,9 @@ def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -
     if bad.any():
         used_bad = np.intersect1d(np.flatnonzero(bad), faces.ravel())
         if len(used_bad):
+            what = "vertex used by a face has" if len(used_bad) == 1 else "vertices used by faces have"
             raise ModelError(
-                f"{len(used_bad)} vertices used by faces have NaN or infinite coordinates "
-                f"(first: vertex {int(used_bad[0])})",
+                f"{len(used_bad)} {what} NaN or infinite coordinates (first: vertex {int(used_bad[0])})",
                 path,
             )
     lo, hi = int(faces.min()), int(faces.max())
