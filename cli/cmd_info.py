@@ -1,0 +1,33 @@
+"""``meshvis info MODEL [--json]``: what is wrong with a model (counts and timings)."""
+from __future__ import annotations
+
+import argparse
+import json
+
+from meshvis.errors import ParameterError
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser(
+        "info",
+        help="diagnose a model: components, holes, non-manifold edges, winding, "
+        "degenerate / duplicate / intersecting / coplanar faces",
+    )
+    p.add_argument("model", help="input model")
+    p.add_argument("--json", action="store_true", help="print the numbers as JSON")
+    p.add_argument("--eps", type=float, default=1e-6,
+                   help="distance tolerance of the intersection tests, fraction of the diagonal (default 1e-6)")
+    p.add_argument("--no-intersections", action="store_true",
+                   help="skip the intersection / coplanarity tests (the slowest stage)")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from meshvis.diagnostics import diagnose, format_report
+    from meshvis.io import load
+
+    if not (1e-9 <= args.eps < 1):
+        raise ParameterError(f"--eps must lie in [1e-9, 1), got {args.eps}")
+    report = diagnose(load(args.model), eps=args.eps, intersections=not args.no_intersections)
+    print(json.dumps(report, indent=1) if args.json else format_report(report))
+    return 0
