@@ -32,6 +32,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
+from .adjacency import WELD_TOL, components, edges, face_adjacency, weld
 from .errors import ModelError, ParameterError
 from .soup import Soup
 
@@ -50,6 +51,7 @@ __all__ = [
     "soupify",
     "from_closed_mesh",
     "is_closed",
+    "signed_volume",
     "real_models_dir",
     "GENERATORS",
 ]
@@ -481,51 +483,41 @@ def signed_volume(V: np.ndarray, F: np.ndarray) -> float:
 
 
 # ====================================================================== closedness, components
-def _weld_positions(soup: Soup) -> np.ndarray:
-    """(m, 3) corner keys equal where corners coincide exactly (soups are not welded)."""
-    _, inv = np.unique(soup.triangles.reshape(-1, 3), axis=0, return_inverse=True)
-    return inv.reshape(-1, 3).astype(np.int64)
+def _welded(soup: Soup, tol: float = 0.0) -> np.ndarray:
+    """(m, 3) welded corner ids (:func:`meshvis.adjacency.weld`; exact duplicates by default)."""
+    return weld(soup.vertices, soup.faces, tol)[1]
 
 
-def is_closed(soup: Soup, oriented: bool = True) -> bool:
-    """Whether the surface is closed once coincident corners are merged.
+def is_closed(soup: Soup, oriented: bool = True, tol: float = WELD_TOL) -> bool:
+    """Whether the surface is closed once corners closer than ``tol`` x diagonal are merged.
 
     Closed means every edge is used an even number of times; *oriented* closed (the
-    default) means every directed edge ``a -> b`` is matched by as many ``b -> a``, i.e. the
-    surface bounds a volume with consistent winding.  Non-manifold edges are allowed.
+    default) means every edge is crossed as often in one direction as in the other, i.e.
+    the surface bounds a volume with consistent winding.  Non-manifold edges are allowed.
     """
     if soup.n_faces == 0:
         return False
-    k = _weld_positions(soup)
-    a = k.ravel()
-    b = k[:, [1, 2, 0]].ravel()
-    n = int(k.max()) + 1
+    table = edges(_welded(soup, tol))
     if oriented:
-        fwd = np.unique(a * n + b, return_counts=True)
-        bwd = np.unique(b * n + a, return_counts=True)
-        return fwd[0].shape == bwd[0].shape and bool(np.all(fwd[0] == bwd[0]) and np.all(fwd[1] == bwd[1]))
-    und = np.minimum(a, b) * n + np.maximum(a, b)
-    _, counts = np.unique(und, return_counts=True)
-    return bool(np.all(counts % 2 == 0))
+        forward = np.bincount(table.half_edge, weights=table.half_forward, minlength=len(table.count))
+        return bool(np.all(2 * forward == table.count))
+    return bool(np.all(table.count % 2 == 0))
 
 
-def _components(soup: Soup) -> np.ndarray:
-    """(m,) label of the edge-connected component of every face (coincident corners merged)."""
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
+def _components(soup: Soup, tol: float = WELD_TOL) -> np.ndarray:
+    """(m,) label of the edge-connected component (body) of every face."""
+    pairs = face_adjacency(edges(_welded(soup, tol)), manifold_only=False)
+    return components(soup.n_faces, pairs)[1]
 
-    m = soup.n_faces
-    k = _weld_positions(soup)
-    a = k.ravel()
-    b = k[:, [1, 2, 0]].ravel()
-    n = int(k.max()) + 1
-    _, edge = np.unique(np.minimum(a, b) * n + np.maximum(a, b), return_inverse=True)
-    face = np.repeat(np.arange(m), 3)
-    # bipartite graph faces <-> edges; faces sharing an edge end up in one component
-    g = coo_matrix((np.ones(3 * m), (face, m + edge.ravel())), shape=(m + edge.max() + 1,) * 2)
-    _, labels = connected_components(g, directed=False)
-    _, labels = np.unique(labels[:m], return_inverse=True)
-    return labels.astype(np.int64)
+
+def _outward_bodies(soup: Soup) -> tuple[np.ndarray, np.ndarray]:
+    """Body (edge-connected component) of every face, and whether the face's front faces
+    out of its body: the body's signed volume (sum of ``v0 . (v1 x v2)``) is not negative.
+    Meaningful for closed, consistently wound bodies."""
+    labels = _components(soup)
+    t = soup.triangles - soup.bounds.mean(axis=0)
+    vol = np.bincount(labels, np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])))
+    return labels, (vol >= 0)[labels]
 
 
 def _containment(pieces: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
@@ -1142,11 +1134,7 @@ def skin_and_ribcage(folder: str | os.PathLike | None = None) -> GroundTruth:
     skin = _load_mesh(folder / "dm_control__SKINbody.stl")
     ribs = _load_mesh(folder / "dm_control__BONERibcage.stl")
     s_out = signed_volume(skin.vertices, skin.faces) > 0
-    # orientation of every rib-cage body from its own signed volume
-    labels = _components(ribs)
-    t = ribs.triangles - ribs.bounds.mean(axis=0)
-    vol = np.bincount(labels, np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])))
-    r_out = vol[labels] >= 0
+    r_out = _outward_bodies(ribs)[1]
     c = ribs.triangles.mean(axis=1)
     w = np.asarray(igl.fast_winding_number(skin.vertices, skin.faces, c))
     if not s_out:
@@ -1294,7 +1282,7 @@ def soupify(truth: GroundTruth, flip: float = 0.3, unweld: bool = True, shuffle:
     t = truth
     m = t.n_faces
     if holes and m:
-        keys = _weld_positions(t.soup)
+        keys = _welded(t.soup)
         seeds = rng.choice(m, size=min(int(holes), m), replace=False)
         marked = np.zeros(int(keys.max()) + 1, bool)
         marked[keys[seeds].ravel()] = True
@@ -1350,11 +1338,8 @@ def from_closed_mesh(model: Any, name: str | None = None) -> GroundTruth:
     soup = as_soup(model)
     if not is_closed(soup, oriented=True):
         raise ModelError("the model is not closed with consistent winding; its truth is not known", soup.path)
-    labels = _components(soup)
-    t = soup.triangles - soup.bounds.mean(axis=0)
-    vol = np.bincount(labels, np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])))
-    out = vol >= 0
-    flip = ~out[labels]
+    labels, outward = _outward_bodies(soup)
+    flip = ~outward
     # make every body outward, find nesting, then restore the input winding
     fixed = soup.flipped(flip)
     order = np.argsort(labels, kind="stable")
@@ -1373,7 +1358,6 @@ def from_closed_mesh(model: Any, name: str | None = None) -> GroundTruth:
         d = np.zeros(soup.n_faces, np.int64)
         a = np.zeros(soup.n_faces, bool)
     vis = d == 0
-    outward = ~flip
     outside = np.stack([vis & outward, vis & ~outward], 1)
     nm = name or (os.path.splitext(os.path.basename(soup.path))[0] if soup.path else "closed_mesh")
     return GroundTruth(soup=soup, outside=outside, layer=d + 1, outward=outward, ambiguous=a, name=nm,
