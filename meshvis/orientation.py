@@ -8,7 +8,11 @@ turned so that its front faces the outside.  The other cases are decided by opti
   escaping ray share, i.e. outside weight per area, Eq. 7, wins);
 * hidden faces (both sides inside): oriented by the layer they belong to — layer
   semantics (DESIGN.md §4): each shell faces outward with respect to its layer; with
-  ``semantics="cavity"``, shells of even layers face inward instead (a solid with voids);
+  ``semantics="cavity"``, shells of even layers face inward instead (a solid with voids).
+  A hidden face that is two-sided even at its own layer (e.g. the part of one solid that
+  lies inside another: once the outer layer is peeled, both its sides are reachable)
+  takes the orientation of the surface it belongs to: the connected, orientable patch
+  of faces joined by manifold edges, whose one-sided faces vote by area;
 * flagged faces whose sample points disagree: by area ``majority`` (default) or
   ``duplicate``.
 """
@@ -82,6 +86,29 @@ def strongest_side(c: Classification) -> np.ndarray:
     return (c.face_labels_from(w)[:, 1] > c.face_labels_from(w)[:, 0]).astype(np.int8)
 
 
+def surface_vote(c: Classification, outer: np.ndarray, decided: np.ndarray) -> np.ndarray:
+    """Side that should face front for every face, voted over its orientable surface patch.
+
+    Faces joined by manifold edges (after welding; flagged faces included) form patches
+    whose sides split into two consistent sets (the orientation double cover of
+    :func:`meshvis.clusters.cluster_sides`).  Each decided face votes with its area for the
+    set its outer side belongs to.  Returns, per face, the side in the winning set (0 where
+    the patch has no decided face or the vote is tied: the face is kept as it is).
+    """
+    from .adjacency import edges
+    from .clusters import cluster_sides
+
+    patches = cluster_sides(edges(c.pre.faces_welded), ~c.degenerate)
+    node = patches.side_node
+    votes = np.zeros(patches.n_nodes)
+    d = np.flatnonzero(decided & (node[:, 0] >= 0))
+    np.add.at(votes, node[d, outer[d]], c.soup.areas[d])
+    ok = node[:, 0] >= 0
+    out = np.zeros(len(outer), np.int8)
+    out[ok] = (votes[node[ok, 1]] > votes[node[ok, 0]]).astype(np.int8)
+    return out
+
+
 def orient(
     model: Any,
     *,
@@ -147,8 +174,12 @@ def orient(
     if hidden.any():
         lay = layers(soup, classification=c)
         side = lay.outer_side[hidden]
-        side = np.where(side == 2, 0, side)  # two-sided at its layer: keep
-        side = np.where(side < 0, 0, side)  # unreached: keep
+        side = np.where(side == 2, -1, side)
+        undecided = side < 0  # two-sided at its layer, or never reached
+        outer[hidden] = np.maximum(side, 0)
+        decided = status == ONE_SIDED
+        decided[np.flatnonzero(hidden)[~undecided]] = True
+        side[undecided] = surface_vote(c, outer, decided)[np.flatnonzero(hidden)[undecided]]
         outer[hidden] = side
         if semantics == "cavity":
             even = hidden & (lay.layer % 2 == 0)

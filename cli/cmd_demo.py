@@ -1,0 +1,29 @@
+"""``meshvis demo``: orient, remove-interior and layers on a bundled model, with previews."""
+from __future__ import annotations
+
+import argparse
+import os
+
+from cli.common import say
+from meshvis.errors import OutputError
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("demo", help="run all three repairs on a bundled model and write results + previews")
+    p.add_argument("--out", default="meshvis-demo", help="folder to write into (default ./meshvis-demo)")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--size", type=int, default=512, help="preview size in pixels (default 512)")
+    p.add_argument("--force", action="store_true", help="write into a folder that already has demo files")
+    p.add_argument("--quiet", "-q", action="store_true")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from meshvis.demo import DEMO_FILES, run_demo
+
+    if os.path.exists(args.out) and not os.path.isdir(args.out):
+        raise OutputError("exists and is not a folder", args.out)
+    if not args.force and any(os.path.exists(os.path.join(args.out, f)) for f in DEMO_FILES):
+        raise OutputError("already holds demo results; use --force to overwrite", args.out)
+    run_demo(args.out, seed=args.seed, size=args.size, say=lambda text: say(args, text))
+    return 0
