@@ -15,7 +15,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from .clusters import Clustering
-from .sampling import cosine_hemisphere, sample_scheme_barycentric, uniform_in_triangles
+from .sampling import cosine_hemisphere, sample_scheme_barycentric, tangent_frames, uniform_in_triangles
 
 
 @dataclass
@@ -43,6 +43,7 @@ class NodeSet:
     sample_bary : (samples, 3) barycentric pattern of the sample points (same on every face)
     flagged_metric : (k, 3) float64, per flagged face ``(e1·e1, e1·e2, e2·e2)`` with
         ``e1 = b - a``, ``e2 = c - a``: the metric of its barycentric coordinates
+    tangents : two (m, 3) arrays, a tangent frame of every face normal (for ray directions)
     """
 
     n: int
@@ -64,6 +65,7 @@ class NodeSet:
     flagged_index: np.ndarray
     sample_bary: np.ndarray
     flagged_metric: np.ndarray
+    tangents: tuple[np.ndarray, np.ndarray]
 
     @property
     def n_points(self) -> int:
@@ -153,7 +155,7 @@ def build_nodes(
         entry_node=e_node, entry_face=e_face, entry_side=e_side, entry_cumarea=np.cumsum(areas[e_face]),
         node_start=node_start, flagged=flagged_faces, samples=samples, point_face=point_face,
         point_pos=pos, point_origin=origin, flagged_index=flagged_index, sample_bary=bary,
-        flagged_metric=metric,
+        flagged_metric=metric, tangents=tangent_frames(normals),
     )
 
 
@@ -253,5 +255,8 @@ def node_rays(nodes: NodeSet, normals: np.ndarray, triangles: np.ndarray, counts
         p, s = k // 2, k % 2
         origins[pn] = nodes.point_origin[p, s]
         face[pn], side[pn] = nodes.point_face[p], s
-    directions = cosine_hemisphere(side_normals(normals[face], side), rng)
+    # tangent frames depend on the face only (flipping the normal keeps them orthogonal)
+    t1, t2 = nodes.tangents
+    directions = cosine_hemisphere(side_normals(normals[face], side), rng, (t1[face], t2[face]))
     return source, origins, directions
+

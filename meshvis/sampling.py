@@ -27,7 +27,8 @@ def uniform_in_triangles(triangles: np.ndarray, rng: np.random.Generator) -> np.
     return w0[:, None] * triangles[:, 0] + w1[:, None] * triangles[:, 1] + w2[:, None] * triangles[:, 2]
 
 
-def cosine_hemisphere(normals: np.ndarray, rng: np.random.Generator) -> np.ndarray:
+def cosine_hemisphere(normals: np.ndarray, rng: np.random.Generator,
+                      frames: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
     """Cosine-distributed unit directions around each unit normal.
 
     ``θ = arccos √ξ₁``, ``φ = 2π ξ₂`` (DESIGN.md §4): the density is ``cos θ / π``, so the
@@ -38,6 +39,8 @@ def cosine_hemisphere(normals: np.ndarray, rng: np.random.Generator) -> np.ndarr
     ----------
     normals : (n, 3) unit vectors
     rng : numpy Generator
+    frames : optional precomputed tangents ``(t1, t2)`` of the normals (any orthonormal
+        pair orthogonal to the normal; see :func:`tangent_frames`)
 
     Returns
     -------
@@ -48,9 +51,11 @@ def cosine_hemisphere(normals: np.ndarray, rng: np.random.Generator) -> np.ndarr
     cos_t = np.sqrt(1.0 - xi1)  # same distribution as sqrt(xi1), but never exactly 0 at xi1=0
     sin_t = np.sqrt(xi1)
     phi = 2 * np.pi * xi2
-    t1, t2 = tangent_frames(normals)
-    d = (sin_t * np.cos(phi))[:, None] * t1 + (sin_t * np.sin(phi))[:, None] * t2 + cos_t[:, None] * normals
-    return d / np.linalg.norm(d, axis=1, keepdims=True)
+    t1, t2 = tangent_frames(normals) if frames is None else frames
+    d = (sin_t * np.cos(phi))[:, None] * t1
+    d += (sin_t * np.sin(phi))[:, None] * t2
+    d += cos_t[:, None] * normals
+    return d
 
 
 def tangent_frames(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

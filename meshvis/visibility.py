@@ -99,12 +99,12 @@ def sample_round(
         f, s, sr = h.face[hit], h.side[hit].astype(np.int64), src[hit]
         dst = nodes.side_node[f, s]
         keep = np.ones(len(f), bool)
-        on_flagged = dst < 0
-        if on_flagged.any():
-            idx = np.flatnonzero(on_flagged)
-            p = snap_to_points(nodes, f[idx], h.bary[hit][idx])
+        idx = np.flatnonzero(dst < 0)  # hits on flagged faces: snap, then check the way back
+        if len(idx):
+            hit_idx = np.flatnonzero(hit)[idx]
+            p = snap_to_points(nodes, f[idx], h.bary[hit_idx])
             t0 = time.perf_counter()
-            blocked = caster.occluded(nodes.point_origin[p, s[idx]], origins[hit][idx])
+            blocked = caster.occluded(nodes.point_origin[p, s[idx]], origins[hit_idx])
             counts.time_embree += time.perf_counter() - t0
             counts.reverse_rays += len(idx)
             dst[idx] = nodes.point_node(p, s[idx])

@@ -52,19 +52,16 @@ def edge_weights(hits: sp.spmatrix, counted: np.ndarray, area: np.ndarray, is_po
     r, c, n_ij = coo.row.astype(np.int64), coo.col.astype(np.int64), coo.data
     off = r != c
     r, c, n_ij = r[off], c[off], n_ij[off]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        t = np.where(counted[r] > 0, area[r] * n_ij / np.maximum(counted[r], 1), 0.0)
-    mixed = is_point[r] != is_point[c]
+    t = area[r] * n_ij / np.maximum(counted[r], 1)
+    t[counted[r] <= 0] = 0.0
     # a term from a point node towards a cluster node is dropped; the other one counts fully
-    factor = np.where(mixed, np.where(is_point[r], 0.0, 1.0), 0.5)
-    t = t * factor
-    lo, hi = np.minimum(r, c), np.maximum(r, c)
+    mixed = is_point[r] != is_point[c]
+    t *= np.where(mixed, np.where(is_point[r], 0.0, 1.0), 0.5)
     n = len(area)
-    key = lo * np.int64(n) + hi
-    uniq, inv = np.unique(key, return_inverse=True)
-    w = np.bincount(inv, t, minlength=len(uniq))
-    keep = w > 0
-    return (uniq // n)[keep], (uniq % n)[keep], w[keep]
+    T = sp.csr_matrix((t, (r, c)), shape=(n, n))
+    W = sp.triu(T + T.T, k=1, format="coo")  # sparse addition merges (i,j) with (j,i)
+    keep = W.data > 0
+    return W.row[keep].astype(np.int64), W.col[keep].astype(np.int64), W.data[keep]
 
 
 def outside_weights(escaped: np.ndarray, counted: np.ndarray, area: np.ndarray) -> np.ndarray:
