@@ -17,6 +17,32 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
         p.add_argument("-o", "--output", required=True, help="output model; format from the extension")
     p.add_argument("--report", metavar="REPORT.json", help="write a JSON report with per-face results")
     p.add_argument("--preview", metavar="PICTURE.png", help="write a ray-cast preview image")
+    algorithm_options(p)
+    p.add_argument("--inside-point", type=point, action="append", default=[], metavar="X,Y,Z",
+                   help="a point known to be inside (repeatable)")
+    p.add_argument("--outside-point", type=point, action="append", default=[], metavar="X,Y,Z",
+                   help="a point known to be outside (repeatable)")
+    p.add_argument("--inside-box", type=box, action="append", default=[], metavar="X0,Y0,Z0,X1,Y1,Z1",
+                   help="an axis-aligned box known to be inside (repeatable)")
+    p.add_argument("--outside-box", type=box, action="append", default=[], metavar="X0,Y0,Z0,X1,Y1,Z1",
+                   help="an axis-aligned box known to be outside (repeatable)")
+    p.add_argument("--force", action="store_true", help="overwrite existing outputs")
+    p.add_argument("--quiet", "-q", action="store_true", help="print nothing but errors")
+
+
+def box(text: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
+    """Parse ``x0,y0,z0,x1,y1,z1`` (min corner, max corner)."""
+    try:
+        v = [float(t) for t in text.split(",")]
+    except ValueError:
+        v = []
+    if len(v) != 6 or any(a > b for a, b in zip(v[:3], v[3:])):
+        raise argparse.ArgumentTypeError(f"expected x0,y0,z0,x1,y1,z1 with min <= max, got {text!r}")
+    return tuple(v[:3]), tuple(v[3:])
+
+
+def algorithm_options(p: argparse.ArgumentParser) -> None:
+    """Add the graph-cut options that apply to any model (shared with ``meshvis batch``)."""
     p.add_argument("--seed", type=int, default=0, help="random seed (default 0)")
     p.add_argument("--rays-per-node", type=positive_int, default=32, help="ray budget per node (default 32)")
     p.add_argument("--samples-per-face", type=positive_int, default=4,
@@ -24,12 +50,6 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     p.add_argument("--no-filter", action="store_true", help="switch off the cosine filter (Eq. 8-9)")
     p.add_argument("--no-progressive", action="store_true", help="cast the whole ray budget in one round")
     p.add_argument("--solver", choices=("pymaxflow", "scipy"), default="pymaxflow")
-    p.add_argument("--inside-point", type=point, action="append", default=[], metavar="X,Y,Z",
-                   help="a point known to be inside (repeatable)")
-    p.add_argument("--outside-point", type=point, action="append", default=[], metavar="X,Y,Z",
-                   help="a point known to be outside (repeatable)")
-    p.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    p.add_argument("--quiet", "-q", action="store_true", help="print nothing but errors")
 
 
 def add_parser(sub) -> None:
@@ -63,10 +83,13 @@ def add_parser(sub) -> None:
 def classify_kwargs(args: argparse.Namespace) -> dict:
     from meshvis.hints import Hints
 
+    given = {k: getattr(args, k, None) or [] for k in ("inside_point", "outside_point", "inside_box", "outside_box")}
     hints = None
-    if args.inside_point or args.outside_point:
-        hints = Hints(inside_points=np.array(args.inside_point).reshape(-1, 3),
-                      outside_points=np.array(args.outside_point).reshape(-1, 3))
+    if any(given.values()):
+        hints = Hints(inside_points=np.array(given["inside_point"]).reshape(-1, 3),
+                      outside_points=np.array(given["outside_point"]).reshape(-1, 3),
+                      inside_boxes=np.array(given["inside_box"]).reshape(-1, 2, 3),
+                      outside_boxes=np.array(given["outside_box"]).reshape(-1, 2, 3))
     return dict(rays_per_node=args.rays_per_node, seed=args.seed, samples_per_face=args.samples_per_face,
                 use_filter=not args.no_filter, progressive=not args.no_progressive, solver=args.solver,
                 hints=hints)

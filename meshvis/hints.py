@@ -93,6 +93,6 @@ def hint_weights(caster: RayCaster, nodes: NodeSet, hints: Hints, rng: np.random
             flag = dst < 0
             if flag.any():
                 dst[flag] = nodes.point_node(snap_to_points(nodes, f[flag], h.bary[hit][flag]), s[flag])
-            w = np.bincount(dst, minlength=nodes.n) * (hints.strength * total_area / hints.rays)
+            w = np.bincount(dst, minlength=nodes.n) * (hints.strength * total_area / max(len(dst), 1))
         out.append(w)
     return out[0], out[1], n_cast

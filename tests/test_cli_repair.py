@@ -127,3 +127,26 @@ def test_demo_writes_everything(tmp_path):
     assert report["orientation_correct_area"] >= 0.995
     assert report["removal_agreement_faces"] >= 0.995
     assert main(["demo", "--out", str(folder), "-q"]) == 2  # refuses to overwrite
+
+
+def test_terrain_hints_from_the_command_line(tmp_path):
+    truth = G.terrain(n=24)
+    path = tmp_path / "terrain.obj"
+    save(truth.soup, str(path))
+    rep = tmp_path / "t.json"
+    lo, hi = truth.soup.bounds
+    below = ",".join(f"{x:.6g}" for x in [lo[0] + 0.4 * (hi[0] - lo[0]), lo[1] + 0.4 * (hi[1] - lo[1]), lo[2] - 1.0,
+                                          lo[0] + 0.6 * (hi[0] - lo[0]), lo[1] + 0.6 * (hi[1] - lo[1]), lo[2] - 0.5])
+    above = ",".join(f"{x:.6g}" for x in [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 1.0])
+    assert main(["classify", str(path), "--inside-box", below, "--outside-point", above,
+                 "--report", str(rep), "-q"]) == 0
+    r = json.loads(rep.read_text())
+    front = np.array(r["per_face"]["outside_front"]) > 0.5
+    back = np.array(r["per_face"]["outside_back"]) > 0.5
+    assert np.array_equal(front, truth.outside[:, 0]) and np.array_equal(back, truth.outside[:, 1])
+
+
+def test_bad_box_is_a_usage_error(tmp_path):
+    with pytest.raises(SystemExit) as e:
+        main(["classify", "x.obj", "--inside-box", "1,2,3"])
+    assert e.value.code == 2
