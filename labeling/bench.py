@@ -1,0 +1,269 @@
+"""Labeling benchmark: per-stage times and layout quality against the two baselines.
+
+Three parts, all measured in one process on the same ID buffers:
+
+1. **layouts** — for every layout at one image size (default 512 x 512): the time of
+   every stage (median of ``repeat`` runs; ``layout_ms`` = everything after the ID
+   buffer) and the quality metrics of the fuzzy-greedy method, the classic two-step
+   method and adjustText fed the two-step anchors;
+2. **sizes** — quality and time against the image size (256 ... 1024) for one layout:
+   the labeling curve of the error-against-run-time report.  The error of a size is the
+   mean distance of its anchors from the same method's anchors at the largest size
+   (in image fractions, divided by ``d_S``);
+3. **orbit** — frame-to-frame motion along an orbit: fuzzy with the coherence terms
+   f6, f7, fuzzy without them, and the two-step method.
+
+``meshvis bench labeling`` calls :func:`main`; Python code calls :func:`run`.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import statistics
+import time
+from typing import Any, Callable, Sequence
+
+import numpy as np
+
+from meshvis.rays import RayCaster
+
+from .baselines import adjust_text
+from .candidates import LAYOUTS
+from .frames import layout_frames, orbit
+from .idbuffer import id_buffer
+from .inputs import label_texts, load_models
+from .metrics import sequence_metrics
+from .pipeline import LAYOUT_STAGES, fit_camera, solve
+
+#: metrics shown in the tables
+QUALITY = ("labels", "overlaps", "crossings", "leaders_through_labels", "label_over_model", "invalid_anchors",
+           "salience_mean", "leader_mean_norm", "leader_max_norm", "shifted_labels", "labelling_rate")
+
+
+def default_model() -> tuple[Any, str]:
+    """The project's engine-like assembly (``models/assembly.obj``, else the generator)."""
+    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    path = os.path.join(here, "models", "assembly.obj")
+    if os.path.exists(path):
+        return load_models(path), path
+    from meshvis.generators import assembly
+
+    return assembly().soup, "meshvis.generators.assembly()"
+
+
+def _pick(metrics: dict[str, Any]) -> dict[str, Any]:
+    return {k: metrics[k] for k in QUALITY if k in metrics}
+
+
+def _median_timings(runs: Sequence[dict[str, float]]) -> dict[str, float]:
+    keys = [k for k in runs[0] if k != "metrics"]
+    return {k: float(statistics.median(r.get(k, 0.0) for r in runs)) for k in keys}
+
+
+def run(
+    model: Any = None,
+    *,
+    size: int = 512,
+    layouts: Sequence[str] = tuple(LAYOUTS),
+    sizes: Sequence[int] = (256, 384, 512, 768, 1024),
+    size_layout: str = "left-right",
+    orbit_frames: int = 12,
+    orbit_layout: str = "left-right",
+    repeat: int = 5,
+    adjusttext: bool = True,
+    adjusttext_iterations: int = 200,
+    up: Sequence[float] = (0.0, 0.0, 1.0),
+    azimuth: float = 30.0,
+    elevation: float = 20.0,
+    progress: Callable[[str], None] | None = None,
+) -> dict[str, Any]:
+    """Run the labeling benchmark.
+
+    Parameters
+    ----------
+    model : anything :func:`labeling.layout` takes; default :func:`default_model`
+    size : image width = height of the layout comparison (pixels)
+    layouts : layouts to compare
+    sizes : image sizes of the quality-against-size curve
+    size_layout : layout of the size curve
+    orbit_frames : frames of the orbit (0 skips the orbit)
+    orbit_layout : layout of the orbit
+    repeat : runs per timing (the median is reported); the first, untimed run warms caches
+    adjusttext : also run the adjustText baseline (slow: seconds per layout)
+    adjusttext_iterations : its fixed iteration count
+    up, azimuth, elevation : the camera (fitted to the model)
+    progress : called with a line of text after each step
+
+    Returns
+    -------
+    dict
+        ``model``, ``parts``, ``size``, ``layouts`` (per layout: ``fuzzy``, ``two-step``,
+        ``adjusttext`` each with ``timings`` (seconds, ``layout_ms`` in ms) and
+        ``metrics``), ``sizes`` (per size: times and metrics of both methods, ``error``),
+        ``orbit`` (sequence metrics of the three variants).
+    """
+    say = progress or (lambda s: None)
+    if model is None:
+        soup, name = default_model()
+    else:
+        soup = load_models(model)
+        name = soup.path or str(model)
+    texts = label_texts(soup.part_names)
+    t0 = time.perf_counter()
+    caster = RayCaster(soup)
+    setup_s = time.perf_counter() - t0
+    cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up)
+    out: dict[str, Any] = {"model": name, "parts": soup.n_parts, "faces": soup.n_faces, "size": int(size),
+                           "repeat": int(repeat), "setup_s": setup_s, "layouts": {}, "sizes": {}, "orbit": {}}
+
+    def idbuf_at(n: int):
+        t = time.perf_counter()
+        ib = id_buffer(soup, cam, (n, n), caster=caster)
+        return ib, time.perf_counter() - t
+
+    ib, id_s = idbuf_at(size)
+    out["visible_parts"] = int(len(ib.visible()))
+    out["idbuffer_s"] = id_s
+    for layout in layouts:
+        entry: dict[str, Any] = {}
+        for method in ("fuzzy", "two-step"):
+            solve(ib, texts, layout=layout, method=method)  # warm-up (fonts, caches)
+            runs = [solve(ib, texts, layout=layout, method=method) for _ in range(max(1, repeat))]
+            entry[method] = {"timings": _median_timings([r.timings for r in runs]), "metrics": _pick(runs[-1].metrics)}
+            ref = runs[-1]
+            if method == "two-step" and adjusttext:
+                at = adjust_text(ref, iterations=adjusttext_iterations)
+                entry["adjusttext"] = {"timings": {"boxes": at.timings["boxes"],
+                                                   "layout_ms": 1000.0 * at.timings["boxes"]},
+                                       "metrics": _pick(at.metrics)}
+        out["layouts"][layout] = entry
+        f = entry["fuzzy"]
+        say(f"{layout:11s} fuzzy {f['timings']['layout_ms']:6.1f} ms, leader {f['metrics']['leader_mean_norm']:.3f}, "
+            f"salience {f['metrics']['salience_mean']:.3f}")
+    # quality and time against the image size
+    ref_anchor: dict[str, dict[int, np.ndarray]] = {}
+    ref_ds: dict[str, float] = {}
+    per_size = {}
+    for n in sorted(sizes, reverse=True):
+        ibn, idn = idbuf_at(n)
+        rec: dict[str, Any] = {"idbuffer_s": idn}
+        for method in ("fuzzy", "two-step"):
+            solve(ibn, texts, layout=size_layout, method=method)
+            runs = [solve(ibn, texts, layout=size_layout, method=method) for _ in range(max(1, repeat))]
+            r = runs[-1]
+            lay_ms = float(statistics.median(x.timings["layout_ms"] for x in runs))
+            scale = 1.0 / n  # anchors in fractions of the image, comparable across sizes
+            anchors = {lab.part: lab.anchor * scale for lab in r.labels}
+            if method not in ref_anchor:  # the largest size is each method's reference
+                ref_anchor[method] = dict(anchors)
+                ref_ds[method] = r.sphere_diameter * scale
+            ref = ref_anchor[method]
+            common = sorted(set(anchors) & set(ref))
+            err = float(np.mean([np.linalg.norm(anchors[p] - ref[p]) for p in common]) / ref_ds[method]) if common else 0.0
+            rec[method] = {"layout_ms": lay_ms, "total_s": idn + lay_ms / 1000.0, "error": err,
+                           "metrics": _pick(r.metrics)}
+        per_size[int(n)] = rec
+        say(f"size {n:5d}: id buffer {idn * 1000:7.1f} ms, fuzzy layout {rec['fuzzy']['layout_ms']:6.1f} ms, "
+            f"error {rec['fuzzy']['error']:.4f}")
+    out["sizes"] = {k: per_size[k] for k in sorted(per_size)}
+    out["size_layout"] = size_layout
+    if orbit_frames and orbit_frames > 1:
+        cams = orbit(soup, orbit_frames, elevation=elevation, start=azimuth, up=up)
+        variants = {"fuzzy": dict(method="fuzzy"), "fuzzy-no-coherence": dict(method="fuzzy", coherence=False),
+                    "two-step": dict(method="two-step", coherence=False)}
+        for key, kw in variants.items():
+            res = layout_frames(soup, cams, caster=caster, layout=orbit_layout, size=(size, size), **kw)
+            seq = sequence_metrics(res)
+            seq["clean_frames"] = int(sum(r.metrics["overlaps"] == 0 and r.metrics["crossings"] == 0
+                                          and r.metrics["label_over_model"] == 0 for r in res))
+            seq["layout_ms_mean"] = float(np.mean([r.timings["layout_ms"] for r in res[1:]] or [0.0]))
+            seq["leader_mean_norm"] = float(np.mean([r.metrics["leader_mean_norm"] for r in res]))
+            seq["salience_mean"] = float(np.mean([r.metrics["salience_mean"] for r in res]))
+            out["orbit"][key] = seq
+            say(f"orbit {key:18s} label motion {seq['label_motion_mean']:.2f} px/frame, anchor motion "
+                f"{seq['anchor_motion_mean']:.2f}, flips {seq['side_flips']}, swaps {seq['order_swaps']}")
+        out["orbit_layout"] = orbit_layout
+        out["orbit_frames"] = int(orbit_frames)
+    return out
+
+
+def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' common name
+    """Plain-text tables of a :func:`run` result."""
+    lines = [f"labeling benchmark: {result['model']} ({result['parts']} parts, {result['visible_parts']} visible), "
+             f"{result['size']} x {result['size']}, median of {result['repeat']} runs",
+             f"ray caster build {result['setup_s'] * 1000:.1f} ms, ID buffer {result['idbuffer_s'] * 1000:.1f} ms", ""]
+    stages = [s for s in LAYOUT_STAGES]
+    head = f"{'layout':11s} {'method':10s} " + " ".join(f"{s[:6]:>6s}" for s in stages) + f" {'layout':>7s}"
+    lines += ["per-stage time per frame (ms)", head]
+    for layout, entry in result["layouts"].items():
+        for method in ("fuzzy", "two-step"):
+            t = entry[method]["timings"]
+            lines.append(f"{layout:11s} {method:10s} " + " ".join(f"{1000 * t.get(s, 0.0):6.1f}" for s in stages)
+                         + f" {t['layout_ms']:7.1f}")
+        if "adjusttext" in entry:
+            lines.append(f"{layout:11s} {'adjusttext':10s} " + " ".join(f"{'':6s}" for _ in stages)
+                         + f" {entry['adjusttext']['timings']['layout_ms']:7.1f}")
+    lines += ["", "quality", f"{'layout':11s} {'method':10s} {'labels':>6s} {'overlap':>7s} {'cross':>5s} "
+              f"{'thru':>4s} {'over_px':>7s} {'bad_a':>5s} {'salience':>8s} {'leader':>7s} {'max':>6s} {'shifted':>7s}"]
+    for layout, entry in result["layouts"].items():
+        for method in ("fuzzy", "two-step", "adjusttext"):
+            if method not in entry:
+                continue
+            m = entry[method]["metrics"]
+            lines.append(f"{layout:11s} {method:10s} {m['labels']:6d} {m['overlaps']:7d} {m['crossings']:5d} "
+                         f"{m['leaders_through_labels']:4d} {m['label_over_model']:7d} {m['invalid_anchors']:5d} "
+                         f"{m['salience_mean']:8.3f} {m['leader_mean_norm']:7.3f} {m['leader_max_norm']:6.3f} "
+                         f"{m.get('shifted_labels', 0):7d}")
+    if result.get("sizes"):
+        lines += ["", f"quality against image size ({result['size_layout']}); error = mean anchor distance to the "
+                  f"same method's anchors at the largest size / d_S",
+                  f"{'size':>5s} {'id_ms':>7s} {'fz_ms':>7s} {'fz_err':>7s} {'fz_leader':>9s} {'fz_sal':>6s} "
+                  f"{'2s_ms':>7s} {'2s_err':>7s} {'2s_leader':>9s} {'2s_sal':>6s}"]
+        for n, rec in result["sizes"].items():
+            f, t = rec["fuzzy"], rec["two-step"]
+            lines.append(f"{int(n):5d} {rec['idbuffer_s'] * 1000:7.1f} {f['layout_ms']:7.1f} {f['error']:7.4f} "
+                         f"{f['metrics']['leader_mean_norm']:9.3f} {f['metrics']['salience_mean']:6.3f} "
+                         f"{t['layout_ms']:7.1f} {t['error']:7.4f} {t['metrics']['leader_mean_norm']:9.3f} "
+                         f"{t['metrics']['salience_mean']:6.3f}")
+    if result.get("orbit"):
+        lines += ["", f"orbit of {result['orbit_frames']} frames ({result['orbit_layout']}), motion per frame (px)",
+                  f"{'variant':20s} {'label':>6s} {'anchor':>6s} {'flips':>5s} {'swaps':>5s} {'clean':>5s} "
+                  f"{'leader':>6s} {'salience':>8s} {'ms':>6s}"]
+        for key, s in result["orbit"].items():
+            lines.append(f"{key:20s} {s['label_motion_mean']:6.2f} {s['anchor_motion_mean']:6.2f} {s['side_flips']:5d} "
+                         f"{s['order_swaps']:5d} {s['clean_frames']:5d} {s['leader_mean_norm']:6.3f} "
+                         f"{s['salience_mean']:8.3f} {s['layout_ms_mean']:6.1f}")
+    return "\n".join(lines)
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    """Options of ``meshvis bench labeling``."""
+    parser.add_argument("model", nargs="*", help="model file(s) (default: models/assembly.obj)")
+    parser.add_argument("--size", type=int, default=512, help="image size of the layout comparison (default 512)")
+    parser.add_argument("--sizes", type=int, nargs="+", default=[256, 384, 512, 768, 1024],
+                        help="image sizes of the quality-against-size curve")
+    parser.add_argument("--layouts", nargs="+", choices=tuple(LAYOUTS), default=list(LAYOUTS))
+    parser.add_argument("--orbit", type=int, default=12, help="frames of the orbit (0: skip)")
+    parser.add_argument("--repeat", type=int, default=5, help="runs per timing, median reported (default 5)")
+    parser.add_argument("--no-adjusttext", action="store_true", help="skip the (slow) adjustText baseline")
+    parser.add_argument("--up", choices=("x", "y", "z"), default="z", help="the model's up axis (default z)")
+    parser.add_argument("--json", metavar="FILE", help="also write the numbers as JSON")
+
+
+def main(args: argparse.Namespace) -> int:
+    """Entry point of ``meshvis bench labeling``."""
+    from meshvis.camera import AXES
+
+    from .output import write_json
+
+    model = None
+    if args.model:
+        model = args.model if len(args.model) > 1 else args.model[0]
+    result = run(model, size=args.size, layouts=args.layouts, sizes=args.sizes, orbit_frames=args.orbit,
+                 repeat=args.repeat, adjusttext=not args.no_adjusttext, up=AXES[args.up],
+                 progress=lambda s: print(s, flush=True))
+    print()
+    print(format(result))
+    if args.json:
+        write_json(result, args.json)
+    return 0

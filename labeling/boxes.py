@@ -1,0 +1,623 @@
+"""Label boxes: stacking along the internal area and the corrections of appendix I §5.5.
+
+The greedy step gives every label an anchor ``a`` and a candidate endpoint ``e`` on the
+boundary of ``A_I``.  This module turns them into drawn leaders and boxes with no box
+overlaps, no leader crossings and no box over the model:
+
+* **west / east** (left, right, left-right layouts): the boxes of a side are stacked in one
+  column just outside ``A_I`` (as in appendix I, Fig. 2a-b).  A box wants to sit at its
+  endpoint's height; where boxes would overlap they are **shifted** apart along the
+  column by the least total squared displacement that keeps their order (pool-adjacent-
+  violators on the stacked positions).  Shifting rotates leaders ("relieving criterion 1"),
+  which may make two of them cross; crossing pairs then **swap** their slots, which
+  strictly shortens the sum of leader lengths, so the swapping ends (§5.5).
+* **north / south** (top, bottom, top-bottom): leader ports are spread along a line just
+  above (below) ``A_I`` with the same shift-then-swap step; the boxes hang like flags off
+  the leaders and are stacked in tiers away from the model where they do not fit side by
+  side; labels left of the centre extend left and fill tiers outside-in, those right of it
+  extend right, which keeps every extended leader clear of the other boxes.
+* **radial** (silhouette layout): labels are taken in order along the boundary of
+  ``A_I``; each box goes on the ray of the boundary's outward normal at its endpoint,
+  just outside ``A_I``, and is pushed further out in tiers where it collides (the
+  "extruded" leaders of Fig. 4b).  A box may hang off its port at any corner or edge
+  middle; the cheapest valid place that blocks no later label's ray wins.  Normals of a
+  convex boundary diverge, so the rays never meet.  Only a label whose own leader is
+  blocked (e.g. it shares its endpoint with a placed one) gets its endpoint shifted a
+  few pixels along the boundary.
+
+A last pass checks every pair of labels and re-places a label of any conflicting pair
+(the one placed later by the greedy order) by the same candidate search; a label with no
+valid place is left out and reported.  Everything is deterministic: sorts are stable
+with the label index as the last key, and candidate ties go to the lowest index.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from .candidates import EAST, NORTH, RADIAL, SOUTH, WEST
+from .geometry2d import boxes_overlap, segment_hits_box, segments_intersect
+from .internal_area import InternalArea, resample_boundary
+
+
+@dataclass(frozen=True)
+class Spacing:
+    """Distances of the box layout, in pixels.
+
+    Attributes
+    ----------
+    gap : free space between two boxes
+    clearance : free space between ``A_I`` and the boxes (column / row / ray start)
+    port_gap : least distance between two leader ports of the north/south layouts
+    inset : distance of a flag leader from the near end of its box (north/south)
+    """
+
+    gap: float = 3.0
+    clearance: float = 4.0
+    port_gap: float = 5.0
+    inset: float = 2.0
+
+
+@dataclass
+class Placement:
+    """Where one label ended up.
+
+    Attributes
+    ----------
+    leader : (k, 2) float, polyline from the anchor to the box
+    box : (4,) float, (x0, y0, x1, y1)
+    side : int, side code
+    tier : int, 0 next to ``A_I``, higher = pushed further out
+    shift : float, distance of the box's port from the candidate endpoint along the side
+    """
+
+    leader: np.ndarray
+    box: np.ndarray
+    side: int
+    tier: int = 0
+    shift: float = 0.0
+
+
+@dataclass
+class BoxStats:
+    """Counts of the corrections applied."""
+
+    shifted: int = 0
+    swaps: int = 0
+    repaired: int = 0
+    unplaced: list = field(default_factory=list)
+
+
+# ---------------------------------------------------------------------------- shift (1D)
+def pack_1d(desired: np.ndarray, sizes: np.ndarray, gap: float, lo: float, hi: float) -> np.ndarray:
+    """Centres of boxes in a row: least squared shift from ``desired``, order kept, no overlap.
+
+    Minimises ``sum (p_i - desired_i)^2`` subject to ``p_{i+1} - p_i >= (s_i + s_{i+1})/2
+    + gap`` and ``lo <= p_0 - s_0/2``, ``p_{n-1} + s_{n-1}/2 <= hi``.  ``desired`` must be
+    sorted.  Substituting ``z_i = p_i - o_i`` (``o`` = cumulative spacing) turns it into
+    isotonic regression of ``desired - o``, solved exactly by pool-adjacent-violators and
+    then clipped to the bounds.  When the row does not fit, it is centred between them.
+    """
+    desired = np.asarray(desired, np.float64)
+    sizes = np.asarray(sizes, np.float64)
+    n = len(desired)
+    if n == 0:
+        return desired.copy()
+    off = np.concatenate([[0.0], np.cumsum((sizes[:-1] + sizes[1:]) / 2 + gap)])
+    z = desired - off
+    sums: list[float] = []
+    counts: list[int] = []
+    for v in z:  # pool adjacent violators: one pass over the (few) labels of a side
+        sums.append(float(v))
+        counts.append(1)
+        while len(sums) > 1 and sums[-2] / counts[-2] > sums[-1] / counts[-1]:
+            s, c = sums.pop(), counts.pop()
+            sums[-1] += s
+            counts[-1] += c
+    fit = np.repeat([s / c for s, c in zip(sums, counts)], counts)
+    zlo = lo + sizes[0] / 2
+    zhi = hi - sizes[-1] / 2 - off[-1]
+    fit = np.clip(fit, zlo, zhi) if zlo <= zhi else np.full(n, 0.5 * (zlo + zhi))
+    return fit + off
+
+
+def uncross(anchors: np.ndarray, ports: np.ndarray, max_swaps: int | None = None) -> tuple[np.ndarray, int]:
+    """Swap ports of crossing straight leaders ``anchor -> port`` until none cross.
+
+    Each swap of two crossing segments' ends shortens the total length (triangle
+    inequality), so the loop ends; the first crossing pair in index order is swapped.
+
+    Returns
+    -------
+    assignment : (n,) int, port index of each anchor
+    swaps : int
+    """
+    n = len(anchors)
+    assign = np.arange(n)
+    limit = n * n + 1 if max_swaps is None else max_swaps
+    swaps = 0
+    segs = np.stack([anchors, ports[assign]], axis=1)
+    x = segments_intersect(segs, segs)
+    np.fill_diagonal(x, False)
+    while swaps < limit and x.any():
+        i, j = np.unravel_index(np.argmax(np.triu(x, 1)), x.shape)
+        assign[[i, j]] = assign[[j, i]]
+        swaps += 1
+        segs[[i, j], 1] = ports[assign[[i, j]]]
+        rows = segments_intersect(segs[[i, j]], segs)  # only the two moved leaders changed
+        x[[i, j], :] = rows
+        x[:, [i, j]] = rows.T
+        np.fill_diagonal(x, False)
+    return assign, swaps
+
+
+# ---------------------------------------------------------------------------- layout context
+class _Context:
+    """Everything the placement of one frame shares."""
+
+    def __init__(self, anchors, endpoints, sides, widths, height, area, image_size, spacing, rank):
+        self.anchors = np.asarray(anchors, np.float64).reshape(-1, 2)
+        self.endpoints = np.asarray(endpoints, np.float64).reshape(-1, 2)
+        self.sides = np.asarray(sides, np.int64)
+        self.widths = np.asarray(widths, np.float64)
+        self.height = float(height)
+        self.area = area
+        self.W, self.H = (float(s) for s in image_size)
+        self.sp = spacing
+        self.rank = np.asarray(rank, np.int64)
+        self.placed: list[Placement | None] = [None] * len(self.anchors)
+        x0, y0, x1, y1 = area.bbox
+        self.col_x = {WEST: float(np.nanmin(area.left)) - spacing.clearance,
+                      EAST: float(np.nanmax(area.right)) + spacing.clearance}
+        self.row_y = {NORTH: float(np.nanmin(area.top)) - spacing.clearance,
+                      SOUTH: float(np.nanmax(area.bottom)) + spacing.clearance}
+        self.center = area.centroid
+        self.stats = BoxStats()
+        self._boundary = None
+        self._rays = None
+        self._cache = None
+
+    # geometry of one label in a column / row
+    def column_box(self, k: int, side: int, y: np.ndarray) -> np.ndarray:
+        x = self.col_x[side]
+        w, h = self.widths[k], self.height
+        y = np.asarray(y, np.float64)
+        x0 = np.full_like(y, x - w if side == WEST else x)
+        return np.stack([x0, y - h / 2, x0 + w, y + h / 2], axis=-1)
+
+    def row_box(self, k: int, side: int, x: np.ndarray, tier: np.ndarray) -> np.ndarray:
+        """Flag box of label k whose leader port is at ``x``, in ``tier``."""
+        w, h, sp = self.widths[k], self.height, self.sp
+        x = np.asarray(x, np.float64)
+        tier = np.asarray(tier, np.float64)
+        left_flag = x < self.center[0]
+        x0 = np.where(left_flag, x + sp.inset - w, x - sp.inset)
+        step = h + sp.gap
+        if side == NORTH:
+            y1 = self.row_y[NORTH] - tier * step
+            y0 = y1 - h
+        else:
+            y0 = self.row_y[SOUTH] + tier * step
+            y1 = y0 + h
+        x0, y0, y1 = np.broadcast_arrays(x0, y0, y1)
+        return np.stack([x0, y0, x0 + w, y1], axis=-1)
+
+    def row_leader(self, k: int, side: int, x: float, tier: int) -> np.ndarray:
+        box = self.row_box(k, side, np.array(x), np.array(tier))
+        port = (x, self.row_y[side])
+        pts = [self.anchors[k], port]
+        if tier > 0:
+            pts.append((x, box[3] if side == NORTH else box[1]))
+        return np.array(pts, np.float64)
+
+    boundary_step = 2.0
+    future: tuple = ()
+
+    def ray_direction(self, k: int) -> np.ndarray:
+        """Outward unit normal of ``A_I`` at label k's endpoint: the direction of its push-out.
+
+        Normals of a convex boundary turn monotonically, so these rays never meet.
+        """
+        if self._rays is None:
+            pts, normals = self.boundary
+            d2 = ((self.endpoints[:, None, :] - pts[None, :, :]) ** 2).sum(axis=2)
+            self._rays = normals[np.argmin(d2, axis=1)]
+        return self._rays[k]
+
+    def future_rays(self, k: int) -> np.ndarray:
+        """Rays (m, 2, 2) of the radial labels not placed yet (other than k)."""
+        js = np.array([j for j in self.future if j != k], np.int64)
+        if len(js) == 0:
+            return np.zeros((0, 2, 2))
+        self.ray_direction(0)
+        far = 2.0 * (self.W + self.H)
+        e = self.endpoints[js]
+        return np.stack([e, e + far * self._rays[js]], axis=1)
+
+    @property
+    def boundary(self) -> tuple[np.ndarray, np.ndarray]:
+        """Points every 2 px along the boundary of ``A_I`` and their outward unit normals."""
+        if self._boundary is None:
+            pts, arc = resample_boundary(self.area.polygon, 2.0)
+            self.boundary_step = float(arc[1] - arc[0])
+            tangent = np.roll(pts, -1, axis=0) - np.roll(pts, 1, axis=0)
+            normal = np.column_stack([tangent[:, 1], -tangent[:, 0]])
+            normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), 1e-12)[:, None]
+            outward = np.einsum("ij,ij->i", normal, pts - self.center) >= 0
+            normal[~outward] *= -1  # convex area: outward = away from the centre
+            self._boundary = (pts, normal)
+        return self._boundary
+
+
+# ---------------------------------------------------------------------------- sides
+def _place_column(ctx: _Context, idx: np.ndarray, side: int) -> None:
+    """Stack the boxes of one west/east side in a column: shift, then swap."""
+    if len(idx) == 0:
+        return
+    desired = ctx.endpoints[idx, 1]
+    order = np.lexsort((idx, desired))
+    idx, desired = idx[order], desired[order]
+    h = ctx.height
+    slots = pack_1d(desired, np.full(len(idx), h), ctx.sp.gap, 0.0, ctx.H)
+    x = ctx.col_x[side]
+    ports = np.column_stack([np.full(len(idx), x), slots])
+    assign, swaps = uncross(ctx.anchors[idx], ports)
+    ctx.stats.swaps += swaps
+    for k, slot in zip(idx, assign):
+        y = slots[slot]
+        shift = abs(y - ctx.endpoints[k, 1])
+        ctx.stats.shifted += int(shift > 0.5)
+        ctx.placed[k] = Placement(
+            leader=np.array([ctx.anchors[k], [x, y]]),
+            box=ctx.column_box(k, side, np.array(y)),
+            side=side,
+            tier=0,
+            shift=float(shift),
+        )
+
+
+def _place_row(ctx: _Context, idx: np.ndarray, side: int) -> None:
+    """Spread the ports of one north/south side (shift, swap), then stack flag boxes in tiers."""
+    if len(idx) == 0:
+        return
+    desired = ctx.endpoints[idx, 0]
+    order = np.lexsort((idx, desired))
+    idx, desired = idx[order], desired[order]
+    # spread the ports as far as the image allows, up to one box width apart: wider
+    # spacing means fewer tiers, at the price of more slanted leaders
+    fair = (ctx.W - 2 * ctx.sp.clearance) / len(idx)
+    gap = float(np.clip(fair, ctx.sp.port_gap, ctx.widths[idx].mean() + ctx.sp.gap))
+    xs = pack_1d(desired, np.zeros(len(idx)), gap, 0.0, ctx.W)
+    y = ctx.row_y[side]
+    ports = np.column_stack([xs, np.full(len(idx), y)])
+    assign, swaps = uncross(ctx.anchors[idx], ports)
+    ctx.stats.swaps += swaps
+    port_x = xs[assign]
+    left = port_x < ctx.center[0]
+    g = ctx.sp.gap
+    # left group: outermost (leftmost) first; a box may sit in tier r only if it starts
+    # right of every box already in tier r or above (those leaders pass through tier r)
+    for group, sign in ((np.flatnonzero(left), 1.0), (np.flatnonzero(~left), -1.0)):
+        seq = group[np.lexsort((idx[group], sign * port_x[group]))]
+        tiers: list[int] = []
+        edges: list[float] = []  # far edge of each placed box toward the centre
+        for j in seq:
+            k = idx[j]
+            box0 = ctx.row_box(k, side, np.array(port_x[j]), np.array(0))
+            near = box0[0] if sign > 0 else box0[2]  # edge facing the labels placed before
+            r = 0
+            t = np.array(tiers)
+            e = np.array(edges)
+            while True:
+                above = t >= r
+                if not above.any():
+                    break
+                if sign > 0 and near - g >= e[above].max():
+                    break
+                if sign < 0 and near + g <= e[above].min():
+                    break
+                r += 1
+            box = ctx.row_box(k, side, np.array(port_x[j]), np.array(r))
+            tiers.append(r)
+            edges.append(box[2] if sign > 0 else box[0])
+            shift = abs(port_x[j] - ctx.endpoints[k, 0])
+            ctx.stats.shifted += int(shift > 0.5)
+            ctx.placed[k] = Placement(ctx.row_leader(k, side, float(port_x[j]), r), box, side, r, float(shift))
+
+
+def _ring_order(ctx: _Context, idx: np.ndarray) -> np.ndarray:
+    """Labels ordered along the boundary of ``A_I``, starting after the widest gap."""
+    pts, _ = ctx.boundary
+    e = ctx.endpoints[idx]
+    q = np.argmin(((e[:, None, :] - pts[None, :, :]) ** 2).sum(axis=2), axis=1)
+    order = np.lexsort((idx, q))
+    idx, q = idx[order], q[order]
+    gaps = np.diff(np.append(q, q[0] + len(pts)))
+    return np.roll(idx, -((int(np.argmax(gaps)) + 1) % len(idx)))
+
+
+def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
+    """Place the boxes of the silhouette layout around ``A_I`` (Fig. 4b of appendix I).
+
+    Labels are taken in their order along the boundary of ``A_I``, starting after the
+    widest gap between endpoints, and each gets its cheapest valid candidate
+    (:func:`_search`): the box just outside ``A_I`` on its endpoint's normal ray, else
+    pushed out in tiers, preferring places that leave the rays of the labels still to
+    come free.  A box may hang off its port at any corner or edge middle, so that a
+    crowded stretch of the boundary becomes a staircase of boxes instead of a pile.
+    """
+    if len(idx) == 0:
+        return
+    order = [int(k) for k in _ring_order(ctx, idx)]
+    for n, k in enumerate(order):
+        ctx.future = tuple(order[n + 1:])
+        if not _search(ctx, k):
+            ctx.stats.unplaced.append(int(k))
+    ctx.future = ()
+
+
+#: attach points of a box: offsets of the box centre from the port, in half widths/heights
+_ATTACH = np.array([[1, 0], [-1, 0], [0, 1], [0, -1], [1, 1], [1, -1], [-1, 1], [-1, -1]], np.float64)
+
+
+# ---------------------------------------------------------------------------- candidate search
+def _placed_arrays(ctx: _Context, exclude: int) -> tuple[np.ndarray, np.ndarray]:
+    """Boxes (P, 4) and leader segments (Q, 2, 2) of every placed label except ``exclude``."""
+    key = (exclude, tuple(id(p) for p in ctx.placed))
+    if ctx._cache is not None and ctx._cache[0] == key:
+        return ctx._cache[1]
+    boxes, segs = [], []
+    for i, p in enumerate(ctx.placed):
+        if p is None or i == exclude:
+            continue
+        boxes.append(p.box)
+        pts = p.leader
+        segs.extend(np.stack([pts[:-1], pts[1:]], axis=1))
+    out = np.array(boxes, np.float64).reshape(-1, 4), np.array(segs, np.float64).reshape(-1, 2, 2)
+    ctx._cache = (key, out)
+    return out
+
+
+def _valid(ctx: _Context, k: int, boxes: np.ndarray, leaders: np.ndarray) -> np.ndarray:
+    """Which candidates (boxes (K, 4), leaders (K, S, 2, 2)) collide with nothing placed."""
+    K, S = leaders.shape[:2]
+    ok = ctx.area.boxes_hit(boxes) == 0
+    pboxes, psegs = _placed_arrays(ctx, k)
+    if len(pboxes):
+        ok &= ~boxes_overlap(boxes, pboxes, ctx.sp.gap).any(axis=1)
+    if len(psegs):
+        ok &= ~segment_hits_box(psegs, boxes).any(axis=0)
+    for s in range(S):
+        seg = leaders[:, s]
+        same = bool(np.all(seg == seg[0]))  # e.g. the inside part a -> e of every candidate
+        test = seg[:1] if same else seg[ok]
+        if len(test) == 0:
+            break
+        bad = np.zeros(len(test), bool)
+        if len(pboxes):
+            bad |= segment_hits_box(test, pboxes).any(axis=1)
+        if len(psegs):
+            bad |= segments_intersect(test, psegs).any(axis=1)
+        if same:
+            if bad[0]:
+                return np.zeros(K, bool)
+        else:
+            ok[np.flatnonzero(ok)[bad]] = False
+    return ok
+
+
+def _outside_image(ctx: _Context, boxes: np.ndarray) -> np.ndarray:
+    return (boxes[:, 0] < 0) | (boxes[:, 1] < 0) | (boxes[:, 2] > ctx.W) | (boxes[:, 3] > ctx.H)
+
+
+def _candidates(ctx: _Context, k: int, reach: float, shifted: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Candidate (boxes, leaders, costs, tiers, shifts) for label k within ``reach`` pixels.
+
+    ``shifted`` (silhouette layout only): endpoints moved up to 24 pixels along the
+    boundary instead of the label's own endpoint, for labels whose own leader is blocked
+    (e.g. by a leader that shares its endpoint).
+    """
+    side = int(ctx.sides[k])
+    a = ctx.anchors[k]
+    h = ctx.height
+    if side in (WEST, EAST):
+        step = max(1.0, reach / 96.0)
+        ys = ctx.endpoints[k, 1] + np.arange(-reach, reach + 0.5 * step, step)
+        boxes = ctx.column_box(k, side, ys)
+        ports = np.column_stack([np.full(len(ys), ctx.col_x[side]), ys])
+        leaders = np.stack([np.broadcast_to(a, ports.shape), ports, ports], axis=1)
+        shifts = np.abs(ys - ctx.endpoints[k, 1])
+        tiers = np.zeros(len(ys), np.int64)
+        cost = shifts
+    elif side in (NORTH, SOUTH):
+        step = max(1.0, reach / 48.0)
+        xs = ctx.endpoints[k, 0] + np.arange(-reach, reach + 0.5 * step, step)
+        n_t = int(min(12, max(1, reach // (h + ctx.sp.gap)) + 1))
+        X, T = np.meshgrid(xs, np.arange(n_t))
+        X, T = X.ravel(), T.ravel()
+        boxes = ctx.row_box(k, side, X, T)
+        y = ctx.row_y[side]
+        tip = boxes[:, 3] if side == NORTH else boxes[:, 1]
+        leaders = np.stack([
+            np.broadcast_to(a, (len(X), 2)),
+            np.column_stack([X, np.full(len(X), y)]),
+            np.column_stack([X, np.where(T > 0, tip, y)]),
+        ], axis=1)
+        shifts = np.abs(X - ctx.endpoints[k, 0])
+        tiers = T
+        cost = shifts + T * (h + ctx.sp.gap) * 2.0
+    else:
+        # push-out along the ray of the endpoint (extruded leaders, appendix I Fig. 4b); in
+        # the wider rounds also endpoints shifted along the boundary (rotated leaders)
+        pts, normals = ctx.boundary
+        m = len(pts)
+        tier_step = 0.5 * h + ctx.sp.gap
+        n_t = int(min(96, max(2, reach // tier_step + 1)))
+        q0 = int(np.argmin(np.hypot(*(pts - ctx.endpoints[k]).T)))
+        e_list = [ctx.endpoints[k][None]]
+        n_list = [ctx.ray_direction(k)[None]]
+        if shifted:  # a few pixels either way parts leaders that share an endpoint; more if needed
+            js = np.unique(np.round(np.arange(3.0, 24.5, 3.0) / ctx.boundary_step).astype(np.int64))
+            js = np.concatenate([-js, js])
+            js = js[(np.abs(js) > 0) & (np.abs(js) <= m // 2)]
+            q = (q0 + js) % m
+            e_list.append(pts[q])
+            n_list.append(normals[q])
+        E = np.concatenate(e_list)
+        N = np.concatenate(n_list)
+        I, T, A = np.meshgrid(np.arange(len(E)), np.arange(n_t), np.arange(len(_ATTACH)), indexing="ij")
+        I, T, A = I.ravel(), T.ravel(), A.ravel()
+        u = N[I]
+        port = E[I] + (ctx.sp.clearance + T * tier_step)[:, None] * u
+        w = ctx.widths[k]
+        off = _ATTACH[A] * np.array([w / 2, h / 2])
+        c = port + off
+        boxes = np.column_stack([c[:, 0] - w / 2, c[:, 1] - h / 2, c[:, 0] + w / 2, c[:, 1] + h / 2])
+        leaders = np.stack([np.broadcast_to(a, port.shape), E[I], port], axis=1)
+        shifts = np.hypot(*(E[I] - ctx.endpoints[k]).T)
+        tiers = T
+        # prefer boxes centred on the ray, then corner flags; boxes behind the port last
+        along = np.einsum("ij,ij->i", off / np.hypot(off[:, 0], off[:, 1])[:, None], u)
+        cost = shifts * 2.0 + (I > 0) * 2.0 * h + T * tier_step + (1.0 - along) * h + 1e6 * (along <= 0.05)
+    cost = cost + 1e4 * _outside_image(ctx, boxes)
+    return boxes, leaders, cost, tiers, shifts
+
+
+def _simplify(pts: np.ndarray) -> np.ndarray:
+    """Drop repeated points and middle points that lie on the straight line of their neighbours."""
+    keep = [pts[0]]
+    for i in range(1, len(pts)):
+        if np.hypot(*(pts[i] - keep[-1])) < 1e-9:
+            continue
+        if len(keep) >= 2:
+            a, b = keep[-2], keep[-1]
+            u, v = b - a, pts[i] - b
+            if abs(u[0] * v[1] - u[1] * v[0]) <= 1e-9 * (np.hypot(*u) * np.hypot(*v)) and u @ v > 0:
+                keep[-1] = pts[i]
+                continue
+        keep.append(pts[i])
+    return np.array(keep, np.float64)
+
+
+def _search(ctx: _Context, k: int) -> bool:
+    """Place label k at its cheapest valid candidate; widen the search until one is found.
+
+    For the silhouette layout a box that would block the ray of a label still to be
+    placed is taken only when no round offers one that does not.
+    """
+    size = max(ctx.W, ctx.H)
+    fallback = None
+    choice = None
+    far = max(1.2 * size, 3.0 * len(ctx.anchors) * (ctx.height + ctx.sp.gap))
+    rounds = [(r, 0) for r in (24.0, 96.0, 0.4 * size, far)]
+    if ctx.sides[k] == RADIAL:
+        rounds += [(r, 1) for r in (96.0, 0.4 * size, far)]
+    for reach, shifted in rounds:
+        boxes, leaders, cost, tiers, shifts = _candidates(ctx, k, reach, shifted)
+        ok = _valid(ctx, k, boxes, np.stack([leaders[:, :-1], leaders[:, 1:]], axis=2))
+        if not ok.any():
+            continue
+        rays = ctx.future_rays(k)
+        blocks = segment_hits_box(rays, boxes).sum(axis=0) if len(rays) else np.zeros(len(boxes))
+        free = ok & (blocks == 0)
+        cand = np.flatnonzero(free if free.any() else ok)
+        best = cand[np.argmin((cost + 1e5 * blocks)[cand])]  # argmin: first of equal costs
+        if free.any():
+            choice = (leaders[best], boxes[best], tiers[best], shifts[best])
+            break
+        if fallback is None:
+            fallback = (leaders[best], boxes[best], tiers[best], shifts[best])
+    if choice is None:
+        choice = fallback
+    if choice is None:
+        return False
+    pts, box, tier, shift = choice
+    ctx.placed[k] = Placement(_simplify(pts), box.copy(), int(ctx.sides[k]), int(tier), float(shift))
+    ctx.stats.shifted += int(shift > 0.5)
+    return True
+
+
+def _conflicting(ctx: _Context) -> list[int]:
+    """Labels to re-place: the later-ranked member of every conflicting pair."""
+    ids = [i for i, p in enumerate(ctx.placed) if p is not None]
+    if len(ids) < 2:
+        return []
+    boxes = np.array([ctx.placed[i].box for i in ids])
+    segs, owner = [], []
+    for n, i in enumerate(ids):
+        pts = ctx.placed[i].leader
+        s = np.stack([pts[:-1], pts[1:]], axis=1)
+        segs.extend(s)
+        owner.extend([n] * len(s))
+    segs = np.array(segs)
+    owner = np.array(owner)
+    m = len(ids)
+    one_hot = np.zeros((len(segs), m), np.int64)
+    one_hot[np.arange(len(segs)), owner] = 1
+    bad = boxes_overlap(boxes, boxes, 0.0)
+    bad |= (one_hot.T @ segments_intersect(segs, segs).astype(np.int64) @ one_hot) > 0
+    through = (one_hot.T @ segment_hits_box(segs, boxes).astype(np.int64)) > 0
+    bad |= through | through.T
+    np.fill_diagonal(bad, False)
+    over = ctx.area.boxes_hit(boxes) > 0
+    redo = set(np.array(ids)[over].tolist())
+    ii, jj = np.nonzero(np.triu(bad, 1))
+    for a, b in zip(ii, jj):
+        i, j = ids[a], ids[b]
+        redo.add(i if ctx.rank[i] > ctx.rank[j] else j)
+    return sorted(redo, key=lambda i: (ctx.rank[i], i))
+
+
+def place_boxes(
+    anchors: np.ndarray,
+    endpoints: np.ndarray,
+    sides: np.ndarray,
+    widths: np.ndarray,
+    height: float,
+    area: InternalArea,
+    image_size: tuple[int, int],
+    rank: np.ndarray | None = None,
+    spacing: Spacing | None = None,
+) -> tuple[list[Placement | None], BoxStats]:
+    """Lay out the boxes and leaders of all labels of one frame.
+
+    Parameters
+    ----------
+    anchors, endpoints : (n, 2) float, the anchors and candidate endpoints (pixels)
+    sides : (n,) int, side code of each label
+    widths : (n,) float, box widths; ``height`` : box height
+    area : InternalArea
+    image_size : (width, height)
+    rank : (n,) int, greedy placement order (lower = placed first); default 0..n-1
+    spacing : Spacing
+
+    Returns
+    -------
+    placements : list of Placement or None (no valid place found)
+    stats : BoxStats
+    """
+    n = len(anchors)
+    rank = np.arange(n) if rank is None else np.asarray(rank)
+    ctx = _Context(anchors, endpoints, sides, widths, height, area, image_size, spacing or Spacing(), rank)
+    for side in (WEST, EAST):
+        _place_column(ctx, np.flatnonzero(ctx.sides == side), side)
+    for side in (NORTH, SOUTH):
+        _place_row(ctx, np.flatnonzero(ctx.sides == side), side)
+    _place_ring(ctx, np.flatnonzero(ctx.sides == RADIAL))
+    for _ in range(4):
+        redo = _conflicting(ctx)
+        if not redo:
+            break
+        for k in redo:
+            ctx.placed[k] = None
+        for k in redo:
+            ctx.stats.repaired += 1
+            if not _search(ctx, k) and k not in ctx.stats.unplaced:
+                ctx.stats.unplaced.append(int(k))
+    else:
+        for k in _conflicting(ctx):
+            ctx.placed[k] = None
+            if k not in ctx.stats.unplaced:
+                ctx.stats.unplaced.append(int(k))
+    return ctx.placed, ctx.stats

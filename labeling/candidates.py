@@ -1,0 +1,199 @@
+"""Leader-line candidates: one per pixel of the internal area (appendix I, §5.2, §5.6, Table 1).
+
+For an anchor pixel ``a`` the candidate leader ``l = (a, e)`` is the shortest segment from
+``a`` to the boundary of ``A_I`` along one of the layout's principal directions:
+
+============  =====================  ==========================================
+layout        principal directions   endpoint ``e``
+============  =====================  ==========================================
+left          west                   the boundary point of ``a``'s row, to the left
+right         east                   ... to the right
+left-right    west, east             the nearer of the two (ties: west)
+top           north                  the boundary point of ``a``'s column, above
+bottom        south                  ... below
+top-bottom    north, south           the nearer of the two (ties: north)
+silhouette    every direction        the nearest boundary point
+============  =====================  ==========================================
+
+Because ``A_I`` is convex, a row (column) crosses it in one interval, so the west/east
+(north/south) distances are exact differences to the interval ends.  The silhouette
+layout uses the exact Euclidean distance transform of ``A_I``
+(``scipy.ndimage.distance_transform_edt`` with feature indices): the nearest pixel outside
+``A_I`` gives the direction, and the endpoint is put on the boundary half a pixel before it.
+This replaces the GPU jump flooding of the paper (§6.2) by exact CPU transforms.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import ndimage
+
+from meshvis.errors import ParameterError
+
+from .internal_area import InternalArea
+
+#: side codes of a leader: the direction it leaves the model in
+WEST, EAST, NORTH, SOUTH, RADIAL = 0, 1, 2, 3, 4
+SIDE_NAMES = ("west", "east", "north", "south", "radial")
+
+#: layout name -> principal directions (side codes)
+LAYOUTS: dict[str, tuple[int, ...]] = {
+    "left": (WEST,),
+    "right": (EAST,),
+    "left-right": (WEST, EAST),
+    "top": (NORTH,),
+    "bottom": (SOUTH,),
+    "top-bottom": (NORTH, SOUTH),
+    "silhouette": (RADIAL,),
+}
+
+
+def check_layout(layout: str) -> tuple[int, ...]:
+    """The side codes of ``layout``; :class:`ParameterError` for an unknown name."""
+    try:
+        return LAYOUTS[layout]
+    except KeyError:
+        raise ParameterError(f"unknown layout {layout!r}; choose one of {', '.join(LAYOUTS)}") from None
+
+
+def is_horizontal(layout: str) -> bool:
+    """True for the layouts whose leaders run left/right (labels stacked in columns)."""
+    return set(check_layout(layout)) <= {WEST, EAST}
+
+
+@dataclass
+class Candidates:
+    """The leader candidate of every pixel of the image.
+
+    Candidates that share an endpoint share its id: the west/east endpoint depends only on
+    the row, the north/south one only on the column, the silhouette one only on the
+    nearest outside pixel.  The greedy loop evaluates ``f5`` once per endpoint.
+
+    Attributes
+    ----------
+    ex, ey : (h, w) float64, endpoint on the boundary of ``A_I`` (NaN outside ``A_I``)
+    length : (h, w) float64, ``|a e|`` from the pixel centre (NaN outside ``A_I``)
+    side : (h, w) int8, side code (:data:`WEST` ... :data:`RADIAL`), -1 outside ``A_I``
+    eid : (h, w) int64, endpoint id (index into ``endpoints``), -1 outside ``A_I``
+    endpoints : (n_e, 2) float64, the distinct endpoints
+    d_max : float, the longest candidate over all of ``A_I`` (appendix I, §6.1 step 3)
+    """
+
+    ex: np.ndarray
+    ey: np.ndarray
+    length: np.ndarray
+    side: np.ndarray
+    eid: np.ndarray
+    endpoints: np.ndarray
+    d_max: float
+
+
+def _edt_in_box(mask: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
+    """Exact EDT of ``mask`` with feature indices, computed on its bounding box plus one pixel."""
+    rows = np.flatnonzero(mask.any(axis=1))
+    cols = np.flatnonzero(mask.any(axis=0))
+    r0, r1 = max(rows[0] - 1, 0), min(rows[-1] + 2, mask.shape[0])
+    c0, c1 = max(cols[0] - 1, 0), min(cols[-1] + 2, mask.shape[1])
+    d, (ri, ci) = ndimage.distance_transform_edt(mask[r0:r1, c0:c1], return_indices=True)
+    dist = np.zeros(mask.shape)
+    R = np.broadcast_to(np.arange(mask.shape[0])[:, None], mask.shape).copy()
+    C = np.broadcast_to(np.arange(mask.shape[1])[None, :], mask.shape).copy()
+    dist[r0:r1, c0:c1] = d
+    R[r0:r1, c0:c1] = ri + r0
+    C[r0:r1, c0:c1] = ci + c0
+    return dist, (R, C)
+
+
+def _radial(mask: np.ndarray, X: np.ndarray, Y: np.ndarray, pad: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Nearest-boundary candidates: (length, ex, ey, key) on the padded grid.
+
+    The EDT gives every inside pixel its nearest outside pixel ``q``; the endpoint of all
+    pixels that share ``q`` is ``q`` moved half a pixel back along their mean direction,
+    i.e. onto the boundary of ``A_I``.
+    """
+    hp, wp = mask.shape
+    _, (ri, ci) = _edt_in_box(mask)
+    key = ri * wp + ci
+    inside = np.flatnonzero(mask.ravel())
+    k = key.ravel()[inside]
+    qx = ci.ravel()[inside] + 0.5 - pad
+    qy = ri.ravel()[inside] + 0.5 - pad
+    dx, dy = qx - X.ravel()[inside], qy - Y.ravel()[inside]
+    norm = np.maximum(np.hypot(dx, dy), 1e-12)
+    uniq, inv = np.unique(k, return_inverse=True)
+    mx = np.bincount(inv, dx / norm, len(uniq))
+    my = np.bincount(inv, dy / norm, len(uniq))
+    mn = np.maximum(np.hypot(mx, my), 1e-12)
+    ex = np.full(hp * wp, np.nan)
+    ey = np.full(hp * wp, np.nan)
+    ex[inside] = qx - 0.5 * (mx / mn)[inv]
+    ey[inside] = qy - 0.5 * (my / mn)[inv]
+    length = np.full(hp * wp, np.inf)
+    length[inside] = np.hypot(ex[inside] - X.ravel()[inside], ey[inside] - Y.ravel()[inside])
+    return length.reshape(hp, wp), ex.reshape(hp, wp), ey.reshape(hp, wp), key
+
+
+def leader_candidates(area: InternalArea, layout: str) -> Candidates:
+    """Compute the candidate endpoint, length and side of every pixel of ``A_I``.
+
+    Parameters
+    ----------
+    area : InternalArea
+    layout : a key of :data:`LAYOUTS`
+
+    Returns
+    -------
+    Candidates
+        Arrays cover the image (the padding of ``area`` is cut off); ``d_max`` is taken
+        over the whole of ``A_I``, padding included.
+    """
+    sides = check_layout(layout)
+    mask = area.mask
+    hp, wp = mask.shape
+    p = area.pad
+    xc = np.arange(wp, dtype=np.float64) + 0.5 - p
+    yc = np.arange(hp, dtype=np.float64) + 0.5 - p
+    X = np.broadcast_to(xc[None, :], (hp, wp))
+    Y = np.broadcast_to(yc[:, None], (hp, wp))
+    R = np.broadcast_to(np.arange(hp)[:, None], (hp, wp))
+    C = np.broadcast_to(np.arange(wp)[None, :], (hp, wp))
+    best = np.full((hp, wp), np.inf)
+    ex = np.full((hp, wp), np.nan)
+    ey = np.full((hp, wp), np.nan)
+    side = np.full((hp, wp), -1, np.int8)
+    key = np.full((hp, wp), -1, np.int64)
+
+    def offer(code: int, length: np.ndarray, bx: np.ndarray, by: np.ndarray, k: np.ndarray) -> None:
+        # strictly shorter wins, so the first direction listed wins ties
+        better = mask & (length < best)
+        best[better] = length[better]
+        ex[better] = np.broadcast_to(bx, (hp, wp))[better]
+        ey[better] = np.broadcast_to(by, (hp, wp))[better]
+        key[better] = np.broadcast_to(k, (hp, wp))[better]
+        side[better] = code
+
+    with np.errstate(invalid="ignore"):
+        for code in sides:
+            if code == WEST:
+                offer(code, X - area.left[:, None], area.left[:, None], Y, R)
+            elif code == EAST:
+                offer(code, area.right[:, None] - X, area.right[:, None], Y, hp + R)
+            elif code == NORTH:
+                offer(code, Y - area.top[None, :], X, area.top[None, :], 2 * hp + C)
+            elif code == SOUTH:
+                offer(code, area.bottom[None, :] - Y, X, area.bottom[None, :], 2 * hp + wp + C)
+            else:
+                length, bx, by, k = _radial(mask, X, Y, p)
+                offer(code, length, bx, by, 2 * hp + 2 * wp + k)
+    best[~mask] = np.nan
+    d_max = float(np.nanmax(best)) if mask.any() else 1.0
+    sl = (slice(p, hp - p), slice(p, wp - p))
+    key_img = key[sl]
+    inside = key_img >= 0
+    uniq, first, inv = np.unique(key_img[inside], return_index=True, return_inverse=True)
+    eid = np.full(key_img.shape, -1, np.int64)
+    eid[inside] = inv
+    exi, eyi = ex[sl], ey[sl]
+    endpoints = np.column_stack([exi[inside][first], eyi[inside][first]])
+    return Candidates(exi.copy(), eyi.copy(), best[sl].copy(), side[sl].copy(), eid, endpoints, max(d_max, 1e-9))

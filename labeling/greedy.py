@@ -1,0 +1,162 @@
+"""Greedy placement of leader lines (appendix I, §5.4 and §6.1 step 7).
+
+Every candidate ``l`` of every labelled area carries its feasibility ``F(l)`` (Eq. 12).
+The loop
+
+1. computes the priority ``P_i = sum_{l in A_i} (1 - F(l))`` of every unlabelled area (Eq. 14),
+2. takes the area with the highest priority,
+3. takes its most feasible candidate as the leader,
+4. updates the anchor- and endpoint-distance memberships ``f4``, ``f5`` (Eq. 4–7) of the
+   candidates of the remaining areas, and the priorities with them,
+
+until every area has its leader.  No backtracking, no wall-clock rule.
+
+Speed.  ``F(l) = s(l) f4(l)^w4 f5(e(l))^w5`` where ``s`` collects the memberships that do
+not change (f2, f3, f6, f7) and ``f5`` depends on the endpoint only, which many candidates
+share (a row, a column, a boundary pixel).  So ``P_i = n_i - sum_e S[i, e] f5(e)^w5`` with
+``S[i, e] = sum of s f4^w4 over the candidates of area i with endpoint e``: a small dense
+matrix (areas x distinct endpoints).  ``f5`` is updated per endpoint; ``f4`` changes only for
+candidates within ``d_a`` of the new anchor (found through a grid of buckets), and ``S``
+takes the change of those few.  One step costs O(areas x endpoints + touched candidates).
+
+Ties: areas of equal priority go by area index; candidates of equal feasibility go by
+pixel order (row-major).  When every candidate of the chosen area has ``F = 0`` (all its
+endpoints coincide with placed ones), the candidate with the best remaining criteria
+(``F`` with ``f5`` floored at 1e-6) is taken.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from .membership import dist_threshold
+
+
+class _Buckets:
+    """Indices of points grouped by grid cell, for "points within d of p" queries."""
+
+    def __init__(self, x: np.ndarray, y: np.ndarray, cell: float):
+        self.cell = float(max(cell, 4.0))
+        self.cx = np.floor(x / self.cell).astype(np.int64)
+        self.cy = np.floor(y / self.cell).astype(np.int64)
+        self.x0, self.y0 = int(self.cx.min()), int(self.cy.min())
+        self.nx = int(self.cx.max()) - self.x0 + 1
+        self.ny = int(self.cy.max()) - self.y0 + 1
+        key = (self.cy - self.y0) * self.nx + (self.cx - self.x0)
+        self.order = np.argsort(key, kind="stable")
+        self.start = np.searchsorted(key[self.order], np.arange(self.nx * self.ny + 1))
+
+    def near(self, px: float, py: float, d: float) -> np.ndarray:
+        """Indices of the points in the cells that touch the square ``p +- d``."""
+        i0 = max(int(np.floor((px - d) / self.cell)) - self.x0, 0)
+        i1 = min(int(np.floor((px + d) / self.cell)) - self.x0, self.nx - 1)
+        j0 = max(int(np.floor((py - d) / self.cell)) - self.y0, 0)
+        j1 = min(int(np.floor((py + d) / self.cell)) - self.y0, self.ny - 1)
+        if i0 > i1 or j0 > j1:
+            return np.zeros(0, np.int64)
+        pieces = [self.order[self.start[j * self.nx + i0]: self.start[j * self.nx + i1 + 1]] for j in range(j0, j1 + 1)]
+        return np.concatenate(pieces) if pieces else np.zeros(0, np.int64)
+
+
+@dataclass
+class GreedyResult:
+    """Outcome of the greedy loop.
+
+    Attributes
+    ----------
+    area_order : (k,) int, areas in the order they were labelled
+    pick : (k,) int, chosen candidate (index into the candidate arrays) of each of them
+    feasibility : (k,) float, ``F`` of the chosen candidate when it was chosen
+    priority : (k,) float, ``P_i`` of the area when it was chosen
+    """
+
+    area_order: np.ndarray
+    pick: np.ndarray
+    feasibility: np.ndarray
+    priority: np.ndarray
+
+
+def greedy_layout(
+    area: np.ndarray,
+    ax: np.ndarray,
+    ay: np.ndarray,
+    eid: np.ndarray,
+    endpoints: np.ndarray,
+    static: np.ndarray,
+    n_areas: int,
+    d_a: float,
+    d_e: float,
+    w4: float = 1.0,
+    w5: float = 1.0,
+) -> GreedyResult:
+    """Run the greedy loop over candidates grouped by area.
+
+    Parameters
+    ----------
+    area : (N,) int, area index (0 .. n_areas-1) of each candidate, **sorted ascending**
+    ax, ay : (N,) float, anchor (pixel centre) of each candidate
+    eid : (N,) int, endpoint id of each candidate (row of ``endpoints``)
+    endpoints : (n_e, 2) float, the distinct endpoints
+    static : (N,) float, product of the weighted memberships that do not depend on the
+        placed leaders: ``f2^w2 f3^w3 f6^w6 f7^w7``
+    n_areas : int, number of areas
+    d_a, d_e : float, distance thresholds of Eq. 4 and Eq. 6, pixels (0 disables)
+    w4, w5 : weights of f4 and f5
+
+    Returns
+    -------
+    GreedyResult
+    """
+    area = np.asarray(area, np.int64)
+    eid = np.asarray(eid, np.int64)
+    static = np.asarray(static, np.float64)
+    endpoints = np.asarray(endpoints, np.float64).reshape(-1, 2)
+    n_e = len(endpoints)
+    start = np.searchsorted(area, np.arange(n_areas + 1))
+    count = np.diff(start).astype(np.float64)
+    cell = area * n_e + eid
+    f4w = np.ones(len(area))  # f4 ** w4 per candidate
+    f4 = np.ones(len(area))
+    f5 = np.ones(n_e)
+    S = np.bincount(cell, weights=static, minlength=n_areas * n_e).reshape(n_areas, n_e)
+    alive = count > 0
+    done = np.zeros(len(area), bool)
+    abk = _Buckets(ax, ay, d_a) if d_a > 0 and len(area) else None
+    order, picks, feas, prio = [], [], [], []
+    while alive.any():
+        f5w = f5 ** w5 if w5 != 1 else f5
+        P = count - S @ f5w
+        i = int(np.argmax(np.where(alive, P, -np.inf)))
+        lo, hi = start[i], start[i + 1]
+        F = static[lo:hi] * f4w[lo:hi] * f5w[eid[lo:hi]]
+        j = int(np.argmax(F))
+        if F[j] <= 0.0:
+            # every candidate is infeasible: keep to endpoints nobody uses, then the rest
+            f5a = f5[eid[lo:hi]]
+            tie = static[lo:hi] * f4w[lo:hi] * np.maximum(f5a, 1e-6) ** w5
+            tie = np.where(f5a > 0, tie + 1.0, tie) if d_e > 0 else tie
+            j = int(np.argmax(tie))
+        pick = lo + j
+        order.append(i)
+        picks.append(pick)
+        feas.append(float(F[j]))
+        prio.append(float(P[i]))
+        alive[i] = False
+        done[lo:hi] = True
+        if abk is not None:
+            near = abk.near(ax[pick], ay[pick], d_a)
+            near = near[~done[near]]
+            new = np.minimum(f4[near], dist_threshold(ax[near] - ax[pick], ay[near] - ay[pick], d_a))
+            changed = new < f4[near]
+            near, new = near[changed], new[changed]
+            if len(near):
+                new_w = new ** w4 if w4 != 1 else new
+                delta = static[near] * (new_w - f4w[near])
+                S += np.bincount(cell[near], weights=delta, minlength=n_areas * n_e).reshape(n_areas, n_e)
+                f4[near] = new
+                f4w[near] = new_w
+        if d_e > 0:
+            e = endpoints[eid[pick]]
+            np.minimum(f5, dist_threshold(endpoints[:, 0] - e[0], endpoints[:, 1] - e[1], d_e), out=f5)
+    return GreedyResult(np.array(order, np.int64), np.array(picks, np.int64), np.array(feas), np.array(prio))
