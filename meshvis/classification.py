@@ -22,7 +22,7 @@ from typing import Any, Callable
 import numpy as np
 
 from . import __version__
-from .errors import ParameterError
+from .errors import ModelError, ParameterError
 from .graphcut import SOLVERS, Cut, VisibilityGraph
 from .hints import Hints, hint_weights
 from .nodes import NodeSet, build_nodes
@@ -228,6 +228,13 @@ def classify(
     -------
     Classification
 
+    Raises
+    ------
+    ModelError
+        The model is unusable, or every face is degenerate (nothing to classify).
+    ParameterError
+        An argument is out of its range.
+
     Examples
     --------
     >>> import trimesh
@@ -259,6 +266,9 @@ def classify(
     t = time.perf_counter()
     report("preprocess", 0.0)
     pre = preprocess(soup)
+    if pre.degenerate.all():  # no side has an area: there is no graph to cut
+        what = "the only face is" if soup.n_faces == 1 else f"all {soup.n_faces} faces are"
+        raise ModelError(f"{what} degenerate (zero area): nothing to classify", soup.path)
     stages.append(Stage("preprocess", True, time.perf_counter() - t,
                         f"{pre.clustering.n_clusters} clusters, {int(pre.flagged.sum())} flagged faces"))
 

@@ -76,6 +76,8 @@ def _cut_pymaxflow(n, i, j, cap_ij, cap_ji, cap_source, cap_sink) -> Cut:
     """
     import maxflow
 
+    if n == 0:  # every face degenerate: no nodes (PyMaxflow refuses empty arrays)
+        return Cut(np.zeros(0, bool), 0.0, "pymaxflow")
     g = maxflow.Graph[float](n, len(i))
     ids = g.add_nodes(n)
     if len(i):

@@ -159,6 +159,11 @@ def build_nodes(
     )
 
 
+#: |cos| between a partner's normal and a side normal below which the two are taken as
+#: perpendicular (about 0.06 degrees, like the parallel-plane tolerance of the flags)
+PERPENDICULAR_COS = 1e-3
+
+
 def _pushed_origins(pos, point_face, side, triangles, normals, flagged_index, pairs, samples, offset, proximity):
     """Ray origins of sample points on one side, pushed off the surface (appendix H Fig. 6).
 
@@ -188,8 +193,18 @@ def _pushed_origins(pos, point_face, side, triangles, normals, flagged_index, pa
     pt, ng, d = pt[inside], ng[inside], d[inside]
     if len(pt) == 0:
         return origin
-    orient = np.sign(np.einsum("ij,ij->i", ng, n_s[pt]))
-    orient[orient == 0] = 1.0
+    cos = np.einsum("ij,ij->i", ng, n_s[pt])
+    orient = np.sign(cos)
+    # A partner at right angles (a face against a wall at a T-junction, a sliver along
+    # it): the normals do not tell which side of the partner the origin belongs to, and
+    # picking one at random can push it through the partner (e.g. out of a room).  Keep
+    # the side the sample point lies on; on the partner's plane itself, do not move.
+    square = np.abs(cos) < PERPENDICULAR_COS
+    orient[square] = np.sign(d[square])
+    moved = orient != 0
+    pt, ng, d, orient = pt[moved], ng[moved], d[moved], orient[moved]
+    if len(pt) == 0:
+        return origin
     move = offset - orient * d  # distance to travel along orient*ng to clear g by offset
     order = np.lexsort((move, pt))
     last = np.r_[pt[order][1:] != pt[order][:-1], True]
