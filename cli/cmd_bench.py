@@ -2,9 +2,8 @@
 from __future__ import annotations
 
 import argparse
-import json
 
-from cli.common import positive_int, say, write_json
+from cli.common import positive_int, write_json
 
 
 def add_parser(sub) -> None:

@@ -2,12 +2,12 @@
 from __future__ import annotations
 
 import argparse
-import json
 import os
 import sys
 from typing import Any
 
 from meshvis.errors import OutputError, ParameterError
+from meshvis.jsonfile import write_json  # noqa: F401  (re-exported for the commands)
 
 
 def point(text: str) -> tuple[float, float, float]:
@@ -35,25 +35,6 @@ def check_output(path: str, inputs: list[str], force: bool) -> None:
         raise OutputError("output folder does not exist", folder)
     if not os.access(folder, os.W_OK):
         raise OutputError("output folder is not writable", folder)
-
-
-def write_json(path: str, data: Any) -> None:
-    """Write JSON atomically (temp file, then rename)."""
-    from meshvis.io import atomic_write
-
-    with atomic_write(path, "w") as fh:
-        json.dump(data, fh, indent=1, default=_jsonable)
-        fh.write("\n")
-
-
-def _jsonable(obj: Any) -> Any:
-    import numpy as np
-
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        return obj.item()
-    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
 
 
 def say(args: argparse.Namespace, *text: Any) -> None:

@@ -17,6 +17,7 @@ import os
 from typing import Any, Mapping, Sequence
 
 from meshvis.errors import ModelError, ParameterError
+from meshvis.io import unique_names
 from meshvis.soup import Soup, as_soup
 
 
@@ -55,20 +56,7 @@ def load_models(model: Any) -> Soup:
     if len(soups) == 1:
         return soups[0]
     out = Soup.concatenate(soups)
-    out.part_names = _unique(out.part_names)
-    return out
-
-
-def _unique(names: Sequence[str]) -> list[str]:
-    out, seen = [], set()
-    for i, n in enumerate(names):
-        base = str(n) or f"part{i}"
-        cand, k = base, 1
-        while cand in seen:
-            cand = f"{base}.{k}"
-            k += 1
-        seen.add(cand)
-        out.append(cand)
+    out.part_names = unique_names(out.part_names, "part")
     return out
 
 

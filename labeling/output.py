@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import base64
 import io
-import json
 import os
 from typing import Any, Sequence
 from xml.sax.saxutils import escape, quoteattr
@@ -176,32 +175,11 @@ def write_gif(results: Sequence[LayoutResult], path: str, *, duration_ms: int = 
                        loop=int(loop), optimize=False, disposal=1)
 
 
-def _jsonable(obj: Any) -> Any:
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        return obj.item()
-    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
-
-
 def write_json(data: Any, path: str) -> None:
     """Write JSON atomically (NaN written as null)."""
-    text = json.dumps(_clean(data), indent=1, default=_jsonable)
-    with _atomic(_check_path(path), "w") as fh:
-        fh.write(text + "\n")
+    from meshvis.jsonfile import write_json as _write
 
-
-def _clean(obj: Any) -> Any:
-    """Replace non-finite floats by None so the JSON is standard."""
-    if isinstance(obj, float):
-        return obj if np.isfinite(obj) else None
-    if isinstance(obj, dict):
-        return {k: _clean(v) for k, v in obj.items()}
-    if isinstance(obj, (list, tuple)):
-        return [_clean(v) for v in obj]
-    if isinstance(obj, np.generic):
-        return _clean(obj.item())
-    return obj
+    _write(_check_path(path), data)
 
 
 def write(result: LayoutResult | Sequence[LayoutResult], path: str, **kw: Any) -> list[str]:

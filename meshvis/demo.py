@@ -9,7 +9,6 @@ ground truth.
 """
 from __future__ import annotations
 
-import json
 import os
 import time
 from typing import Callable
@@ -19,7 +18,8 @@ import numpy as np
 from .camera import Camera
 from .classification import classify
 from .generators import overlapping_solids, soupify
-from .io import atomic_write, save
+from .io import save
+from .jsonfile import write_json
 from .layering import layers
 from .orientation import orient
 from .removal import remove_interior
@@ -83,7 +83,6 @@ def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str]
         "seconds": time.perf_counter() - t0,
         "classification": c.report(per_face=False),
     }
-    with atomic_write(os.path.join(folder, "report.json"), "w") as fh:
-        json.dump(summary, fh, indent=1, default=lambda x: x.tolist() if hasattr(x, "tolist") else str(x))
+    write_json(os.path.join(folder, "report.json"), summary)
     say(f"wrote {len(DEMO_FILES)} files to {folder}/ in {summary['seconds']:.1f} s")
     return summary

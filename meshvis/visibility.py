@@ -7,7 +7,7 @@ The counts of one or more rounds are accumulated in a :class:`VisibilityCounts`:
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp

@@ -129,7 +129,6 @@ def graph_weights(
     ``w_max(i) = max(max_j w(i,j), w_o(i), w_in(i))`` (Eq. 8), so ``cap(i→j)`` and
     ``cap(j→i)`` may differ.  Terminal links are filtered with the same ``w_max(i)``.
     """
-    n = len(area)
     i, j, w = edge_weights(hits, counted, area, is_point)
     w_out = outside_weights(escaped, counted, area)
     w_in = inside_prior(w_out, escaped, counted, opposite, opening)

@@ -35,7 +35,6 @@ explanation of the crack threshold is in ``docs/stability.md``.
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import os
 import tempfile
@@ -869,17 +868,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", metavar="FILE", help="also write every number as JSON")
 
 
-def _jsonable(obj: Any) -> Any:
-    if isinstance(obj, np.ndarray):
-        return obj.tolist()
-    if isinstance(obj, np.generic):
-        return obj.item()
-    raise TypeError(f"not JSON serialisable: {type(obj).__name__}")
-
-
 def main(args: argparse.Namespace) -> int:
     """Run the cases, print one line each as they finish and the count; 1 if any case failed."""
-    from ..io import atomic_write
+    from ..jsonfile import write_json
 
     result = run(quick=bool(getattr(args, "quick", False)), seed=int(getattr(args, "seed", 0)),
                  rays_per_node=int(getattr(args, "rays_per_node", 32)),
@@ -888,7 +879,5 @@ def main(args: argparse.Namespace) -> int:
     print(f"stability{' (quick)' if result['quick'] else ''}: {result['passed']} of {total} cases passed, "
           f"{result['failed']} failed ({result['seconds']:.1f} s)")
     if getattr(args, "json", None):
-        with atomic_write(args.json, "w") as fh:
-            json.dump(result, fh, indent=1, default=_jsonable)
-            fh.write("\n")
+        write_json(args.json, result)
     return 1 if result["failed"] else 0
