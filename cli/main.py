@@ -2,13 +2,15 @@
 
 Each subcommand lives in its own module of this package with two functions:
 ``add_parser(subparsers)`` and ``run(args) -> int``.  User errors (:class:`MeshvisError`)
-print one line and exit with status 2; Ctrl-C exits with 130.
+print one line and exit with status 2, as do refused file operations (``OSError``: disk
+full, I/O error); warnings print as one line; Ctrl-C exits with 130.
 """
 from __future__ import annotations
 
 import argparse
 import importlib
 import sys
+import warnings
 
 # subcommand name -> module in this package
 COMMANDS = {
@@ -58,7 +60,9 @@ def main(argv: list[str] | None = None) -> int:
         parser.print_help()
         return 2
     try:
-        return int(args.func(args) or 0)
+        with warnings.catch_warnings():
+            warnings.showwarning = _show_warning
+            return int(args.func(args) or 0)
     except MeshvisError as exc:
         print(f"meshvis: error: {exc}", file=sys.stderr)
         return 2
@@ -67,6 +71,15 @@ def main(argv: list[str] | None = None) -> int:
         return 130
     except BrokenPipeError:
         return 0
+    except OSError as exc:  # the system refused a file operation (disk full, I/O error): a user error
+        where = f"{exc.filename}: " if exc.filename else ""
+        print(f"meshvis: error: {where}{exc.strerror or exc}", file=sys.stderr)
+        return 2
+
+
+def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
+    """Warnings about the input (skipped records, ...) as one line, without source location."""
+    print(f"meshvis: warning: {message}", file=sys.stderr)
 
 
 if __name__ == "__main__":

@@ -179,7 +179,7 @@ class RayCaster:
         face = r["primID"].astype(np.int64)
         hit = face >= 0
         distance = np.full(len(face), np.inf)
-        distance[hit] = r["tfar"][hit] / self.scale
+        distance[hit] = r["tfar"][hit].astype(np.float64) / self.scale
         # side from Embree's geometric normal, which points like ours (counter-clockwise)
         dots = np.einsum("ij,ij->i", d, r["Ng"])
         side = np.where(hit, dots >= 0, -1).astype(np.int8)
