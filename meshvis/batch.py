@@ -5,7 +5,7 @@ and its options).  :func:`run_file` performs it — load, classify, orient / rem
 interior / peel layers, write the output and a JSON report — and returns one *summary
 row* (a flat dict, see :data:`COLUMNS`).  It never raises for a bad file: the row says
 what went wrong.  The operation itself is the same code path as the single-file
-commands (``cli.cmd_repair.run_op`` by default), so a batch output is byte for byte the
+commands (:func:`meshvis.operations.run_operation` by default), so a batch output is byte for byte the
 output of ``meshvis <op> FILE``.
 
 Where the tasks run
@@ -64,7 +64,7 @@ from .io import READ_FORMATS, WRITE_FORMATS, atomic_write, one_line
 #: operations a batch can run
 OPERATIONS = ("orient", "remove-interior", "layers")
 #: the per-file operation: ``module:function`` called as ``f(op, soup, args, progress) -> report``
-DEFAULT_RUNNER = "cli.cmd_repair:run_op"
+DEFAULT_RUNNER = "meshvis.operations:run_operation"
 #: columns of a summary row, in the order of ``summary.csv``
 COLUMNS = ("input", "status", "error", "faces_in", "faces_out", "rays", "seconds", "output", "report", "warnings")
 #: statuses of a summary row; the first two count as success
@@ -315,36 +315,23 @@ def _resolve(runner: str) -> Callable:
     return getattr(importlib.import_module(module), name)
 
 
-_ARGS_CACHE: dict[str, dict] = {}
 
 
-def operation_args(task: FileTask):
-    """The ``argparse.Namespace`` of ``meshvis <op> INPUT -o OUTPUT`` with the task's options.
+def operation_args(task: FileTask) -> dict:
+    """Every option of the task's operation: the library defaults
+    (:func:`meshvis.operations.default_options`, which the single-file command uses too)
+    updated with the task's options, plus its input and output paths."""
+    from .operations import default_options
 
-    Defaults come from the single-file command's own parser, so a batch file is
-    processed exactly as the single-file command would process it.
-    """
-    import argparse
-
-    if task.op not in _ARGS_CACHE:
-        from cli.cmd_repair import add_parser
-
-        parser = argparse.ArgumentParser(add_help=False)
-        add_parser(parser.add_subparsers(dest="command"))
-        _ARGS_CACHE[task.op] = vars(parser.parse_args([task.op, "IN", "-o", "OUT"]))
-    ns = argparse.Namespace(**_ARGS_CACHE[task.op])
-    for key, value in task.options.items():
-        setattr(ns, key, value)
-    ns.input, ns.output, ns.op = task.input, task.output, task.op
-    ns.report = ns.preview = ns.removed = ns.graphml = None
-    ns.quiet, ns.force = True, True
+    ns = {**default_options(task.op), **task.options}
+    ns.update(input=task.input, output=task.output, op=task.op, report=None, preview=None,
+              removed=None, graphml=None)
     return ns
 
 
 def _effective(task: FileTask, options: dict) -> dict:
     """Every option of the operation, defaults filled in, as JSON would store them."""
-    ns = vars(operation_args(replace(task, options=json.loads(json.dumps(options)))))
-    return {k: v for k, v in ns.items() if k != "func"}
+    return operation_args(replace(task, options=json.loads(json.dumps(options))))
 
 
 def _rays(report: dict) -> int | None:
@@ -432,9 +419,7 @@ def run_file(task: FileTask) -> dict:
     -------
     dict with the keys :data:`COLUMNS`
     """
-    from cli.common import check_output
-
-    from .io import load
+    from .io import check_output, load
 
     row = empty_row(task, ERROR)
     t0 = time.perf_counter()

@@ -471,3 +471,22 @@ def unique_names(names: list[str], fallback: str) -> list[str]:
         seen.add(cand)
         out.append(cand)
     return out
+
+
+def check_output(path: str, inputs: list[str], force: bool) -> None:
+    """Refuse an output path that is an input, a folder, in a missing or unwritable folder,
+    or that exists while ``force`` is False (raises :class:`OutputError`)."""
+    for inp in inputs:
+        if os.path.exists(path) and os.path.exists(inp) and os.path.samefile(path, inp):
+            raise OutputError("output path is the input file; choose another path", path)
+        if os.path.abspath(path) == os.path.abspath(inp):
+            raise OutputError("output path is the input file; choose another path", path)
+    if os.path.isdir(path):
+        raise OutputError("output path is a folder", path)
+    if os.path.exists(path) and not force:
+        raise OutputError("exists; use --force to overwrite", path)
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise OutputError("output folder does not exist", folder)
+    if not os.access(folder, os.W_OK):
+        raise OutputError("output folder is not writable", folder)

@@ -82,12 +82,12 @@ def _partial_write(args) -> None:
     """Start writing the output (a temporary file appears) and never finish."""
     from meshvis.io import atomic_write
 
-    writer = atomic_write(args.output, "w")
+    writer = atomic_write(args["output"], "w")
     _OPEN.append(writer)
     fh = writer.__enter__()
     fh.write("partial")
     fh.flush()
-    assert glob.glob(os.path.join(os.path.dirname(args.output), ".*.tmp"))
+    assert glob.glob(os.path.join(os.path.dirname(args["output"]), ".*.tmp"))
 
 
 def hang(op, soup, args, progress):
