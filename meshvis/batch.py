@@ -63,7 +63,7 @@ from .io import READ_FORMATS, WRITE_FORMATS, atomic_write, one_line
 
 #: operations a batch can run
 OPERATIONS = ("orient", "remove-interior", "layers")
-#: the per-file operation: ``module:function`` called as ``f(op, soup, args, progress) -> report``
+#: the per-file operation: ``module:function`` called as ``f(op, soup, options, progress) -> report``
 DEFAULT_RUNNER = "meshvis.operations:run_operation"
 #: columns of a summary row, in the order of ``summary.csv``
 COLUMNS = ("input", "status", "error", "faces_in", "faces_out", "rays", "seconds", "output", "report", "warnings")
