@@ -1073,12 +1073,24 @@ def sphere_pair(subdivisions: int = 4, crack: int = 6, inner_radius: float = 0.5
 
 # ====================================================================== 9. skin and ribcage
 def real_models_dir() -> Path:
-    """Folder of the shared real test models: ``$MESHVIS_REAL_MODELS`` or
-    ``<project>/../shared/models/real``."""
+    """Folder of the shared real test models.
+
+    ``$MESHVIS_REAL_MODELS`` if set; otherwise the first existing ``shared/models/real``
+    beside the project: next to the source tree (editable install) or next to the current
+    folder or one of its parents (a checkout with the package installed elsewhere).
+    The first candidate is returned when none exists, so messages name a sensible path.
+    """
     env = os.environ.get("MESHVIS_REAL_MODELS")
     if env:
         return Path(env)
-    return Path(__file__).resolve().parents[1].parent / "shared" / "models" / "real"
+    rel = Path("shared") / "models" / "real"
+    candidates = [Path(__file__).resolve().parents[1].parent / rel]
+    here = Path.cwd().resolve()
+    candidates += [folder.parent / rel for folder in (here, *here.parents)]
+    for c in candidates:
+        if c.is_dir():
+            return c
+    return candidates[0]
 
 
 def _load_mesh(path: Path) -> Soup:
