@@ -6,11 +6,13 @@ Pipeline (DESIGN.md §4)::
          → weights (Eq. 5–9) → s-t min cut → per-(face, side) labels
 
 Sampling is *progressive*: rays are cast in rounds and the loop stops as soon as a round
-changes the labels of less than ``tolerance`` of the total area, or when the ray budget
-``rays_per_node`` is spent.  The first two rounds sample every node; later rounds double
-the rays of the undecided nodes only — those whose label changed in the last round and
-those on the cut (linked to a node of the other label) — in the spirit of adaptive
-global visibility sampling (AGVS).  A clean closed model stops after two small rounds.  Stages a model does not need (point nodes when nothing is
+changes the labels of less than ``tolerance`` of the total area, when no node is left
+undecided, or when the ray budget ``rays_per_node`` is spent.  The first round samples
+every node; later rounds double the rays of the undecided nodes only — those whose label
+changed in the last round, those on the cut (linked to a node of the other label) and,
+after the first round, those whose two terminal links are within a factor of two — in the
+spirit of adaptive global visibility sampling (AGVS).  A clean closed model stops after
+one small round.  Stages a model does not need (point nodes when nothing is
 flagged, hint rays without hints) are skipped, and the result says so.
 """
 from __future__ import annotations
@@ -328,16 +330,20 @@ def classify(
         # Next round: double the rays of the nodes that are still undecided.  After the
         # first round every node is undecided; later only nodes whose label changed and
         # nodes on the cut (an edge to a node of the other label) get more rays.
+        active = np.zeros(nodes.n, bool) if prev_nodes is None else cut.outside != prev_nodes
+        w = graph.weights
+        across = cut.outside[w.edges_i] != cut.outside[w.edges_j]
+        active[w.edges_i[across]] = True
+        active[w.edges_j[across]] = True
         if prev_nodes is None:
-            active = np.ones(nodes.n, bool)
-        else:
-            active = cut.outside != prev_nodes
-            w = graph.weights
-            across = cut.outside[w.edges_i] != cut.outside[w.edges_j]
-            active[w.edges_i[across]] = True
-            active[w.edges_j[across]] = True
+            # after the first round also every node whose terminal links are close to a tie
+            margin = np.abs(w.cap_out - w.cap_in) <= 0.5 * np.maximum(w.cap_out, w.cap_in)
+            active |= margin & (np.maximum(w.cap_out, w.cap_in) > 0)
         give = np.where(active, np.minimum(cast, budget - cast), 0)
         prev, prev_nodes = labels, cut.outside
+        if not active.any():
+            stop_reason = f"settled after {len(rounds)} round(s): no node left undecided"
+            break
         if give.sum() == 0:
             stop_reason = f"ray budget reached after {len(rounds)} rounds"
             break
