@@ -9,9 +9,10 @@ Sampling is *progressive*: rays are cast in rounds and the loop stops as soon as
 changes the labels of less than ``tolerance`` of the total area, when no node is left
 undecided, or when the ray budget ``rays_per_node`` is spent.  The first round samples
 every node; later rounds double the rays of the undecided nodes only — those whose label
-changed in the last round, those on the cut (linked to a node of the other label) and,
-after the first round, those whose two terminal links are within a factor of two — in the
-spirit of adaptive global visibility sampling (AGVS).  A clean closed model stops after
+changed in the last round, those on the cut (linked to a node of the other label), those
+whose escape share is within a factor of two of the ``opening`` threshold and, after the
+first round, those whose two terminal links are within a factor of two — in the spirit of
+adaptive global visibility sampling (AGVS).  A clean closed model stops after
 one small round.  Stages a model does not need (point nodes when nothing is
 flagged, hint rays without hints) are skipped, and the result says so.
 """
@@ -32,7 +33,7 @@ from .preprocess import Preprocessed, preprocess
 from .rays import RayCaster
 from .soup import Soup, as_soup
 from .visibility import VisibilityCounts, sample_round
-from .weights import graph_weights
+from .weights import DEFAULT_OPENING, graph_weights
 
 #: rays of the first progressive round, per node (before the cluster-size factor)
 FIRST_ROUND_RAYS = 4
@@ -196,7 +197,7 @@ def classify(
     samples_per_face: int = 4,
     sampling_scheme: int = 2,
     use_filter: bool = True,
-    opening: float | None = 0.05,
+    opening: float | None = DEFAULT_OPENING,
     progressive: bool = True,
     tolerance: float = 1e-3,
     solver: str = "pymaxflow",
@@ -339,6 +340,10 @@ def classify(
             # after the first round also every node whose terminal links are close to a tie
             margin = np.abs(w.cap_out - w.cap_in) <= 0.5 * np.maximum(w.cap_out, w.cap_in)
             active |= margin & (np.maximum(w.cap_out, w.cap_in) > 0)
+        if opening is not None:
+            # and every node whose escape share is too close to the opening threshold to tell
+            share = counts.escaped / np.maximum(counted, 1)
+            active |= (share > 0.5 * opening) & (share < 2 * opening)
         give = np.where(active, np.minimum(cast, budget - cast), 0)
         prev, prev_nodes = labels, cut.outside
         if not active.any():

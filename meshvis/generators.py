@@ -1132,8 +1132,10 @@ def skin_and_ribcage(folder: str | os.PathLike | None = None) -> GroundTruth:
     GroundTruth
         Skin: layer 1, one-sided, outward where its winding agrees with its signed volume.
         Rib cage faces inside the skin (generalised winding number of the skin > 0.5) are
-        hidden, layer 2; any outside the skin would be layer 1.  The rib cage's own bones
-        may touch each other; that does not change the answer.
+        hidden, layer 2; any outside the skin would be layer 1.  Where two bones touch,
+        the file holds the same triangle twice, once per bone: such coincident copies are
+        ``ambiguous`` for orientation — an STL has no connectivity, so which bone owns which
+        copy (and so which way it faces) cannot be observed from the geometry.
 
     Raises
     ------
@@ -1152,11 +1154,15 @@ def skin_and_ribcage(folder: str | os.PathLike | None = None) -> GroundTruth:
     if not s_out:
         w = -w
     hidden = w > 0.5
+    from .adjacency import duplicate_faces, weld
+
+    first = duplicate_faces(weld(ribs.vertices, ribs.faces)[1])
+    coincident = np.bincount(first, minlength=len(first))[first] > 1  # every member of a copy group
     pieces = [
         _Piece(skin.vertices, skin.faces, "skin", outside=(s_out, not s_out), layer=1, outward=s_out),
         _Piece(ribs.vertices, ribs.faces, "ribcage",
                outside=np.stack([~hidden & r_out, ~hidden & ~r_out], 1), layer=np.where(hidden, 2, 1),
-               outward=r_out),
+               outward=r_out, ambiguous=coincident),
     ]
     return _compose(pieces, "skin_and_ribcage",
                     "real closed skin with the rib cage inside: inside removal and layers on real data")

@@ -9,10 +9,12 @@ turned so that its front faces the outside.  The other cases are decided by opti
 * hidden faces (both sides inside): oriented by the layer they belong to — layer
   semantics (DESIGN.md §4): each shell faces outward with respect to its layer; with
   ``semantics="cavity"``, shells of even layers face inward instead (a solid with voids).
-  A hidden face that is two-sided even at its own layer (e.g. the part of one solid that
-  lies inside another: once the outer layer is peeled, both its sides are reachable)
-  takes the orientation of the surface it belongs to: the connected, orientable patch
-  of faces joined by manifold edges, whose one-sided faces vote by area;
+  A shell faces outward as a whole: a hidden face takes the orientation voted by area
+  over the connected, orientable patch of faces (joined by manifold edges) it belongs to,
+  where every face that is one-sided (at layer 1 or at its own layer) votes.  This
+  settles faces whose own evidence is ambiguous: contact faces between touching solids,
+  and parts of one solid inside another that are two-sided once the outer layer is
+  peeled.  A face whose patch has no vote keeps its own layer side;
 * flagged faces whose sample points disagree: by area ``majority`` (default) or
   ``duplicate``.
 """
@@ -86,14 +88,18 @@ def strongest_side(c: Classification) -> np.ndarray:
     return (c.face_labels_from(w)[:, 1] > c.face_labels_from(w)[:, 0]).astype(np.int8)
 
 
-def surface_vote(c: Classification, outer: np.ndarray, decided: np.ndarray) -> np.ndarray:
+def surface_vote(c: Classification, outer: np.ndarray, decided: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Side that should face front for every face, voted over its orientable surface patch.
 
     Faces joined by manifold edges (after welding; flagged faces included) form patches
     whose sides split into two consistent sets (the orientation double cover of
     :func:`meshvis.clusters.cluster_sides`).  Each decided face votes with its area for the
-    set its outer side belongs to.  Returns, per face, the side in the winning set (0 where
-    the patch has no decided face or the vote is tied: the face is kept as it is).
+    set its outer side belongs to.
+
+    Returns
+    -------
+    side : (m,) int8, the side of each face in the winning set (0 where there is no vote)
+    decisive : (m,) bool, the face's patch has votes and they are not tied
     """
     from .adjacency import edges
     from .clusters import cluster_sides
@@ -104,9 +110,12 @@ def surface_vote(c: Classification, outer: np.ndarray, decided: np.ndarray) -> n
     d = np.flatnonzero(decided & (node[:, 0] >= 0))
     np.add.at(votes, node[d, outer[d]], c.soup.areas[d])
     ok = node[:, 0] >= 0
-    out = np.zeros(len(outer), np.int8)
-    out[ok] = (votes[node[ok, 1]] > votes[node[ok, 0]]).astype(np.int8)
-    return out
+    side = np.zeros(len(outer), np.int8)
+    decisive = np.zeros(len(outer), bool)
+    v0, v1 = votes[node[ok, 0]], votes[node[ok, 1]]
+    side[ok] = (v1 > v0).astype(np.int8)
+    decisive[ok] = v0 != v1
+    return side, decisive
 
 
 def orient(
@@ -175,11 +184,14 @@ def orient(
         lay = layers(soup, classification=c)
         side = lay.outer_side[hidden]
         side = np.where(side == 2, -1, side)
-        undecided = side < 0  # two-sided at its layer, or never reached
+        own = side >= 0  # one-sided at its own layer
         outer[hidden] = np.maximum(side, 0)
         decided = status == ONE_SIDED
-        decided[np.flatnonzero(hidden)[~undecided]] = True
-        side[undecided] = surface_vote(c, outer, decided)[np.flatnonzero(hidden)[undecided]]
+        decided[np.flatnonzero(hidden)[own]] = True
+        vote, decisive = surface_vote(c, outer, decided)
+        # a shell faces outward as a whole: where the face's patch has a clear vote it wins
+        # over the face's own side (contact faces between touching solids see both ways)
+        side = np.where(decisive[hidden], vote[hidden], np.maximum(side, 0))
         outer[hidden] = side
         if semantics == "cavity":
             even = hidden & (lay.layer % 2 == 0)

@@ -44,6 +44,7 @@ from typing import Any, Callable, Iterable
 
 import numpy as np
 
+from ..weights import DEFAULT_OPENING
 from .. import generators
 from ..classification import Classification, classify
 from ..errors import ModelError
@@ -477,7 +478,7 @@ def escape_share(c: Classification, faces: np.ndarray, side: int, n_rays: int, s
 
 
 def crack_sweep(widths: Iterable[float], cell: float, rays_per_node: int, seed: int, share_rays: int,
-                opening: float = 0.05) -> list[dict]:
+                opening: float = DEFAULT_OPENING) -> list[dict]:
     """Classify :func:`meshvis.generators.cracked_box` for every crack width.
 
     Returns
