@@ -63,12 +63,9 @@ def add_parser(sub) -> None:
 
 
 def _up(args: argparse.Namespace) -> tuple[float, float, float]:
-    from meshvis.camera import AXES
+    from meshvis.camera import up_axis
 
-    if args.up != "auto":
-        return AXES[args.up]
-    gltf = all(os.path.splitext(p)[1].lower() in (".gltf", ".glb") for p in args.inputs)
-    return AXES["y"] if gltf else AXES["z"]
+    return up_axis(args.up, args.inputs)
 
 
 def _weights(text: str | None):

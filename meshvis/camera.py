@@ -5,6 +5,7 @@ pixel and its centre is at (0.5, 0.5).  The vertical field of view ``fov`` is in
 """
 from __future__ import annotations
 
+import os
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -14,6 +15,15 @@ from .errors import ParameterError
 
 #: unit vectors of the axis names accepted as "up"
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, float, float]:
+    """The up vector for an axis name, or for ``"auto"``: +y when every file is glTF/GLB
+    (the format fixes y up), +z otherwise (the CAD and scanning convention)."""
+    if name != "auto":
+        return AXES[name]
+    gltf = bool(paths) and all(os.path.splitext(str(p))[1].lower() in (".gltf", ".glb") for p in paths)
+    return AXES["y"] if gltf else AXES["z"]
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
