@@ -11,8 +11,9 @@ so an origin exactly on its own triangle hits it about half of the time).  The p
 normalised copy (about 6e-8) and far below any feature users care about.
 
 Threads or processes?  ``embreex`` releases the GIL while it traces, so two threads
-trace a large batch about twice as fast as one on a 2-core machine; processes would have
-to rebuild the scene and copy the rays.  ``meshvis bench rays`` measures both.
+trace a large batch 1.5–1.8 times as fast as one on a 2-core machine (docs/performance.md);
+processes would have to rebuild the scene and copy the rays and results, and measure
+slower.  ``meshvis bench rays`` measures all three side by side.
 """
 from __future__ import annotations
 
