@@ -75,30 +75,8 @@ class IdBuffer:
 
 
 def pixel_rays(camera: Camera, col: np.ndarray, row: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
-    """The primary rays of a few pixels: the matching rows of ``camera.rays(width, height)``.
-
-    ``Camera.rays`` makes the rays of every pixel; the labeling needs a handful (one per
-    anchor), so the same pixel-centre formula is evaluated for the given pixels only.  The
-    half height of the view is read off the two rays of a 1 x 2 image, whose pixel centres
-    lie at +-1/2 of it.
-    """
-    right, up, forward = camera.basis()
-    o2, d2 = camera.rays(1, 2)
-    if camera.orthographic:
-        hh = 2.0 * float(np.dot(o2[0] - camera.position, up))
-    else:
-        hh = 2.0 * float(np.dot(d2[0], up) / np.dot(d2[0], forward))
-    hw = hh * width / height
-    gx = ((np.asarray(col) + 0.5) / width * 2 - 1) * hw
-    gy = (1 - (np.asarray(row) + 0.5) / height * 2) * hh
-    if camera.orthographic:
-        origins = camera.position + gx[:, None] * right + gy[:, None] * up
-        directions = np.broadcast_to(forward, origins.shape).copy()
-    else:
-        directions = forward + gx[:, None] * right + gy[:, None] * up
-        directions /= np.linalg.norm(directions, axis=1, keepdims=True)
-        origins = np.broadcast_to(camera.position, directions.shape).copy()
-    return origins, directions
+    """The primary rays of a few pixels (one per anchor): :meth:`Camera.pixel_rays`."""
+    return camera.pixel_rays(col, row, width, height)
 
 
 def projected_sphere(soup: Soup, camera: Camera, width: int, height: int) -> tuple[np.ndarray, float]:

@@ -94,13 +94,21 @@ class Camera:
         -------
         origins, directions : (height*width, 3) float64 (directions are unit vectors)
         """
+        row, col = np.divmod(np.arange(width * height), width)
+        return self.pixel_rays(col, row, width, height)
+
+    def pixel_rays(self, col: np.ndarray, row: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """Primary rays through the centres of the given pixels of a ``width`` x ``height`` image.
+
+        Returns
+        -------
+        origins, directions : (n, 3) float64 (directions are unit vectors)
+        """
         right, up, forward = self.basis()
         hh = self._half_height()
         hw = hh * width / height
-        xs = ((np.arange(width) + 0.5) / width * 2 - 1) * hw
-        ys = (1 - (np.arange(height) + 0.5) / height * 2) * hh
-        gx, gy = np.meshgrid(xs, ys)
-        gx, gy = gx.ravel(), gy.ravel()
+        gx = ((np.asarray(col) + 0.5) / width * 2 - 1) * hw
+        gy = (1 - (np.asarray(row) + 0.5) / height * 2) * hh
         if self.orthographic:
             origins = self.position + gx[:, None] * right + gy[:, None] * up
             directions = np.broadcast_to(forward, origins.shape).copy()
