@@ -52,11 +52,21 @@ def snap_to_points(nodes: NodeSet, face: np.ndarray, bary: np.ndarray) -> np.nda
     """
     q = nodes.flagged_index[face]
     g = nodes.flagged_metric[q]  # (n, 3): e1·e1, e1·e2, e2·e2
-    pattern = nodes.sample_bary[:, 1:]  # (K, 2): weights of corners b and c
-    du = bary[:, 0:1] - pattern[None, :, 0]
-    dv = bary[:, 1:2] - pattern[None, :, 1]
-    d2 = g[:, 0:1] * du * du + 2 * g[:, 1:2] * du * dv + g[:, 2:3] * dv * dv
-    return q * nodes.samples + np.argmin(d2, axis=1)
+    g0, g1, g2 = g[:, 0], g[:, 1], g[:, 2]
+    u, v = bary[:, 0], bary[:, 1]
+    best = np.zeros(len(face), np.int64)
+    best_d2 = None
+    # one pass per sample (K is small) keeps the temporaries at n values each
+    for k, (_, bu, bv) in enumerate(nodes.sample_bary):
+        du, dv = u - bu, v - bv
+        d2 = g0 * du * du + 2 * g1 * du * dv + g2 * dv * dv
+        if best_d2 is None:
+            best_d2 = d2
+        else:
+            closer = d2 < best_d2  # strict: ties keep the first sample, like argmin
+            best[closer] = k
+            best_d2 = np.where(closer, d2, best_d2)
+    return q * nodes.samples + best
 
 
 def sample_round(
