@@ -156,14 +156,15 @@ def _summary_table(result, out_dir: str, limit: int = 60):
 
 
 def run(args: argparse.Namespace) -> int:
-    from meshvis.batch import default_jobs, plan, prepare_output_dir, run_batch, write_summary
+    from meshvis.batch import default_jobs, plan, run_batch, write_summary
+    from meshvis.io import ensure_folder
     from meshvis.errors import ParameterError
 
     if args.dask_scheduler and args.jobs:
         raise ParameterError("--jobs sets local worker processes; with --dask-scheduler the cluster decides")
     options = {dest: getattr(args, dest) for dest in _algorithm_dests()}
     tasks = plan(args.inputs, args.op, args.out, options)
-    prepare_output_dir(args.out)
+    ensure_folder(args.out)
     jobs = None if args.dask_scheduler else (args.jobs or default_jobs(len(tasks)))
     with _Display(tasks, args.quiet) as display:
         result = run_batch(tasks, jobs=jobs, time_limit=args.time_limit, scheduler=args.dask_scheduler,

@@ -48,7 +48,6 @@ import select
 import signal
 import subprocess
 import sys
-import tempfile
 import threading
 import time
 import traceback
@@ -279,28 +278,6 @@ def plan(inputs: Sequence[str], op: str, out_dir: str, options: dict | None = No
                 raise ParameterError(f"{p}: the output of {path} would overwrite an input file; choose another --out")
         tasks.append(task)
     return tasks
-
-
-def prepare_output_dir(out_dir: str) -> None:
-    """Create the output folder if needed and check that files can be created in it.
-
-    Raises
-    ------
-    OutputError
-        The path is a file, cannot be created, or is not writable.
-    """
-    if os.path.exists(out_dir) and not os.path.isdir(out_dir):
-        raise OutputError("the output folder is a file", out_dir)
-    try:
-        os.makedirs(out_dir, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"cannot create the output folder: {one_line(exc.strerror or exc)}", out_dir) from None
-    try:  # os.access is not enough: root passes it, read-only mounts fail only on write
-        fd, probe = tempfile.mkstemp(prefix=".meshvis-probe-", dir=out_dir)
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise OutputError(f"output folder is not writable ({one_line(exc.strerror or exc)})", out_dir) from None
 
 
 def default_jobs(n_tasks: int) -> int:

@@ -490,3 +490,25 @@ def check_output(path: str, inputs: list[str], force: bool) -> None:
         raise OutputError("output folder does not exist", folder)
     if not os.access(folder, os.W_OK):
         raise OutputError("output folder is not writable", folder)
+
+
+def ensure_folder(out_dir: str) -> None:
+    """Create the output folder if needed and check that files can be created in it.
+
+    Raises
+    ------
+    OutputError
+        The path is a file, cannot be created, or is not writable.
+    """
+    if os.path.exists(out_dir) and not os.path.isdir(out_dir):
+        raise OutputError("the output folder is a file", out_dir)
+    try:
+        os.makedirs(out_dir, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot create the output folder: {one_line(exc.strerror or exc)}", out_dir) from None
+    try:  # os.access is not enough: root passes it, read-only mounts fail only on write
+        fd, probe = tempfile.mkstemp(prefix=".meshvis-probe-", dir=out_dir)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise OutputError(f"output folder is not writable ({one_line(exc.strerror or exc)})", out_dir) from None

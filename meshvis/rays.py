@@ -24,7 +24,7 @@ from typing import Any
 
 import numpy as np
 
-from .soup import Soup, as_soup
+from .soup import as_soup
 
 #: default push of an origin off its surface, as a fraction of the bounding-box diagonal
 DEFAULT_OFFSET = 1e-5
@@ -233,21 +233,3 @@ class RayCaster:
     def __repr__(self) -> str:
         return f"<RayCaster {self.soup.n_faces} faces, {self.threads} threads>"
 
-
-def raw_embree_throughput(soup: Soup, origins: np.ndarray, directions: np.ndarray, repeat: int = 3) -> float:
-    """Rays per second of one plain single-threaded ``embreex`` call on already-prepared rays.
-
-    This is the reference for ``meshvis bench rays``: the same normalised scene and rays,
-    with none of meshvis' work around the call.
-    """
-    import time
-
-    rc = RayCaster(soup, threads=1)
-    o32 = rc.to_unit(origins)
-    d32 = RayCaster._unit_dirs(directions).astype(np.float32)
-    best = np.inf
-    for _ in range(repeat):
-        t = time.perf_counter()
-        rc._scene.run(o32, d32, output=1)
-        best = min(best, time.perf_counter() - t)
-    return len(origins) / best

@@ -196,7 +196,6 @@ class Soup:
         out = replace(self, vertices=v)
         if np.linalg.det(matrix[:3, :3]) < 0:
             out = out.flipped(np.ones(self.n_faces, bool))
-            out.vertices = v
         return out
 
     def copy(self) -> "Soup":

@@ -358,7 +358,7 @@ def test_usage_errors(tmp_path, capsys, monkeypatch):
     def refuse(*args, **kwargs):
         raise PermissionError(errno.EACCES, "Permission denied")
 
-    monkeypatch.setattr(mb.tempfile, "mkstemp", refuse)
+    monkeypatch.setattr(mio.tempfile, "mkstemp", refuse)
     one_line(["batch", src, "--op", "orient", "--out", str(tmp_path / "ro")], "not writable")
     monkeypatch.undo()
     with pytest.raises(SystemExit) as exc:

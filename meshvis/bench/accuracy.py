@@ -60,13 +60,7 @@ def sweep(cases: Iterable[C.Case], *, quick: bool = False, seed: int = 0, peel_t
     points: list[C.Point] = []
     skipped: list[str] = []
     C.warm_up()
-    for case in cases:
-        truth, why = C.load_case(case)
-        if truth is None:
-            skipped.append(f"{case.name}: {why}")
-            log(f"{case.name}: {why}")
-            continue
-        log(f"{case.name}: {truth.n_faces} faces")
+    for case, truth in C.built_cases(cases, skipped, log):
         settings = [(r, dict(rays_per_node=r, progressive=False), False) for r in (RAYS_QUICK if quick else RAYS_FULL)]
         settings.append((32, {}, True))  # the defaults: progressive, up to 32 rays per node
         for r, kw, default in settings:
@@ -292,12 +286,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 def prepare_out(out: str, names: tuple[str, ...], force: bool) -> None:
     """Create ``out``; refuse to overwrite earlier results in it without ``force``."""
-    if os.path.exists(out) and not os.path.isdir(out):
-        raise OutputError("is a file, expected a folder", out)
-    try:
-        os.makedirs(out, exist_ok=True)
-    except OSError as exc:
-        raise OutputError(f"cannot create the folder ({exc.strerror})", out) from None
+    from ..io import ensure_folder
+
+    ensure_folder(out)
     there = [n for n in names if os.path.exists(os.path.join(out, n))]
     if there and not force:
         raise OutputError(f"holds earlier results ({', '.join(there)}); use --force to overwrite", out)

@@ -88,6 +88,19 @@ def select_cases(names: str | None, default: tuple[str, ...]) -> list[Case]:
     return [CASES[n] for n in wanted]
 
 
+def built_cases(cases, skipped: list[str], log):
+    """Yield ``(case, truth)`` for every case that can be built; the others are logged and
+    appended to ``skipped`` (a missing real model is not an error of the benchmark)."""
+    for case in cases:
+        truth, why = load_case(case)
+        if truth is None:
+            skipped.append(f"{case.name}: {why}")
+            log(f"{case.name}: {why}")
+            continue
+        log(f"{case.name}: {truth.n_faces} faces")
+        yield case, truth
+
+
 def load_case(case: Case) -> tuple[GroundTruth | None, str]:
     """Build a case's truth; ``(None, reason)`` when a real model is missing or unusable."""
     try:

@@ -151,13 +151,7 @@ def main(args: argparse.Namespace) -> int:
     C.warm_up()
     points: list[C.Point] = []
     skipped: list[str] = []
-    for case in chosen:
-        truth, why = C.load_case(case)
-        if truth is None:
-            skipped.append(f"{case.name}: {why}")
-            log(f"{case.name}: {why}")
-            continue
-        log(f"{case.name}: {truth.n_faces} faces")
+    for case, truth in C.built_cases(chosen, skipped, log):
         points += compare_case(truth, case.name, seed=args.seed, repeat=args.repeat,
                                peel_timeout=args.peel_timeout, log=log)
     command = "meshvis bench compare " + " ".join(
