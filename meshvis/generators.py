@@ -522,45 +522,37 @@ def _outward_bodies(soup: Soup) -> tuple[np.ndarray, np.ndarray]:
 
 def _containment(pieces: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
                  fast: bool = False) -> tuple[list[np.ndarray], list[np.ndarray]]:
-    """How many *other* closed pieces contain each face, and which faces are ambiguous.
+    """How deep inside the closed pieces each face lies, and which faces are ambiguous.
 
-    For every face of piece ``p`` the generalised winding number of all other pieces is
-    evaluated at points pushed ``eps`` off the centroid to both sides and at the corners
-    (pulled 2 % toward the centroid, pushed to the front).  The rounded front value is the
-    depth.  A face is ambiguous when the two sides disagree (it lies on another piece's
-    surface) or a corner disagrees with the centroid (it straddles an intersection curve).
+    For every face of piece ``p`` the generalised winding number of all pieces (its own
+    included) is evaluated at points pushed ``eps`` off the centroid to both sides and at
+    the corners (pulled 2 % toward the centroid, pushed to the front).  The rounded front
+    value is the depth: the number of pieces around the face, plus the folds of its own
+    piece when that piece crosses itself (a face inside its own piece's volume cannot be
+    seen).  The back value of a clean face is one more than the front.  A face is
+    ambiguous when the two sides do not differ by one (it lies on another piece's surface)
+    or a corner disagrees with the centroid (it straddles an intersection curve).
     """
     import igl
 
     wn = igl.fast_winding_number if fast else igl.winding_number
-    boxes = np.array([[V[np.unique(F)].min(0), V[np.unique(F)].max(0)] for V, F in pieces])
-    depth, ambiguous = [], []
-    for p, (V, F) in enumerate(pieces):
-        t = V[F]
-        c = t.mean(axis=1)
-        n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
-        n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
-        corners = (c[:, None] + 0.98 * (t - c[:, None]) + eps * n[:, None]).reshape(-1, 3)
-        Q = np.concatenate([c + eps * n, c - eps * n, corners])
-        # a closed surface has winding number 0 outside its bounding box: only pieces whose
-        # boxes overlap count, evaluated together (winding numbers add up)
-        lo, hi = boxes[p, 0] - 2 * eps, boxes[p, 1] + 2 * eps
-        near = [q for q in range(len(pieces))
-                if q != p and not (np.any(boxes[q, 0] > hi) or np.any(boxes[q, 1] < lo))]
-        if near:
-            offsets = np.cumsum([0] + [len(pieces[q][0]) for q in near[:-1]])
-            Vn = np.concatenate([pieces[q][0] for q in near])
-            Fn = np.concatenate([np.asarray(pieces[q][1], np.int64) + o for q, o in zip(near, offsets)])
-            w = np.asarray(wn(np.ascontiguousarray(Vn, np.float64), np.ascontiguousarray(Fn), Q))
-        else:
-            w = np.zeros(len(Q))
-        m = len(F)
-        front, back, corner = w[:m], w[m:2 * m], w[2 * m:].reshape(m, 3)
-        d = np.maximum(np.rint(front), 0).astype(np.int64)
-        amb = (np.rint(front) != np.rint(back)) | np.any(np.rint(corner) != np.rint(front)[:, None], axis=1)
-        amb |= np.abs(front - np.rint(front)) > 0.25
-        depth.append(d)
-        ambiguous.append(amb)
+    # winding numbers add up over closed pieces: evaluate the whole model once
+    offsets = np.cumsum([0] + [len(V) for V, _ in pieces[:-1]])
+    Vall = np.ascontiguousarray(np.concatenate([V for V, _ in pieces]), np.float64)
+    Fall = np.ascontiguousarray(np.concatenate([np.asarray(F, np.int64) + o for (_, F), o in zip(pieces, offsets)]))
+    t = Vall[Fall]
+    c = t.mean(axis=1)
+    n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
+    n /= np.maximum(np.linalg.norm(n, axis=1, keepdims=True), 1e-300)
+    corners = (c[:, None] + 0.98 * (t - c[:, None]) + eps * n[:, None]).reshape(-1, 3)
+    w = np.asarray(wn(Vall, Fall, np.concatenate([c + eps * n, c - eps * n, corners])))
+    m = len(Fall)
+    front, back, corner = w[:m], w[m:2 * m], w[2 * m:].reshape(m, 3)
+    d = np.maximum(np.rint(front), 0).astype(np.int64)
+    amb = (np.rint(back) - np.rint(front) != 1) | np.any(np.rint(corner) != np.rint(front)[:, None], axis=1)
+    amb |= np.abs(front - np.rint(front)) > 0.25
+    split = np.cumsum([len(F) for _, F in pieces])[:-1]
+    depth, ambiguous = np.split(d, split), np.split(amb, split)
     return depth, ambiguous
 
 
@@ -1130,42 +1122,31 @@ def skin_and_ribcage(folder: str | os.PathLike | None = None) -> GroundTruth:
     Returns
     -------
     GroundTruth
-        Skin: layer 1, one-sided, outward where its winding agrees with its signed volume.
-        Rib cage faces inside the skin (generalised winding number of the skin > 0.5) are
-        hidden, layer 2; any outside the skin would be layer 1.  Where two bones touch,
-        the file holds the same triangle twice, once per bone: such coincident copies are
-        ``ambiguous`` for orientation — an STL has no connectivity, so which bone owns which
-        copy (and so which way it faces) cannot be observed from the geometry.
+        The truth of :func:`from_closed_mesh` for skin and bones together: the skin is
+        layer 1, a bone inside the skin is layer 2, and the parts of a bone that sink into
+        another bone lie one layer deeper (the rib cage's bones interpenetrate).  Where two
+        bones touch, the file holds the same triangle twice, once per bone: such coincident
+        copies are ``ambiguous`` — an STL has no connectivity, so which bone owns which
+        copy (and so which way it faces) cannot be observed from the geometry; so are faces
+        that cross another face.
 
     Raises
     ------
     FileNotFoundError
         When either file is missing.
     """
-    import igl
+    from .adjacency import duplicate_faces, weld
 
     folder = Path(folder) if folder is not None else real_models_dir()
     skin = _load_mesh(folder / "dm_control__SKINbody.stl")
     ribs = _load_mesh(folder / "dm_control__BONERibcage.stl")
-    s_out = signed_volume(skin.vertices, skin.faces) > 0
-    r_out = _outward_bodies(ribs)[1]
-    c = ribs.triangles.mean(axis=1)
-    w = np.asarray(igl.fast_winding_number(skin.vertices, skin.faces, c))
-    if not s_out:
-        w = -w
-    hidden = w > 0.5
-    from .adjacency import duplicate_faces, weld
-
-    first = duplicate_faces(weld(ribs.vertices, ribs.faces)[1])
-    coincident = np.bincount(first, minlength=len(first))[first] > 1  # every member of a copy group
-    pieces = [
-        _Piece(skin.vertices, skin.faces, "skin", outside=(s_out, not s_out), layer=1, outward=s_out),
-        _Piece(ribs.vertices, ribs.faces, "ribcage",
-               outside=np.stack([~hidden & r_out, ~hidden & ~r_out], 1), layer=np.where(hidden, 2, 1),
-               outward=r_out, ambiguous=coincident),
-    ]
-    return _compose(pieces, "skin_and_ribcage",
-                    "real closed skin with the rib cage inside: inside removal and layers on real data")
+    both = Soup.concatenate([skin, ribs])
+    both = Soup(both.vertices, both.faces, part_id=both.part_id, part_names=["skin", "ribcage"])
+    t = from_closed_mesh(both, name="skin_and_ribcage")
+    first = duplicate_faces(weld(both.vertices, both.faces)[1])
+    t.ambiguous |= np.bincount(first, minlength=len(first))[first] > 1  # every member of a copy group
+    t.notes = "real closed skin with the rib cage inside: inside removal and layers on real data"
+    return t
 
 
 # ====================================================================== 11. assembly
@@ -1339,8 +1320,12 @@ def from_closed_mesh(model: Any, name: str | None = None) -> GroundTruth:
     The model must be closed with consistent winding (every directed edge matched by its
     reverse once coincident corners are merged), else :class:`ModelError`.  Bodies are
     the edge-connected components; each is outward where its signed volume is positive.
-    A body inside ``d`` others (winding number) is hidden with layer ``d + 1``; for a
-    single body this is simply: all faces layer 1, outside on the outward side.
+    A face whose outward side has winding number ``d`` (of all bodies, its own included)
+    is hidden with layer ``d + 1`` when ``d > 0``: it lies inside another body, or inside
+    a fold of its own body when the surface crosses itself (``cow.obj`` does).  Faces that
+    cross another face, straddle an intersection curve or touch another body's surface
+    are ambiguous (see :func:`_containment`).  For a clean single body this is simply:
+    all faces layer 1, outside on the outward side.
 
     Parameters
     ----------
@@ -1366,15 +1351,15 @@ def from_closed_mesh(model: Any, name: str | None = None) -> GroundTruth:
     for b in range(labels.max() + 1):
         used, f = np.unique(fixed.faces[order[bounds[b]:bounds[b + 1]]], return_inverse=True)
         bodies.append((fixed.vertices[used], f.reshape(-1, 3)))
-    if len(bodies) > 1:
-        depth, amb = _containment(bodies, 1e-6 * soup.diagonal, fast=True)
-        d = np.empty(soup.n_faces, np.int64)
-        a = np.empty(soup.n_faces, bool)
-        d[order] = np.concatenate(depth)
-        a[order] = np.concatenate(amb)
-    else:
-        d = np.zeros(soup.n_faces, np.int64)
-        a = np.zeros(soup.n_faces, bool)
+    depth, amb = _containment(bodies, 1e-6 * soup.diagonal, fast=True)
+    d = np.empty(soup.n_faces, np.int64)
+    a = np.empty(soup.n_faces, bool)
+    d[order] = np.concatenate(depth)
+    a[order] = np.concatenate(amb)
+    # a face that crosses another is partly in front of and partly behind it: no single answer
+    from .intersect import intersection_flags
+
+    a |= intersection_flags(soup.vertices, soup.faces)["intersects"]
     vis = d == 0
     outside = np.stack([vis & outward, vis & ~outward], 1)
     nm = name or (os.path.splitext(os.path.basename(soup.path))[0] if soup.path else "closed_mesh")

@@ -102,10 +102,16 @@ def inside_prior(w_out: np.ndarray, escaped: np.ndarray, counted: np.ndarray, op
 
 
 def cosine_filter(w: np.ndarray, w_max: np.ndarray) -> np.ndarray:
-    """Eq. 9: ``½ (1 + cos(π − π w / w_max)) · w`` (0 where ``w_max`` is 0)."""
+    """Eq. 9: ``½ (1 + cos(π − π w / w_max)) · w`` (0 where ``w_max`` is 0).
+
+    Evaluated as ``sin²(π r / 2) · w`` with ``r = w / w_max``, the same function: the
+    literal form cancels to exactly 0 for ``r`` below about 1e-8 (1 + cos(π − x) rounds
+    to 0), which would cut a weak link completely instead of damping it — a small part
+    seen by a large cluster would then be unreachable from it.
+    """
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(w_max > 0, w / w_max, 0.0)
-    return 0.5 * (1.0 + np.cos(np.pi - np.pi * np.clip(ratio, 0.0, 1.0))) * w
+    return np.sin(0.5 * np.pi * np.clip(ratio, 0.0, 1.0)) ** 2 * w
 
 
 def graph_weights(

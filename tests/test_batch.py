@@ -312,7 +312,7 @@ def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
     env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
     proc = subprocess.Popen(
         [sys.executable, "-m", "meshvis", "batch", str(src), "--op", "orient", "--out", str(out), "--jobs", "2",
-         "--rays-per-node", "256", "--no-progressive"],
+         "--rays-per-node", "2048", "--no-progressive"],
         stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
     try:
         t0 = time.monotonic()

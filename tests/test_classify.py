@@ -137,6 +137,17 @@ def test_cosine_filter_endpoints():
     assert np.allclose(cosine_filter(w, np.ones(3)), [0.0, 0.25, 1.0])
 
 
+def test_cosine_filter_damps_weak_links_without_cutting_them():
+    # the literal 1 + cos(pi - x) rounds to 0 for x below ~1e-8; a damped link must stay positive
+    from meshvis.weights import cosine_filter
+
+    w = np.array([1e-12, 1e-9, 1e-6])
+    f = cosine_filter(w, np.ones(3))
+    assert np.all(f > 0)
+    np.testing.assert_allclose(f, (np.pi * w / 2) ** 2 * w, rtol=1e-6)
+
+
+
 def test_bad_parameters():
     with pytest.raises(ParameterError):
         classify(trimesh.creation.box(), rays_per_node=0)
