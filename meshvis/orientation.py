@@ -118,6 +118,47 @@ def surface_vote(c: Classification, outer: np.ndarray, decided: np.ndarray) -> t
     return side, decisive
 
 
+def parity_side(c: Classification, faces: np.ndarray, seed: int = 0, rays: int = 9,
+                max_crossings: int = 64) -> np.ndarray:
+    """Outer side of ``faces`` by ray parity against their own body.
+
+    From each face's centroid, ``rays`` cosine-distributed rays leave its front side and
+    every crossing of a face of the same body (the face's component over all welded edges,
+    non-manifold ones included) is counted: an even count means the front looks out of
+    the body.  The majority over the rays decides (ties: front).  Meant for the few hidden
+    faces that visibility leaves open — two-sided at their layer, on a patch that no
+    one-sided face votes for (a sliver cut off by non-manifold edges where solids touch).
+
+    Returns
+    -------
+    (len(faces),) int8, 0 when the front should face out, 1 when the back should
+    """
+    from .adjacency import components, edges, face_adjacency
+    from .sampling import cosine_hemisphere
+
+    faces = np.asarray(faces, np.int64)
+    if len(faces) == 0:
+        return np.zeros(0, np.int8)
+    soup, caster = c.soup, c.caster
+    body = components(soup.n_faces, face_adjacency(edges(c.pre.faces_welded), manifold_only=False))[1]
+    f = np.repeat(faces, rays)
+    d = cosine_hemisphere(soup.normals[f], np.random.default_rng(seed))
+    o = caster.push_off(soup.triangles[f].mean(axis=1), f, np.zeros(len(f), np.int8))
+    step = caster.offset * caster.diagonal
+    odd = np.zeros(len(f), bool)
+    live = np.arange(len(f))
+    for _ in range(max_crossings):  # one pass per crossing depth, all rays together
+        h = caster.intersect(o[live], d[live])
+        hit = h.hit
+        own = hit & (body[np.where(hit, h.face, 0)] == body[f[live]])
+        odd[live[own]] ^= True
+        o[live[hit]] = h.points(o[live], d[live])[hit] + d[live[hit]] * step
+        live = live[hit]
+        if len(live) == 0:
+            break
+    return (odd.reshape(-1, rays).sum(axis=1) * 2 > rays).astype(np.int8)
+
+
 def orient(
     model: Any,
     *,
@@ -193,6 +234,13 @@ def orient(
         # over the face's own side (contact faces between touching solids see both ways)
         side = np.where(decisive[hidden], vote[hidden], np.maximum(side, 0))
         outer[hidden] = side
+        # faces two-sided at their layer on a patch without a vote (a sliver of surface cut
+        # off by non-manifold edges where solids touch): their neighbours across any edge
+        open_ = np.zeros(m, bool)
+        open_[np.flatnonzero(hidden)[~own]] = True
+        open_ &= ~decisive
+        if open_.any():
+            outer[open_] = parity_side(c, np.flatnonzero(open_), seed=int(c.params.get("seed", 0)))
         if semantics == "cavity":
             even = hidden & (lay.layer % 2 == 0)
             outer[even] = 1 - outer[even]

@@ -150,3 +150,19 @@ def test_bad_box_is_a_usage_error(tmp_path):
     with pytest.raises(SystemExit) as e:
         main(["classify", "x.obj", "--inside-box", "1,2,3"])
     assert e.value.code == 2
+
+
+def test_parity_side_reads_the_winding_of_each_face_against_its_own_body():
+    # nested spheres, a third of the faces turned over: ray parity against the face's own
+    # body tells which side faces out of it, for the hidden inner sphere too
+    from meshvis import classify
+    from meshvis.orientation import parity_side
+
+    t = G.nested_shells(n=2, subdivisions=2)
+    flip = np.zeros(t.n_faces, bool)
+    flip[::3] = True
+    soup = t.soup.flipped(flip)
+    c = classify(soup, seed=0)
+    faces = np.arange(t.n_faces)
+    np.testing.assert_array_equal(parity_side(c, faces, seed=1), flip.astype(np.int8))
+    assert parity_side(c, np.zeros(0, np.int64)).shape == (0,)
