@@ -94,8 +94,8 @@ def pack_1d(desired: np.ndarray, sizes: np.ndarray, gap: float, lo: float, hi: f
     """Centres of boxes in a row: least squared shift from ``desired``, order kept, no overlap.
 
     Minimises ``sum (p_i - desired_i)^2`` subject to ``p_{i+1} - p_i >= (s_i + s_{i+1})/2
-    + gap`` and ``lo <= p_0 - s_0/2``, ``p_{n-1} + s_{n-1}/2 <= hi``.  ``desired`` must be
-    sorted.  Substituting ``z_i = p_i - o_i`` (``o`` = cumulative spacing) turns it into
+    + gap`` and ``lo <= p_0 - s_0/2``, ``p_{n-1} + s_{n-1}/2 <= hi``.  The boxes keep the
+    order they are given in (usually ``desired`` sorted).  Substituting ``z_i = p_i - o_i`` (``o`` = cumulative spacing) turns it into
     isotonic regression of ``desired - o``, solved exactly by pool-adjacent-violators and
     then clipped to the bounds.  When the row does not fit, it is centred between them.
     """
@@ -152,12 +152,44 @@ def uncross(anchors: np.ndarray, ports: np.ndarray, max_swaps: int | None = None
     return assign, swaps
 
 
+def coherent_order(desired: np.ndarray, previous: np.ndarray, pitch: float) -> np.ndarray:
+    """Order of the boxes of one side: by ``desired``, but neighbours closer than ``pitch``
+    keep the order they had in the previous frame.
+
+    Boxes whose desired places are less than one box pitch apart are stacked next to each
+    other whatever their order, so their order is free to follow the previous frame
+    (``previous``: their coordinate along the same side then, NaN when a label was not on
+    this side).  Adjacent such pairs are swapped back until none is left (bubble passes
+    over the few labels of a side); crossings this creates are undone by :func:`uncross`.
+    An addition to appendix I, whose coherence terms f6, f7 act on anchors and endpoints
+    only.
+
+    Returns
+    -------
+    (n,) int, a permutation of ``range(n)``
+    """
+    desired = np.asarray(desired, np.float64)
+    previous = np.asarray(previous, np.float64)
+    order = list(np.lexsort((np.arange(len(desired)), desired)))
+    changed = True
+    while changed:
+        changed = False
+        for i in range(len(order) - 1):
+            a, b = order[i], order[i + 1]
+            if (abs(desired[b] - desired[a]) < pitch and previous[a] > previous[b]):  # NaN compares False
+                order[i], order[i + 1] = b, a
+                changed = True
+    return np.asarray(order, np.int64)
+
+
 # ---------------------------------------------------------------------------- layout context
 class _Context:
     """Everything the placement of one frame shares."""
 
-    def __init__(self, anchors, endpoints, sides, widths, height, area, image_size, spacing, rank):
+    def __init__(self, anchors, endpoints, sides, widths, height, area, image_size, spacing, rank, previous=None):
         self.anchors = np.asarray(anchors, np.float64).reshape(-1, 2)
+        # per label: its box centre along each side in the previous frame (NaN: elsewhere)
+        self.previous = np.full((len(self.anchors), 4), np.nan) if previous is None else np.asarray(previous, np.float64)
         self.endpoints = np.asarray(endpoints, np.float64).reshape(-1, 2)
         self.sides = np.asarray(sides, np.int64)
         self.widths = np.asarray(widths, np.float64)
@@ -256,9 +288,9 @@ def _place_column(ctx: _Context, idx: np.ndarray, side: int) -> None:
     if len(idx) == 0:
         return
     desired = ctx.endpoints[idx, 1]
-    order = np.lexsort((idx, desired))
-    idx, desired = idx[order], desired[order]
     h = ctx.height
+    order = coherent_order(desired, ctx.previous[idx, side], h + ctx.sp.gap)
+    idx, desired = idx[order], desired[order]
     slots = pack_1d(desired, np.full(len(idx), h), ctx.sp.gap, 0.0, ctx.H)
     x = ctx.col_x[side]
     ports = np.column_stack([np.full(len(idx), x), slots])
@@ -282,12 +314,12 @@ def _place_row(ctx: _Context, idx: np.ndarray, side: int) -> None:
     if len(idx) == 0:
         return
     desired = ctx.endpoints[idx, 0]
-    order = np.lexsort((idx, desired))
-    idx, desired = idx[order], desired[order]
     # spread the ports as far as the image allows, up to one box width apart: wider
     # spacing means fewer tiers, at the price of more slanted leaders
     fair = (ctx.W - 2 * ctx.sp.clearance) / len(idx)
     gap = float(np.clip(fair, ctx.sp.port_gap, ctx.widths[idx].mean() + ctx.sp.gap))
+    order = coherent_order(desired, ctx.previous[idx, side], gap)
+    idx, desired = idx[order], desired[order]
     xs = pack_1d(desired, np.zeros(len(idx)), gap, 0.0, ctx.W)
     y = ctx.row_y[side]
     ports = np.column_stack([xs, np.full(len(idx), y)])
@@ -579,6 +611,7 @@ def place_boxes(
     image_size: tuple[int, int],
     rank: np.ndarray | None = None,
     spacing: Spacing | None = None,
+    previous: np.ndarray | None = None,
 ) -> tuple[list[Placement | None], BoxStats]:
     """Lay out the boxes and leaders of all labels of one frame.
 
@@ -591,6 +624,9 @@ def place_boxes(
     image_size : (width, height)
     rank : (n,) int, greedy placement order (lower = placed first); default 0..n-1
     spacing : Spacing
+    previous : (n, 4) float, optional: each label's box centre along the west, east,
+        north and south side in the previous frame (y for west/east, x for north/south;
+        NaN where it was not on that side), for :func:`coherent_order`
 
     Returns
     -------
@@ -599,7 +635,7 @@ def place_boxes(
     """
     n = len(anchors)
     rank = np.arange(n) if rank is None else np.asarray(rank)
-    ctx = _Context(anchors, endpoints, sides, widths, height, area, image_size, spacing or Spacing(), rank)
+    ctx = _Context(anchors, endpoints, sides, widths, height, area, image_size, spacing or Spacing(), rank, previous)
     for side in (WEST, EAST):
         _place_column(ctx, np.flatnonzero(ctx.sides == side), side)
     for side in (NORTH, SOUTH):

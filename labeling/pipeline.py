@@ -211,7 +211,16 @@ def solve(
     anchors = np.column_stack([ax[pick_of], ay[pick_of]])
     endpoints = np.column_stack([ex[pick_of], ey[pick_of]])
     sides = side[pick_of].astype(np.int64)
-    placements, stats = place_boxes(anchors, endpoints, sides, widths, style.box_height, ia, (w, h), rank, spacing)
+    prev_box = None
+    if previous is not None:  # where each label's box sat along each side in the last frame
+        prev_box = np.full((len(labelled), 4), np.nan)
+        for lab in previous.labels:
+            s = slot[lab.part] if lab.part < len(slot) else -1
+            code = SIDE_NAMES.index(lab.side)
+            if s >= 0 and code < 4:
+                prev_box[s, code] = 0.5 * (lab.box[1] + lab.box[3]) if code < 2 else 0.5 * (lab.box[0] + lab.box[2])
+    placements, stats = place_boxes(anchors, endpoints, sides, widths, style.box_height, ia, (w, h), rank, spacing,
+                                    prev_box)
     t = tick("boxes", t)
 
     feas_of = np.full(len(labelled), np.nan)
