@@ -124,8 +124,8 @@ def parity_side(c: Classification, faces: np.ndarray, seed: int = 0, rays: int =
 
     From each face's centroid, ``rays`` cosine-distributed rays leave its front side and
     every crossing of a face of the same body (the face's component over all welded edges,
-    non-manifold ones included) is counted: an even count means the front looks out of
-    the body.  The majority over the rays decides (ties: front).  Meant for the few hidden
+    non-manifold ones included) is counted, coincident copies once each: an even count
+    means the front looks out of the body.  The majority over the rays decides (ties: front).  Meant for the few hidden
     faces that visibility leaves open — two-sided at their layer, on a patch that no
     one-sided face votes for (a sliver cut off by non-manifold edges where solids touch).
 
@@ -133,7 +133,7 @@ def parity_side(c: Classification, faces: np.ndarray, seed: int = 0, rays: int =
     -------
     (len(faces),) int8, 0 when the front should face out, 1 when the back should
     """
-    from .adjacency import components, edges, face_adjacency
+    from .adjacency import components, duplicate_faces, edges, face_adjacency
     from .sampling import cosine_hemisphere
 
     faces = np.asarray(faces, np.int64)
@@ -141,6 +141,17 @@ def parity_side(c: Classification, faces: np.ndarray, seed: int = 0, rays: int =
         return np.zeros(0, np.int8)
     soup, caster = c.soup, c.caster
     body = components(soup.n_faces, face_adjacency(edges(c.pre.faces_welded), manifold_only=False))[1]
+    # Embree reports one of several coincident copies, and the next step jumps past them
+    # all: a hit counts as many crossings as its copy group has faces of the ray's body
+    group = duplicate_faces(c.pre.faces_welded).astype(np.int64)
+    nb = np.int64(body.max() + 1)
+    keys, per_key = np.unique(group * nb + body, return_counts=True)
+
+    def own_copies(face: np.ndarray, of_body: np.ndarray) -> np.ndarray:
+        k = group[face] * nb + of_body
+        i = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
+        return np.where(keys[i] == k, per_key[i], 0)
+
     f = np.repeat(faces, rays)
     d = cosine_hemisphere(soup.normals[f], np.random.default_rng(seed))
     o = caster.push_off(soup.triangles[f].mean(axis=1), f, np.zeros(len(f), np.int8))
@@ -150,8 +161,8 @@ def parity_side(c: Classification, faces: np.ndarray, seed: int = 0, rays: int =
     for _ in range(max_crossings):  # one pass per crossing depth, all rays together
         h = caster.intersect(o[live], d[live])
         hit = h.hit
-        own = hit & (body[np.where(hit, h.face, 0)] == body[f[live]])
-        odd[live[own]] ^= True
+        crossed = np.where(hit, own_copies(np.where(hit, h.face, 0), body[f[live]]), 0)
+        odd[live] ^= crossed % 2 == 1
         o[live[hit]] = h.points(o[live], d[live])[hit] + d[live[hit]] * step
         live = live[hit]
         if len(live) == 0:

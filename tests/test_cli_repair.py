@@ -166,3 +166,32 @@ def test_parity_side_reads_the_winding_of_each_face_against_its_own_body():
     faces = np.arange(t.n_faces)
     np.testing.assert_array_equal(parity_side(c, faces, seed=1), flip.astype(np.int8))
     assert parity_side(c, np.zeros(0, np.int64)).shape == (0,)
+
+
+def test_parity_side_counts_both_copies_where_solids_touch():
+    # two slabs sharing a face: the shared square is there twice (one copy per slab, opposite
+    # windings), welded into one body.  A ray from inside slab A that leaves through the
+    # shared square crosses both copies, then slab B's far wall: three crossings, inward.
+    import trimesh
+
+    from meshvis import classify
+    from meshvis.orientation import parity_side
+
+    a = trimesh.creation.box(bounds=[[0, 0, 0], [0.1, 1, 1]])  # thin slabs: most rays cross the contact
+    v_b = a.vertices.copy()
+    v_b[:, 0] = 0.2 - v_b[:, 0]  # mirror across x = 0.1: the contact triangles coincide
+    V = np.vstack([a.vertices, v_b])
+    F = np.vstack([a.faces, a.faces[:, ::-1] + len(a.vertices)])
+    flip = np.zeros(len(F), bool)
+    flip[: len(a.faces)] = True  # turn cube A inside out: its fronts look into A, toward B
+    F = np.where(flip[:, None], F[:, ::-1], F)
+    c = classify((V, F), seed=0)
+    # the copies themselves lie inside the two cubes together: which way they face is a
+    # question of ownership (ambiguous), not of parity; every other face is checked
+    from meshvis.adjacency import duplicate_faces
+
+    first = duplicate_faces(c.pre.faces_welded)
+    copy = np.bincount(first, minlength=len(F))[first] > 1
+    assert copy.sum() == 4
+    faces = np.flatnonzero(~copy)
+    np.testing.assert_array_equal(parity_side(c, faces, rays=33, seed=2), flip[faces].astype(np.int8))

@@ -498,3 +498,17 @@ def test_bench_runs_small(scene):
     assert set(r["orbit"]) == {"fuzzy", "fuzzy-no-coherence", "two-step"}
     text = bench.format(r)
     assert "per-stage time" in text and "orbit of 3 frames" in text
+
+
+def test_coherent_order_keeps_last_frames_order_only_between_close_neighbours():
+    from labeling.boxes import coherent_order
+
+    nan = np.nan
+    # labels 0 and 1 are closer than one pitch and were in the other order last frame
+    np.testing.assert_array_equal(coherent_order([0.0, 5.0, 100.0], [10.0, 0.0, nan], 10.0), [1, 0, 2])
+    # far apart: the desired order wins whatever came before
+    np.testing.assert_array_equal(coherent_order([0.0, 50.0], [10.0, 0.0], 10.0), [0, 1])
+    # no previous frame (NaN): plain sort, ties by index
+    np.testing.assert_array_equal(coherent_order([3.0, 1.0, 3.0], [nan, nan, nan], 10.0), [1, 0, 2])
+    # a chain of close labels is sorted back into the previous order
+    np.testing.assert_array_equal(coherent_order([0.0, 4.0, 8.0], [3.0, 2.0, 1.0], 10.0), [2, 1, 0])
