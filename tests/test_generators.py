@@ -494,3 +494,19 @@ def test_models_load_with_truth():
     assert soup.part_names == list(np.load(MODELS / "house.truth.npz")["part_names"])
     a = load(MODELS / "assembly.obj")
     assert a.n_parts >= 25 and "fan" in a.part_names
+
+
+def test_folded_onto_neighbour_finds_a_surface_stored_twice():
+    from meshvis.soup import Soup
+
+    def quad(z):  # corner 2 lifted by z: a skew quad
+        return np.array([[0, 0, 0], [1, 0, 0], [1, 1, z], [0, 1, 0.0]])
+
+    both = np.array([[0, 1, 2], [0, 2, 3], [0, 1, 3], [1, 2, 3]])  # both diagonals
+    one = np.array([[0, 1, 2], [0, 2, 3]])
+    assert g._folded_onto_neighbour(Soup(quad(0.0), both)).all()
+    assert not g._folded_onto_neighbour(Soup(quad(0.0), one)).any()
+    # a slightly skew quad (planes about 1 degree apart) is still one surface stored twice
+    assert g._folded_onto_neighbour(Soup(quad(np.tan(np.radians(0.7))), both)).all()
+    # a real fin, 10 degrees open, is not
+    assert not g._folded_onto_neighbour(Soup(quad(np.tan(np.radians(10))), both)).any()
