@@ -416,10 +416,13 @@ def _valid(ctx: _Context, k: int, boxes: np.ndarray, leaders: np.ndarray) -> np.
     K, S = leaders.shape[:2]
     ok = ctx.area.boxes_hit(boxes) == 0
     pboxes, psegs = _placed_arrays(ctx, k)
+    # each test runs only on the candidates that passed the ones before (cheapest first)
     if len(pboxes):
-        ok &= ~boxes_overlap(boxes, pboxes, ctx.sp.gap).any(axis=1)
+        live = np.flatnonzero(ok)
+        ok[live[boxes_overlap(boxes[live], pboxes, ctx.sp.gap).any(axis=1)]] = False
     if len(psegs):
-        ok &= ~segment_hits_box(psegs, boxes).any(axis=0)
+        live = np.flatnonzero(ok)
+        ok[live[segment_hits_box(psegs, boxes[live]).any(axis=0)]] = False
     for s in range(S):
         seg = leaders[:, s]
         same = bool(np.all(seg == seg[0]))  # e.g. the inside part a -> e of every candidate
@@ -551,7 +554,9 @@ def _search(ctx: _Context, k: int) -> bool:
         if not ok.any():
             continue
         rays = ctx.future_rays(k)
-        blocks = segment_hits_box(rays, boxes).sum(axis=0) if len(rays) else np.zeros(len(boxes))
+        blocks = np.zeros(len(boxes))
+        if len(rays):
+            blocks[ok] = segment_hits_box(rays, boxes[ok]).sum(axis=0)
         free = ok & (blocks == 0)
         cand = np.flatnonzero(free if free.any() else ok)
         best = cand[np.argmin((cost + 1e5 * blocks)[cand])]  # argmin: first of equal costs
