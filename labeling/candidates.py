@@ -121,14 +121,14 @@ def _radial(mask: np.ndarray, X: np.ndarray, Y: np.ndarray, pad: int) -> tuple[n
     qy = ri.ravel()[inside] + 0.5 - pad
     dx, dy = qx - X.ravel()[inside], qy - Y.ravel()[inside]
     norm = np.maximum(np.hypot(dx, dy), 1e-12)
-    uniq, inv = np.unique(k, return_inverse=True)
-    mx = np.bincount(inv, dx / norm, len(uniq))
-    my = np.bincount(inv, dy / norm, len(uniq))
+    # mean direction per nearest outside pixel: sums over the pixel grid, no sort needed
+    mx = np.bincount(k, dx / norm, hp * wp)[k]
+    my = np.bincount(k, dy / norm, hp * wp)[k]
     mn = np.maximum(np.hypot(mx, my), 1e-12)
     ex = np.full(hp * wp, np.nan)
     ey = np.full(hp * wp, np.nan)
-    ex[inside] = qx - 0.5 * (mx / mn)[inv]
-    ey[inside] = qy - 0.5 * (my / mn)[inv]
+    ex[inside] = qx - 0.5 * (mx / mn)
+    ey[inside] = qy - 0.5 * (my / mn)
     length = np.full(hp * wp, np.inf)
     length[inside] = np.hypot(ex[inside] - X.ravel()[inside], ey[inside] - Y.ravel()[inside])
     return length.reshape(hp, wp), ex.reshape(hp, wp), ey.reshape(hp, wp), key
