@@ -446,6 +446,11 @@ def _outside_image(ctx: _Context, boxes: np.ndarray) -> np.ndarray:
     return (boxes[:, 0] < 0) | (boxes[:, 1] < 0) | (boxes[:, 2] > ctx.W) | (boxes[:, 3] > ctx.H)
 
 
+def _radial_tiers(ctx: _Context, reach: float) -> int:
+    """Push-out tiers of the silhouette layout's candidates within ``reach`` pixels."""
+    return int(min(96, max(2, reach // (0.5 * ctx.height + ctx.sp.gap) + 1)))
+
+
 def _candidates(ctx: _Context, k: int, reach: float, shifted: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Candidate (boxes, leaders, costs, tiers, shifts) for label k within ``reach`` pixels.
 
@@ -488,7 +493,7 @@ def _candidates(ctx: _Context, k: int, reach: float, shifted: int = 0) -> tuple[
         pts, normals = ctx.boundary
         m = len(pts)
         tier_step = 0.5 * h + ctx.sp.gap
-        n_t = int(min(96, max(2, reach // tier_step + 1)))
+        n_t = _radial_tiers(ctx, reach)
         q0 = int(np.argmin(np.hypot(*(pts - ctx.endpoints[k]).T)))
         e_list = [ctx.endpoints[k][None]]
         n_list = [ctx.ray_direction(k)[None]]
@@ -548,15 +553,27 @@ def _search(ctx: _Context, k: int) -> bool:
     rounds = [(r, 0) for r in (24.0, 96.0, 0.4 * size, far)]
     if ctx.sides[k] == RADIAL:
         rounds += [(r, 1) for r in (96.0, 0.4 * size, far)]
-    for reach, shifted in rounds:
+    rays = ctx.future_rays(k)
+
+    def evaluate(reach: float, shifted: int):
         boxes, leaders, cost, tiers, shifts = _candidates(ctx, k, reach, shifted)
         ok = _valid(ctx, k, boxes, np.stack([leaders[:, :-1], leaders[:, 1:]], axis=2))
+        blocks = np.zeros(len(boxes))
+        if len(rays) and ok.any():
+            blocks[ok] = segment_hits_box(rays, boxes[ok]).sum(axis=0)
+        return boxes, leaders, cost, tiers, shifts, ok, blocks
+
+    batch = None  # radial rounds without shifted endpoints are prefixes of one another:
+    for reach, shifted in rounds:  # evaluate up to 0.4 x size once, then cut prefixes
+        if ctx.sides[k] == RADIAL and not shifted:
+            if batch is None or batch[0] < reach:
+                batch = (max(reach, 0.4 * size), evaluate(max(reach, 0.4 * size), 0))
+            n = len(_ATTACH) * _radial_tiers(ctx, reach)
+            boxes, leaders, cost, tiers, shifts, ok, blocks = (x[:n] for x in batch[1])
+        else:
+            boxes, leaders, cost, tiers, shifts, ok, blocks = evaluate(reach, shifted)
         if not ok.any():
             continue
-        rays = ctx.future_rays(k)
-        blocks = np.zeros(len(boxes))
-        if len(rays):
-            blocks[ok] = segment_hits_box(rays, boxes[ok]).sum(axis=0)
         free = ok & (blocks == 0)
         cand = np.flatnonzero(free if free.any() else ok)
         best = cand[np.argmin((cost + 1e5 * blocks)[cand])]  # argmin: first of equal costs
