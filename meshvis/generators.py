@@ -1330,9 +1330,9 @@ def _folded_onto_neighbour(soup: Soup, degrees: float = FOLD_DEGREES, max_fan: i
     of its coincident copies and 32 faces of slightly skew quads stored with both diagonals
     (planes 0.8-1.3 degrees apart); on cow, spot and the dog skin, nothing.
     """
-    tol = 1.0 - np.cos(np.radians(degrees))
     from .adjacency import edges
 
+    tol = 1.0 - np.cos(np.radians(degrees))
     welded = _welded(soup, 0.0)
     table = edges(welded)
     start = np.searchsorted(table.half_edge, np.arange(len(table.count)))

@@ -46,6 +46,7 @@ class OrientResult:
     flipped : (m,) bool, input faces written turned over
     duplicated : (m,) bool, input faces written in both orientations
     status : (m,) int8, one of ``STATUS_NAMES`` per input face
+    parity_faces : int, hidden faces whose side came from ray parity (:func:`parity_side`)
     """
 
     soup: Soup
@@ -55,6 +56,7 @@ class OrientResult:
     status: np.ndarray
     classification: Classification
     layers: LayerResult | None
+    parity_faces: int = 0
 
     def report(self, per_face: bool = True) -> dict:
         counts = np.bincount(self.status, minlength=len(STATUS_NAMES))
@@ -70,6 +72,7 @@ class OrientResult:
             d["layers"] = self.layers.report(per_face=False)
         else:
             d["layers"] = "skipped: no hidden faces"
+        d["parity_faces"] = self.parity_faces if self.parity_faces else "skipped: every hidden face had a vote"
         if per_face:
             d["per_face"] = {"flipped": self.flipped, "duplicated": self.duplicated, "status": self.status,
                              "outside_front": self.classification.outside[:, 0],
@@ -122,16 +125,24 @@ def parity_side(c: Classification, faces: np.ndarray, seed: int = 0, rays: int =
                 max_crossings: int = 64) -> np.ndarray:
     """Outer side of ``faces`` by ray parity against their own body.
 
-    From each face's centroid, ``rays`` cosine-distributed rays leave its front side and
+    From each face's centroid, ``rays`` cosine-distributed rays leave its front side, and
     every crossing of a face of the same body (the face's component over all welded edges,
     non-manifold ones included) is counted, coincident copies once each: an even count
-    means the front looks out of the body.  The majority over the rays decides (ties: front).  Meant for the few hidden
-    faces that visibility leaves open — two-sided at their layer, on a patch that no
-    one-sided face votes for (a sliver cut off by non-manifold edges where solids touch).
+    means the front looks out of the body (Jordan's parity rule).  The majority over the
+    rays decides (ties: front).  Meant for the few hidden faces that visibility leaves
+    open: two-sided at their layer, on a patch that no one-sided face votes for (a sliver
+    cut off by non-manifold edges where solids touch).
+
+    Parameters
+    ----------
+    c : Classification of the model
+    faces : (k,) int, faces to decide
+    seed : seed of the ray directions; rays : rays per face
+    max_crossings : crossings followed per ray at most
 
     Returns
     -------
-    (len(faces),) int8, 0 when the front should face out, 1 when the back should
+    (k,) int8, 0 when the front should face out, 1 when the back should
     """
     from .adjacency import components, duplicate_faces, edges, face_adjacency
     from .sampling import cosine_hemisphere
@@ -231,6 +242,7 @@ def orient(
         outer[ts] = strongest_side(c)[ts]
 
     lay = None
+    n_parity = 0
     hidden = status == HIDDEN
     if hidden.any():
         lay = layers(soup, classification=c)
@@ -246,11 +258,12 @@ def orient(
         side = np.where(decisive[hidden], vote[hidden], np.maximum(side, 0))
         outer[hidden] = side
         # faces two-sided at their layer on a patch without a vote (a sliver of surface cut
-        # off by non-manifold edges where solids touch): their neighbours across any edge
+        # off by non-manifold edges where solids touch): ray parity against their own body
         open_ = np.zeros(m, bool)
         open_[np.flatnonzero(hidden)[~own]] = True
         open_ &= ~decisive
-        if open_.any():
+        n_parity = int(open_.sum())
+        if n_parity:
             outer[open_] = parity_side(c, np.flatnonzero(open_), seed=int(c.params.get("seed", 0)))
         if semantics == "cavity":
             even = hidden & (lay.layer % 2 == 0)
@@ -271,4 +284,4 @@ def orient(
     source = np.concatenate([np.arange(m), extra])
     out_flip = np.concatenate([flip, ~flip[extra]])
     out = soup.subset(source).flipped(out_flip)
-    return OrientResult(out, source, flip, dup, status, c, lay)
+    return OrientResult(out, source, flip, dup, status, c, lay, n_parity)

@@ -114,6 +114,8 @@ def test_orient_cli_options_two_sided_duplicate(tmp_path):
     report = json.loads(rep.read_text())
     assert report["status_counts"]["two-sided"] == truth.soup.n_faces
     assert load(str(out)).n_faces == 2 * truth.soup.n_faces
+    # nothing hidden: no layers, no parity fallback, and the report says so
+    assert report["layers"].startswith("skipped") and report["parity_faces"].startswith("skipped")
 
 
 def test_demo_writes_everything(tmp_path):
@@ -186,8 +188,9 @@ def test_parity_side_counts_both_copies_where_solids_touch():
     flip[: len(a.faces)] = True  # turn cube A inside out: its fronts look into A, toward B
     F = np.where(flip[:, None], F[:, ::-1], F)
     c = classify((V, F), seed=0)
-    # the copies themselves lie inside the two cubes together: which way they face is a
-    # question of ownership (ambiguous), not of parity; every other face is checked
+    # both slabs are seen from outside, so orient itself needs no parity here; the function
+    # is checked directly.  The copies lie inside the two slabs together: which way they face
+    # is a question of ownership (ambiguous), not of parity; every other face is checked
     from meshvis.adjacency import duplicate_faces
 
     first = duplicate_faces(c.pre.faces_welded)
