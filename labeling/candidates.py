@@ -134,18 +134,6 @@ def _radial(mask: np.ndarray, X: np.ndarray, Y: np.ndarray, pad: int) -> tuple[n
     return length.reshape(hp, wp), ex.reshape(hp, wp), ey.reshape(hp, wp), key
 
 
-def _dense_ids(keys: np.ndarray, n_keys: int) -> tuple[np.ndarray, np.ndarray]:
-    """``np.unique(keys, return_index=True, return_inverse=True)[1:]`` for keys in
-    ``[0, n_keys)``, by counting instead of sorting: (index of each distinct key's first
-    occurrence, in key order; the rank of every key among the distinct ones)."""
-    present = np.zeros(n_keys, bool)
-    present[keys] = True
-    rank = np.cumsum(present) - 1
-    first = np.full(n_keys, len(keys), np.int64)
-    np.minimum.at(first, keys, np.arange(len(keys)))
-    return first[present], rank[keys]
-
-
 def leader_candidates(area: InternalArea, layout: str) -> Candidates:
     """Compute the candidate endpoint, length and side of every pixel of ``A_I``.
 
@@ -203,7 +191,7 @@ def leader_candidates(area: InternalArea, layout: str) -> Candidates:
     sl = (slice(p, hp - p), slice(p, wp - p))
     key_img = key[sl]
     inside = key_img >= 0
-    first, inv = _dense_ids(key_img[inside], 2 * hp + 2 * wp + hp * wp)
+    uniq, first, inv = np.unique(key_img[inside], return_index=True, return_inverse=True)
     eid = np.full(key_img.shape, -1, np.int64)
     eid[inside] = inv
     exi, eyi = ex[sl], ey[sl]

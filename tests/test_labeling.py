@@ -512,14 +512,3 @@ def test_coherent_order_keeps_last_frames_order_only_between_close_neighbours():
     np.testing.assert_array_equal(coherent_order([3.0, 1.0, 3.0], [nan, nan, nan], 10.0), [1, 0, 2])
     # a chain of close labels is sorted back into the previous order
     np.testing.assert_array_equal(coherent_order([0.0, 4.0, 8.0], [3.0, 2.0, 1.0], 10.0), [2, 1, 0])
-
-
-def test_dense_ids_match_numpy_unique():
-    from labeling.candidates import _dense_ids
-
-    rng = np.random.default_rng(3)
-    keys = rng.integers(0, 500, 2000)
-    _, first, inv = np.unique(keys, return_index=True, return_inverse=True)
-    got_first, got_inv = _dense_ids(keys, 500)
-    np.testing.assert_array_equal(got_first, first)
-    np.testing.assert_array_equal(got_inv, inv.ravel())
