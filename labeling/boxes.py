@@ -95,9 +95,9 @@ def pack_1d(desired: np.ndarray, sizes: np.ndarray, gap: float, lo: float, hi: f
 
     Minimises ``sum (p_i - desired_i)^2`` subject to ``p_{i+1} - p_i >= (s_i + s_{i+1})/2
     + gap`` and ``lo <= p_0 - s_0/2``, ``p_{n-1} + s_{n-1}/2 <= hi``.  The boxes keep the
-    order they are given in (usually ``desired`` sorted).  Substituting ``z_i = p_i - o_i`` (``o`` = cumulative spacing) turns it into
-    isotonic regression of ``desired - o``, solved exactly by pool-adjacent-violators and
-    then clipped to the bounds.  When the row does not fit, it is centred between them.
+    order they are given in (usually ``desired`` sorted).  Substituting ``z_i = p_i - o_i``
+    (``o`` = cumulative spacing) turns it into isotonic regression of ``desired - o``,
+    solved exactly by pool-adjacent-violators and then clipped to the bounds.  When the row does not fit, it is centred between them.
     """
     desired = np.asarray(desired, np.float64)
     sizes = np.asarray(sizes, np.float64)
@@ -563,8 +563,10 @@ def _search(ctx: _Context, k: int) -> bool:
             blocks[ok] = segment_hits_box(rays, boxes[ok]).sum(axis=0)
         return boxes, leaders, cost, tiers, shifts, ok, blocks
 
-    batch = None  # radial rounds without shifted endpoints are prefixes of one another:
-    for reach, shifted in rounds:  # evaluate up to 0.4 x size once, then cut prefixes
+    # the radial rounds without shifted endpoints list their candidates tier by tier, so a
+    # smaller reach is a prefix of a larger one: evaluate up to 0.4 x size once, cut prefixes
+    batch = None
+    for reach, shifted in rounds:
         if ctx.sides[k] == RADIAL and not shifted:
             if batch is None or batch[0] < reach:
                 batch = (max(reach, 0.4 * size), evaluate(max(reach, 0.4 * size), 0))

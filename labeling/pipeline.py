@@ -67,6 +67,23 @@ def _fit_font(n_labels: int, layout: str, height: int, font_size: int, min_size:
     return style
 
 
+def _previous_frame(previous: LayoutResult, slot: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The previous frame's anchor (n, 2), endpoint (n, 2) and box centre along each of the
+    west, east, north and south sides (n, 4; y for west/east, x for north/south) of every
+    label of this frame; NaN where the label was absent or on another side."""
+    anchor, endpoint, box = np.full((n, 2), np.nan), np.full((n, 2), np.nan), np.full((n, 4), np.nan)
+    for lab in previous.labels:
+        s = slot[lab.part] if lab.part < len(slot) else -1
+        if s < 0:
+            continue
+        anchor[s], endpoint[s] = lab.anchor, lab.endpoint
+        code = SIDE_NAMES.index(lab.side)
+        if code < 4:
+            axis = 1 if code < 2 else 0
+            box[s, code] = 0.5 * (lab.box[axis] + lab.box[axis + 2])
+    return anchor, endpoint, box
+
+
 def solve(
     idbuf: IdBuffer,
     texts: Sequence[str],
@@ -178,13 +195,7 @@ def solve(
     if method == "fuzzy":
         static = weighted(f2_length(length, cand.d_max), weights.w2) * weighted(f3_salience(sal, cand.d_max), weights.w3)
         if previous is not None:
-            prev_a = np.full((len(labelled), 2), np.nan)
-            prev_e = np.full((len(labelled), 2), np.nan)
-            for lab in previous.labels:
-                s = slot[lab.part] if lab.part < len(slot) else -1
-                if s >= 0:
-                    prev_a[s] = lab.anchor
-                    prev_e[s] = lab.endpoint
+            prev_a, prev_e, _ = _previous_frame(previous, slot, len(labelled))
             static = static * weighted(f_coherence(ax, ay, prev_a[area_of], d_s), weights.w6)
             static = static * weighted(f_coherence(ex, ey, prev_e[area_of], d_s), weights.w7)
         t = tick("memberships", t)
@@ -211,14 +222,7 @@ def solve(
     anchors = np.column_stack([ax[pick_of], ay[pick_of]])
     endpoints = np.column_stack([ex[pick_of], ey[pick_of]])
     sides = side[pick_of].astype(np.int64)
-    prev_box = None
-    if previous is not None:  # where each label's box sat along each side in the last frame
-        prev_box = np.full((len(labelled), 4), np.nan)
-        for lab in previous.labels:
-            s = slot[lab.part] if lab.part < len(slot) else -1
-            code = SIDE_NAMES.index(lab.side)
-            if s >= 0 and code < 4:
-                prev_box[s, code] = 0.5 * (lab.box[1] + lab.box[3]) if code < 2 else 0.5 * (lab.box[0] + lab.box[2])
+    prev_box = None if previous is None else _previous_frame(previous, slot, len(labelled))[2]
     placements, stats = place_boxes(anchors, endpoints, sides, widths, style.box_height, ia, (w, h), rank, spacing,
                                     prev_box)
     t = tick("boxes", t)
