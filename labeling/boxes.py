@@ -21,9 +21,11 @@ overlaps, no leader crossings and no box over the model:
   just outside ``A_I``, and is pushed further out in tiers where it collides (the
   "extruded" leaders of Fig. 4b).  A box may hang off its port at any corner or edge
   middle; the cheapest valid place that blocks no later label's ray wins.  Normals of a
-  convex boundary diverge, so the rays never meet.  Only a label whose own leader is
-  blocked (e.g. it shares its endpoint with a placed one) gets its endpoint shifted a
-  few pixels along the boundary.
+  convex boundary diverge, so the rays never meet.  A box that would be pushed out is
+  instead hung, when that makes a shorter leader, off a *rotated* leader: endpoint moved
+  up to ``Spacing.rotate`` pixels along the boundary to a stretch with room within two
+  tiers.  A label whose own leader is blocked (e.g. it shares its endpoint with a placed
+  one) gets its endpoint moved a few pixels along the boundary.
 
 A last pass checks every pair of labels and re-places a label of any conflicting pair
 (the one placed later by the greedy order) by the same candidate search; a label with no
@@ -33,6 +35,7 @@ with the label index as the last key, and candidate ties go to the lowest index.
 from __future__ import annotations
 
 from dataclasses import dataclass, field
+from functools import cached_property
 
 import numpy as np
 
@@ -51,12 +54,16 @@ class Spacing:
     clearance : free space between ``A_I`` and the boxes (column / row / ray start)
     port_gap : least distance between two leader ports of the north/south layouts
     inset : distance of a flag leader from the near end of its box (north/south)
+    rotate : largest move of an endpoint along the boundary of ``A_I`` that turns a
+        leader towards free space, instead of pushing its box out (silhouette layout;
+        0 = never)
     """
 
     gap: float = 3.0
     clearance: float = 4.0
     port_gap: float = 5.0
     inset: float = 2.0
+    rotate: float = 64.0
 
 
 @dataclass
@@ -77,6 +84,11 @@ class Placement:
     side: int
     tier: int = 0
     shift: float = 0.0
+
+    @cached_property
+    def segments(self) -> np.ndarray:
+        """(k - 1, 2, 2) segments of the leader."""
+        return np.stack([self.leader[:-1], self.leader[1:]], axis=1)
 
 
 @dataclass
@@ -254,8 +266,14 @@ class _Context:
         if self._rays is None:
             pts, normals = self.boundary
             d2 = ((self.endpoints[:, None, :] - pts[None, :, :]) ** 2).sum(axis=2)
-            self._rays = normals[np.argmin(d2, axis=1)]
+            self._nearest = np.argmin(d2, axis=1)
+            self._rays = normals[self._nearest]
         return self._rays[k]
+
+    def boundary_index(self, k: int) -> int:
+        """Index of the boundary point (:attr:`boundary`) nearest to label k's endpoint."""
+        self.ray_direction(k)
+        return int(self._nearest[k])
 
     def future_rays(self, k: int) -> np.ndarray:
         """Rays (m, 2, 2) of the radial labels not placed yet (other than k)."""
@@ -266,6 +284,11 @@ class _Context:
         far = 2.0 * (self.W + self.H)
         e = self.endpoints[js]
         return np.stack([e, e + far * self._rays[js]], axis=1)
+
+    def future_insides(self, k: int) -> np.ndarray:
+        """Inside parts (m, 2, 2), anchor to endpoint, of the radial labels not placed yet (other than k)."""
+        js = np.array([j for j in self.future if j != k], np.int64)
+        return np.stack([self.anchors[js], self.endpoints[js]], axis=1).reshape(-1, 2, 2)
 
     @property
     def boundary(self) -> tuple[np.ndarray, np.ndarray]:
@@ -389,6 +412,12 @@ def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
     ctx.future = ()
 
 
+#: endpoint moves along the boundary (step, largest; pixels) that part leaders sharing an endpoint
+_PARTING = (3.0, 24.0)
+#: step of the endpoint moves of rotated leaders (pixels), and the tiers their boxes may use
+_ROTATE_STEP = 4.0
+_ROTATE_TIERS = 3
+
 #: attach points of a box: offsets of the box centre from the port, in half widths/heights
 _ATTACH = np.array([[1, 0], [-1, 0], [0, 1], [0, -1], [1, 1], [1, -1], [-1, 1], [-1, -1]], np.float64)
 
@@ -404,41 +433,22 @@ def _placed_arrays(ctx: _Context, exclude: int) -> tuple[np.ndarray, np.ndarray]
         if p is None or i == exclude:
             continue
         boxes.append(p.box)
-        pts = p.leader
-        segs.extend(np.stack([pts[:-1], pts[1:]], axis=1))
-    out = np.array(boxes, np.float64).reshape(-1, 4), np.array(segs, np.float64).reshape(-1, 2, 2)
+        segs.append(p.segments)
+    out = (np.array(boxes, np.float64).reshape(-1, 4),
+           np.concatenate(segs).reshape(-1, 2, 2) if segs else np.zeros((0, 2, 2)))
     ctx._cache = (key, out)
     return out
 
 
 def _valid(ctx: _Context, k: int, boxes: np.ndarray, leaders: np.ndarray) -> np.ndarray:
     """Which candidates (boxes (K, 4), leaders (K, S, 2, 2)) collide with nothing placed."""
-    K, S = leaders.shape[:2]
-    ok = ctx.area.boxes_hit(boxes) == 0
     pboxes, psegs = _placed_arrays(ctx, k)
-    # each test runs only on the candidates that passed the ones before (cheapest first)
-    if len(pboxes):
-        live = np.flatnonzero(ok)
-        ok[live[boxes_overlap(boxes[live], pboxes, ctx.sp.gap).any(axis=1)]] = False
-    if len(psegs):
-        live = np.flatnonzero(ok)
-        ok[live[segment_hits_box(psegs, boxes[live]).any(axis=0)]] = False
-    for s in range(S):
-        seg = leaders[:, s]
-        same = bool(np.all(seg == seg[0]))  # e.g. the inside part a -> e of every candidate
-        test = seg[:1] if same else seg[ok]
-        if len(test) == 0:
-            break
-        bad = np.zeros(len(test), bool)
-        if len(pboxes):
-            bad |= segment_hits_box(test, pboxes).any(axis=1)
-        if len(psegs):
-            bad |= segments_intersect(test, psegs).any(axis=1)
-        if same:
-            if bad[0]:
-                return np.zeros(K, bool)
-        else:
-            ok[np.flatnonzero(ok)[bad]] = False
+    ok = _boxes_free(ctx, boxes, pboxes, psegs)
+    live = np.flatnonzero(ok)
+    if len(live):
+        # leaders as polylines; the column/row layouts have few distinct ones per label
+        poly = np.concatenate([leaders[live, :, 0], leaders[live, -1:, 1]], axis=1)
+        ok[live] = _leaders_free(poly, pboxes, psegs, None)
     return ok
 
 
@@ -451,13 +461,8 @@ def _radial_tiers(ctx: _Context, reach: float) -> int:
     return int(min(96, max(2, reach // (0.5 * ctx.height + ctx.sp.gap) + 1)))
 
 
-def _candidates(ctx: _Context, k: int, reach: float, shifted: int = 0) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Candidate (boxes, leaders, costs, tiers, shifts) for label k within ``reach`` pixels.
-
-    ``shifted`` (silhouette layout only): endpoints moved up to 24 pixels along the
-    boundary instead of the label's own endpoint, for labels whose own leader is blocked
-    (e.g. by a leader that shares its endpoint).
-    """
+def _candidates(ctx: _Context, k: int, reach: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Candidate (boxes, leaders, costs, tiers, shifts) of a column or row label within ``reach`` pixels."""
     side = int(ctx.sides[k])
     a = ctx.anchors[k]
     h = ctx.height
@@ -488,40 +493,63 @@ def _candidates(ctx: _Context, k: int, reach: float, shifted: int = 0) -> tuple[
         tiers = T
         cost = shifts + T * (h + ctx.sp.gap) * 2.0
     else:
-        # push-out along the ray of the endpoint (extruded leaders, appendix I Fig. 4b); in
-        # the wider rounds also endpoints shifted along the boundary (rotated leaders)
-        pts, normals = ctx.boundary
-        m = len(pts)
-        tier_step = 0.5 * h + ctx.sp.gap
-        n_t = _radial_tiers(ctx, reach)
-        q0 = int(np.argmin(np.hypot(*(pts - ctx.endpoints[k]).T)))
-        e_list = [ctx.endpoints[k][None]]
-        n_list = [ctx.ray_direction(k)[None]]
-        if shifted:  # a few pixels either way parts leaders that share an endpoint; more if needed
-            js = np.unique(np.round(np.arange(3.0, 24.5, 3.0) / ctx.boundary_step).astype(np.int64))
-            js = np.concatenate([-js, js])
-            js = js[(np.abs(js) > 0) & (np.abs(js) <= m // 2)]
-            q = (q0 + js) % m
-            e_list.append(pts[q])
-            n_list.append(normals[q])
-        E = np.concatenate(e_list)
-        N = np.concatenate(n_list)
-        I, T, A = np.meshgrid(np.arange(len(E)), np.arange(n_t), np.arange(len(_ATTACH)), indexing="ij")
-        I, T, A = I.ravel(), T.ravel(), A.ravel()
-        u = N[I]
-        port = E[I] + (ctx.sp.clearance + T * tier_step)[:, None] * u
-        w = ctx.widths[k]
-        off = _ATTACH[A] * np.array([w / 2, h / 2])
-        c = port + off
-        boxes = np.column_stack([c[:, 0] - w / 2, c[:, 1] - h / 2, c[:, 0] + w / 2, c[:, 1] + h / 2])
-        leaders = np.stack([np.broadcast_to(a, port.shape), E[I], port], axis=1)
-        shifts = np.hypot(*(E[I] - ctx.endpoints[k]).T)
-        tiers = T
-        # prefer boxes centred on the ray, then corner flags; boxes behind the port last
-        along = np.einsum("ij,ij->i", off / np.hypot(off[:, 0], off[:, 1])[:, None], u)
-        cost = shifts * 2.0 + (I > 0) * 2.0 * h + T * tier_step + (1.0 - along) * h + 1e6 * (along <= 0.05)
+        raise ValueError("radial labels use _radial_candidates")
     cost = cost + 1e4 * _outside_image(ctx, boxes)
     return boxes, leaders, cost, tiers, shifts
+
+
+def _radial_candidates(ctx: _Context, k: int, reach: float, moves: tuple[float, float] | None = None,
+                       below: float = np.inf) -> tuple[np.ndarray, ...]:
+    """Candidates of a silhouette-layout label: boxes pushed out along the ray of an endpoint.
+
+    Every endpoint E (the label's own; with ``moves`` = (step, most) also points every
+    ``step`` up to ``most`` pixels either way along the boundary of ``A_I``), every tier t
+    within ``reach`` (port at ``E + (clearance + t * step) n(E)``, the extruded leaders of
+    appendix I Fig. 4b) and every attach point of :data:`_ATTACH`; only those that cost
+    less than ``below``.
+
+    Returns
+    -------
+    boxes : (K, 4)
+    leaders : (L, 3, 2), anchor -> E -> port, one per (endpoint, tier)
+    lid : (K,) int, the leader of each box
+    cost : (K,) pixels of leader: the push-out ``t * step``, plus for a moved endpoint
+        the longer inside part and one box height for the bend; then ``(1 - along) h``
+        (boxes centred on the ray before corner flags), 1e6 for boxes behind the port,
+        1e4 for boxes outside the image
+    tiers, shifts : (K,) tier and endpoint move (pixels)
+    """
+    pts, normals = ctx.boundary
+    h, w, a = ctx.height, ctx.widths[k], ctx.anchors[k]
+    E, N = ctx.endpoints[k][None], ctx.ray_direction(k)[None]
+    if moves:
+        step, most = moves
+        m = len(pts)
+        js = np.unique(np.round(np.arange(step, most + 0.5, step) / ctx.boundary_step).astype(np.int64))
+        js = np.concatenate([-js, js])
+        q = (ctx.boundary_index(k) + js[(js != 0) & (np.abs(js) <= m // 2)]) % m
+        E, N = np.concatenate([E, pts[q]]), np.concatenate([N, normals[q]])
+    tier_step = 0.5 * h + ctx.sp.gap
+    n_t, n_a = _radial_tiers(ctx, reach), len(_ATTACH)
+    t = np.arange(n_t)
+    off = _ATTACH * np.array([w / 2, h / 2])  # (A, 2)
+    along = N @ (off / np.hypot(off[:, 0], off[:, 1])[:, None]).T  # (E, A)
+    moved = np.hypot(*(E - ctx.endpoints[k]).T)
+    longer = np.hypot(*(E - a).T) - np.hypot(*(ctx.endpoints[k] - a))
+    cost = (t * tier_step)[None, :, None] + ((moved > 0) * (h + longer))[:, None, None] \
+        + ((1.0 - along) * h + 1e6 * (along <= 0.05))[:, None, :]
+    ie, it, ia = np.nonzero(cost < below)
+    port = E + (ctx.sp.clearance + t[:, None, None] * tier_step) * N  # (T, E, 2)
+    c = port[it, ie] + off[ia]
+    half = np.array([w / 2, h / 2])
+    boxes = np.concatenate([c - half, c + half], axis=1)
+    cost = cost[ie, it, ia] + 1e4 * _outside_image(ctx, boxes)
+    keep = cost < below
+    lid = (ie * n_t + it)[keep]
+    used, lid = np.unique(lid, return_inverse=True)
+    ue, ut = np.divmod(used, n_t)
+    leaders = np.stack([np.broadcast_to(a, (len(used), 2)), E[ue], port[ut, ue]], axis=1)
+    return boxes[keep], leaders, lid.ravel(), cost[keep], it[keep], moved[ie[keep]]
 
 
 def _simplify(pts: np.ndarray) -> np.ndarray:
@@ -540,57 +568,137 @@ def _simplify(pts: np.ndarray) -> np.ndarray:
     return np.array(keep, np.float64)
 
 
-def _search(ctx: _Context, k: int) -> bool:
-    """Place label k at its cheapest valid candidate; widen the search until one is found.
+def _place(ctx: _Context, k: int, leader: np.ndarray, box: np.ndarray, tier: int, shift: float) -> None:
+    ctx.placed[k] = Placement(_simplify(leader), box.copy(), int(ctx.sides[k]), int(tier), float(shift))
+    ctx.stats.shifted += int(shift > 0.5)
 
-    For the silhouette layout a box that would block the ray of a label still to be
-    placed is taken only when no round offers one that does not.
+
+def _search(ctx: _Context, k: int) -> bool:
+    """Place label k at its cheapest valid candidate; widen the search until one is found."""
+    if ctx.sides[k] == RADIAL:
+        return _search_radial(ctx, k)
+    size = max(ctx.W, ctx.H)
+    far = max(1.2 * size, 3.0 * len(ctx.anchors) * (ctx.height + ctx.sp.gap))
+    for reach in (24.0, 96.0, 0.4 * size, far):
+        boxes, leaders, cost, tiers, shifts = _candidates(ctx, k, reach)
+        ok = _valid(ctx, k, boxes, np.stack([leaders[:, :-1], leaders[:, 1:]], axis=2))
+        if ok.any():
+            cand = np.flatnonzero(ok)
+            best = cand[np.argmin(cost[cand])]  # argmin: first of equal costs
+            _place(ctx, k, leaders[best], boxes[best], tiers[best], shifts[best])
+            return True
+    return False
+
+
+def _boxes_free(ctx: _Context, boxes: np.ndarray, pboxes: np.ndarray, psegs: np.ndarray) -> np.ndarray:
+    """Which boxes (K, 4) cover no model pixel, no placed box and no placed leader."""
+    ok = ctx.area.boxes_hit(boxes) == 0
+    # each test runs only on the boxes that passed the ones before (cheapest first)
+    if len(pboxes):
+        live = np.flatnonzero(ok)
+        ok[live[boxes_overlap(boxes[live], pboxes, ctx.sp.gap).any(axis=1)]] = False
+    if len(psegs):
+        live = np.flatnonzero(ok)
+        ok[live[segment_hits_box(psegs, boxes[live]).any(axis=0)]] = False
+    return ok
+
+
+def _leaders_free(leaders: np.ndarray, pboxes: np.ndarray, psegs: np.ndarray, paths: np.ndarray | None) -> np.ndarray:
+    """Which polylines (L, P, 2) cross no placed box, no placed leader and none of ``paths``."""
+    L, P = leaders.shape[:2]
+    segs = np.stack([leaders[:, :-1], leaders[:, 1:]], axis=2).reshape(-1, 2, 2)
+    bad = np.zeros(len(segs), bool)
+    if len(pboxes):
+        bad |= segment_hits_box(segs, pboxes).any(axis=1)
+    for other in (psegs, paths):
+        if other is not None and len(other):
+            bad |= segments_intersect(segs, other).any(axis=1)
+    return ~bad.reshape(L, P - 1).any(axis=1)
+
+
+def _cheapest(ctx: _Context, k: int, cands: tuple, rays: np.ndarray,
+              paths: np.ndarray | None) -> tuple[int | None, int | None]:
+    """Cheapest valid radial candidate that blocks no future ray, and the cheapest valid one.
+
+    ``cands`` = (boxes, leaders, lid, cost, ...) of :func:`_radial_candidates`, where
+    the boxes of one leader share it, so a leader is tested once for all its boxes.  Candidates are tested in order of cost, a first chunk and
+    then the rest, so a label that fits near ``A_I`` costs few tests.  ``paths``: leader
+    paths of labels still to come that the leaders must not cut (for moved endpoints).
+    Returns indices into ``cands``
+    (None: no such candidate); the second ranks blocking candidates by cost + 1e5 x rays
+    blocked and is only computed when no free candidate exists.
+    """
+    boxes, leaders, leader_of, cost = cands[:4]
+    pboxes, psegs = _placed_arrays(ctx, k)
+    order = np.argsort(cost, kind="stable")
+    leader_ok = np.full(len(leaders), -1, np.int8)  # -1: not tested yet
+    fallback, fallback_cost = None, np.inf
+    start, chunk = 0, 256
+    while start < len(order):
+        idx = order[start:start + chunk]
+        start, chunk = start + chunk, len(order)
+        idx = idx[_boxes_free(ctx, boxes[idx], pboxes, psegs)]
+        lid = leader_of[idx]
+        todo = np.unique(lid[leader_ok[lid] < 0])
+        if len(todo):
+            leader_ok[todo] = _leaders_free(leaders[todo], pboxes, psegs, paths)
+        idx = idx[leader_ok[lid] == 1]
+        if len(idx) == 0:
+            continue
+        blocks = segment_hits_box(rays, boxes[idx]).sum(axis=0) if len(rays) else np.zeros(len(idx))
+        if (blocks == 0).any():
+            return int(idx[np.argmax(blocks == 0)]), None  # the first free one in cost order
+        j = int(np.argmin(cost[idx] + 1e5 * blocks))
+        if cost[idx[j]] + 1e5 * blocks[j] < fallback_cost:
+            fallback, fallback_cost = int(idx[j]), cost[idx[j]] + 1e5 * blocks[j]
+    return None, fallback
+
+
+def _search_radial(ctx: _Context, k: int) -> bool:
+    """Place label k of the silhouette layout.
+
+    Candidates (:func:`_radial_candidates`), cheapest valid first: on the label's own
+    ray; then, if that box is pushed out, a *rotated* leader (endpoint moved up to
+    ``Spacing.rotate`` pixels along the boundary, box within ``_ROTATE_TIERS`` tiers)
+    when it costs less leader; if the own ray has no valid place at all, endpoints moved
+    a few pixels (:data:`_PARTING`: a leader blocked at its start, e.g. by one sharing
+    its endpoint).  A moved endpoint's leader must not cut the path of a label still to
+    come; a box that would block the ray of one is taken only when no candidate avoids it.
     """
     size = max(ctx.W, ctx.H)
-    fallback = None
-    choice = None
     far = max(1.2 * size, 3.0 * len(ctx.anchors) * (ctx.height + ctx.sp.gap))
-    rounds = [(r, 0) for r in (24.0, 96.0, 0.4 * size, far)]
-    if ctx.sides[k] == RADIAL:
-        rounds += [(r, 1) for r in (96.0, 0.4 * size, far)]
     rays = ctx.future_rays(k)
-
-    def evaluate(reach: float, shifted: int):
-        boxes, leaders, cost, tiers, shifts = _candidates(ctx, k, reach, shifted)
-        ok = _valid(ctx, k, boxes, np.stack([leaders[:, :-1], leaders[:, 1:]], axis=2))
-        blocks = np.zeros(len(boxes))
-        if len(rays) and ok.any():
-            blocks[ok] = segment_hits_box(rays, boxes[ok]).sum(axis=0)
-        return boxes, leaders, cost, tiers, shifts, ok, blocks
-
-    # the radial rounds without shifted endpoints list their candidates tier by tier, so a
-    # smaller reach is a prefix of a larger one: evaluate up to 0.4 x size once, cut prefixes
-    batch = None
-    for reach, shifted in rounds:
-        if ctx.sides[k] == RADIAL and not shifted:
-            if batch is None or batch[0] < reach:
-                batch = (max(reach, 0.4 * size), evaluate(max(reach, 0.4 * size), 0))
-            n = len(_ATTACH) * _radial_tiers(ctx, reach)
-            boxes, leaders, cost, tiers, shifts, ok, blocks = (x[:n] for x in batch[1])
-        else:
-            boxes, leaders, cost, tiers, shifts, ok, blocks = evaluate(reach, shifted)
-        if not ok.any():
-            continue
-        free = ok & (blocks == 0)
-        cand = np.flatnonzero(free if free.any() else ok)
-        best = cand[np.argmin((cost + 1e5 * blocks)[cand])]  # argmin: first of equal costs
-        if free.any():
-            choice = (leaders[best], boxes[best], tiers[best], shifts[best])
+    paths = np.concatenate([ctx.future_insides(k), rays]) if len(rays) else rays
+    tier_step = 0.5 * ctx.height + ctx.sp.gap
+    best = fallback = None
+    for reach in (0.4 * size, far):  # the far list extends the near one
+        own = _radial_candidates(ctx, k, reach)
+        best, fallback = _cheapest(ctx, k, own, rays, None)
+        if best is not None:
             break
-        if fallback is None:
-            fallback = (leaders[best], boxes[best], tiers[best], shifts[best])
-    if choice is None:
-        choice = fallback
-    if choice is None:
-        return False
-    pts, box, tier, shift = choice
-    ctx.placed[k] = Placement(_simplify(pts), box.copy(), int(ctx.sides[k]), int(tier), float(shift))
-    ctx.stats.shifted += int(shift > 0.5)
+    if best is not None:
+        choice = own
+        # a rotated leader costs at least one box height more than its tier's push-out,
+        # so only a box pushed out further than that can lose to one
+        room = min(own[3][best] - ctx.height, (min(own[4][best], _ROTATE_TIERS) - 1) * tier_step)
+        if room >= 0 and ctx.sp.rotate > 0:
+            rot = _radial_candidates(ctx, k, room, (_ROTATE_STEP, ctx.sp.rotate), below=own[3][best])
+            r, _ = _cheapest(ctx, k, rot, rays, paths)
+            if r is not None:
+                choice, best = rot, r
+    else:
+        moved = _radial_candidates(ctx, k, far, _PARTING)
+        best, fallback2 = _cheapest(ctx, k, moved, rays, paths)
+        choice = moved
+        if best is None:
+            if fallback is not None:
+                choice, best = own, fallback
+            elif fallback2 is not None:
+                best = fallback2
+            else:
+                return False
+    boxes, leaders, leader_of, cost, tiers, shifts = choice
+    _place(ctx, k, leaders[leader_of[best]], boxes[best], tiers[best], shifts[best])
     return True
 
 

@@ -105,8 +105,11 @@ def _edt_in_box(mask: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndar
     return dist, (R, C)
 
 
-def _radial(mask: np.ndarray, X: np.ndarray, Y: np.ndarray, pad: int) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Nearest-boundary candidates: (length, ex, ey, key) on the padded grid.
+def _radial(mask: np.ndarray, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """Nearest-boundary candidates: (length, ex, ey, key) on the grid of ``mask``.
+
+    ``X``, ``Y``: image coordinates of the pixel centres of ``mask``; ``key`` = flat index
+    into ``mask`` of the nearest outside pixel.
 
     The EDT gives every inside pixel its nearest outside pixel ``q``; the endpoint of all
     pixels that share ``q`` is ``q`` moved half a pixel back along their mean direction,
@@ -117,8 +120,8 @@ def _radial(mask: np.ndarray, X: np.ndarray, Y: np.ndarray, pad: int) -> tuple[n
     key = ri * wp + ci
     inside = np.flatnonzero(mask.ravel())
     k = key.ravel()[inside]
-    qx = ci.ravel()[inside] + 0.5 - pad
-    qy = ri.ravel()[inside] + 0.5 - pad
+    qx = ci.ravel()[inside] + X[0, 0]
+    qy = ri.ravel()[inside] + Y[0, 0]
     dx, dy = qx - X.ravel()[inside], qy - Y.ravel()[inside]
     norm = np.maximum(np.hypot(dx, dy), 1e-12)
     # mean direction per nearest outside pixel: sums over the pixel grid, no sort needed
@@ -149,44 +152,65 @@ def leader_candidates(area: InternalArea, layout: str) -> Candidates:
         over the whole of ``A_I``, padding included.
     """
     sides = check_layout(layout)
-    mask = area.mask
-    hp, wp = mask.shape
+    full = area.mask
+    hp, wp = full.shape
     p = area.pad
-    xc = np.arange(wp, dtype=np.float64) + 0.5 - p
-    yc = np.arange(hp, dtype=np.float64) + 0.5 - p
-    X = np.broadcast_to(xc[None, :], (hp, wp))
-    Y = np.broadcast_to(yc[:, None], (hp, wp))
-    R = np.broadcast_to(np.arange(hp)[:, None], (hp, wp))
-    C = np.broadcast_to(np.arange(wp)[None, :], (hp, wp))
-    best = np.full((hp, wp), np.inf)
-    ex = np.full((hp, wp), np.nan)
-    ey = np.full((hp, wp), np.nan)
-    side = np.full((hp, wp), -1, np.int8)
-    key = np.full((hp, wp), -1, np.int64)
+    # work on the bounding box of A_I only (plus a pixel); keys keep the padded grid's indices
+    rows, cols = np.flatnonzero(full.any(axis=1)), np.flatnonzero(full.any(axis=0))
+    if len(rows):
+        r0, r1 = max(rows[0] - 1, 0), min(rows[-1] + 2, hp)
+        c0, c1 = max(cols[0] - 1, 0), min(cols[-1] + 2, wp)
+    else:
+        r0, r1, c0, c1 = 0, hp, 0, wp
+    mask = full[r0:r1, c0:c1]
+    hb, wb = mask.shape
+    xc = np.arange(c0, c1, dtype=np.float64) + 0.5 - p
+    yc = np.arange(r0, r1, dtype=np.float64) + 0.5 - p
+    X = np.broadcast_to(xc[None, :], (hb, wb))
+    Y = np.broadcast_to(yc[:, None], (hb, wb))
+    R = np.broadcast_to(np.arange(r0, r1)[:, None], (hb, wb))
+    C = np.broadcast_to(np.arange(c0, c1)[None, :], (hb, wb))
+    left, right = area.left[r0:r1, None], area.right[r0:r1, None]
+    top, bottom = area.top[None, c0:c1], area.bottom[None, c0:c1]
+    best = np.full((hb, wb), np.inf)
+    ex = np.full((hb, wb), np.nan)
+    ey = np.full((hb, wb), np.nan)
+    side = np.full((hb, wb), -1, np.int8)
+    key = np.full((hb, wb), -1, np.int64)
 
     def offer(code: int, length: np.ndarray, bx: np.ndarray, by: np.ndarray, k: np.ndarray) -> None:
         # strictly shorter wins, so the first direction listed wins ties
         better = mask & (length < best)
         best[better] = length[better]
-        ex[better] = np.broadcast_to(bx, (hp, wp))[better]
-        ey[better] = np.broadcast_to(by, (hp, wp))[better]
-        key[better] = np.broadcast_to(k, (hp, wp))[better]
+        ex[better] = np.broadcast_to(bx, (hb, wb))[better]
+        ey[better] = np.broadcast_to(by, (hb, wb))[better]
+        key[better] = np.broadcast_to(k, (hb, wb))[better]
         side[better] = code
 
     with np.errstate(invalid="ignore"):
         for code in sides:
             if code == WEST:
-                offer(code, X - area.left[:, None], area.left[:, None], Y, R)
+                offer(code, X - left, left, Y, R)
             elif code == EAST:
-                offer(code, area.right[:, None] - X, area.right[:, None], Y, hp + R)
+                offer(code, right - X, right, Y, hp + R)
             elif code == NORTH:
-                offer(code, Y - area.top[None, :], X, area.top[None, :], 2 * hp + C)
+                offer(code, Y - top, X, top, 2 * hp + C)
             elif code == SOUTH:
-                offer(code, area.bottom[None, :] - Y, X, area.bottom[None, :], 2 * hp + wp + C)
+                offer(code, bottom - Y, X, bottom, 2 * hp + wp + C)
             else:
-                length, bx, by, k = _radial(mask, X, Y, p)
-                offer(code, length, bx, by, 2 * hp + 2 * wp + k)
-    best[~mask] = np.nan
+                length, bx, by, k = _radial(mask, X, Y)
+                # the EDT ran on the box: back to the padded grid's pixel indices
+                k = (k // wb + r0) * wp + k % wb + c0
+                offer(code, length, bx, by, 2 * hp + 2 * wp + k.reshape(hb, wb))
+    # back to the padded grid
+    def paste(a: np.ndarray, fill) -> np.ndarray:
+        out = np.full((hp, wp), fill, a.dtype)
+        out[r0:r1, c0:c1] = a
+        return out
+
+    best, ex, ey = paste(best, np.inf), paste(ex, np.nan), paste(ey, np.nan)
+    side, key = paste(side, -1), paste(key, -1)
+    best[~full] = np.nan
     d_max = float(np.nanmax(best)) if mask.any() else 1.0
     sl = (slice(p, hp - p), slice(p, wp - p))
     key_img = key[sl]

@@ -512,3 +512,29 @@ def test_coherent_order_keeps_last_frames_order_only_between_close_neighbours():
     np.testing.assert_array_equal(coherent_order([3.0, 1.0, 3.0], [nan, nan, nan], 10.0), [1, 0, 2])
     # a chain of close labels is sorted back into the previous order
     np.testing.assert_array_equal(coherent_order([0.0, 4.0, 8.0], [3.0, 2.0, 1.0], 10.0), [2, 1, 0])
+
+
+@pytest.mark.parametrize("which", ["buffers", "back_buffers"])
+def test_rotated_leaders_shorten_the_silhouette_layout(request, which):
+    """Rotating a leader to free space instead of pushing its box out: clean, and shorter in total."""
+    soup, ib = request.getfixturevalue(which)["assembly"]
+    texts = label_texts(soup.part_names)
+    plain = solve(ib, texts, layout="silhouette", spacing=boxes.Spacing(rotate=0.0))
+    rotated = solve(ib, texts, layout="silhouette")
+    assert is_clean(plain.metrics) and is_clean(rotated.metrics)
+    assert rotated.metrics["invalid_anchors"] == 0
+    turned = [lab for lab in rotated.labels if lab.shift > 0.5]
+    assert len(turned) > sum(lab.shift > 0.5 for lab in plain.labels)
+    # the leader starts at the anchor and bends at the moved endpoint on the boundary of A_I
+    for lab in turned:
+        assert np.allclose(lab.leader[0], lab.anchor) and len(lab.leader) == 3
+        poly = rotated.area_polygon
+        a, b = poly, np.roll(poly, -1, axis=0)
+        t = np.clip(np.einsum("ij,ij->i", lab.leader[1] - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0, 1)
+        assert np.hypot(*(a + t[:, None] * (b - a) - lab.leader[1]).T).min() < 2.0
+
+    def total(r):
+        return sum(float(np.hypot(*np.diff(lab.leader, axis=0).T).sum()) for lab in r.labels)
+
+    assert len(rotated.labels) >= len(plain.labels)
+    assert total(rotated) / len(rotated.labels) < total(plain) / len(plain.labels)
