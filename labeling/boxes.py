@@ -636,7 +636,7 @@ def _cheapest(ctx: _Context, k: int, cands: tuple, rays: np.ndarray,
     start, chunk = 0, 256
     while start < len(order):
         idx = order[start:start + chunk]
-        start, chunk = start + chunk, len(order)
+        start, chunk = start + chunk, 4 * chunk
         idx = idx[_boxes_free(ctx, boxes[idx], pboxes, psegs)]
         lid = leader_of[idx]
         todo = np.unique(lid[leader_ok[lid] < 0])
@@ -687,8 +687,11 @@ def _search_radial(ctx: _Context, k: int) -> bool:
             if r is not None:
                 choice, best = rot, r
     else:
-        moved = _radial_candidates(ctx, k, far, _PARTING)
-        best, fallback2 = _cheapest(ctx, k, moved, rays, paths)
+        for reach in (0.4 * size, far):
+            moved = _radial_candidates(ctx, k, reach, _PARTING)
+            best, fallback2 = _cheapest(ctx, k, moved, rays, paths)
+            if best is not None:
+                break
         choice = moved
         if best is None:
             if fallback is not None:
