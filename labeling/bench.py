@@ -11,7 +11,10 @@ Three parts, all measured in one process on the same ID buffers:
    mean distance of its anchors from the same method's anchors at the largest size
    (in image fractions, divided by ``d_S``);
 3. **orbit** — frame-to-frame motion along an orbit: fuzzy with the coherence terms
-   f6, f7, fuzzy without them, and the two-step method.
+   f6, f7, fuzzy without them, and the two-step method;
+4. **views** — the quality of both methods over many views (azimuths evenly spaced at
+   two elevations), per layout, so that one lucky or unlucky view does not decide a
+   comparison.
 
 ``meshvis bench labeling`` calls :func:`main`; Python code calls :func:`run`.
 """
@@ -32,7 +35,8 @@ from .candidates import LAYOUTS
 from .frames import layout_frames, orbit
 from .idbuffer import id_buffer
 from .inputs import label_texts, load_models
-from .metrics import sequence_metrics
+from .geometry2d import polyline_length
+from .metrics import is_clean, sequence_metrics
 from .pipeline import LAYOUT_STAGES, fit_camera, solve
 
 #: metrics shown in the tables
@@ -75,6 +79,8 @@ def run(
     up: Sequence[float] = (0.0, 0.0, 1.0),
     azimuth: float = 30.0,
     elevation: float = 20.0,
+    views: int = 12,
+    view_elevations: Sequence[float] = (20.0, 45.0),
     progress: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
     """Run the labeling benchmark.
@@ -92,6 +98,7 @@ def run(
     adjusttext : also run the adjustText baseline (slow: seconds per layout)
     adjusttext_iterations : its fixed iteration count
     up, azimuth, elevation : the camera (fitted to the model)
+    views : azimuths of the many-views comparison (0 skips it), at each of ``view_elevations``
     progress : called with a line of text after each step
 
     Returns
@@ -100,7 +107,8 @@ def run(
         ``model``, ``parts``, ``size``, ``layouts`` (per layout: ``fuzzy``, ``two-step``,
         ``adjusttext`` each with ``timings`` (seconds, ``layout_ms`` in ms) and
         ``metrics``), ``sizes`` (per size: times and metrics of both methods, ``error``),
-        ``orbit`` (sequence metrics of the three variants).
+        ``orbit`` (sequence metrics of the three variants), ``views`` (per layout:
+        :func:`compare_views`).
     """
     say = progress or (lambda s: None)
     if model is None:
@@ -114,7 +122,8 @@ def run(
     setup_s = time.perf_counter() - t0
     cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up)
     out: dict[str, Any] = {"model": name, "parts": soup.n_parts, "faces": soup.n_faces, "size": int(size),
-                           "repeat": int(repeat), "setup_s": setup_s, "layouts": {}, "sizes": {}, "orbit": {}}
+                           "repeat": int(repeat), "setup_s": setup_s, "layouts": {}, "sizes": {}, "orbit": {},
+                           "views": {}, "view_elevations": [float(e) for e in view_elevations]}
 
     def idbuf_at(n: int):
         t = time.perf_counter()
@@ -184,6 +193,48 @@ def run(
                 f"{seq['anchor_motion_mean']:.2f}, flips {seq['side_flips']}, swaps {seq['order_swaps']}")
         out["orbit_layout"] = orbit_layout
         out["orbit_frames"] = int(orbit_frames)
+    if views:
+        cams = [fit_camera(soup, azimuth=az, elevation=el, up=up)
+                for el in view_elevations for az in np.arange(views) * 360.0 / views]
+        bufs = [id_buffer(soup, c, (size, size), caster=caster) for c in cams]
+        for layout in layouts:
+            out["views"][layout] = compare_views(bufs, texts, layout)
+            v = out["views"][layout]
+            say(f"views {layout:11s} leader fuzzy {v['fuzzy']['leader_mean']:.3f} two-step "
+                f"{v['two-step']['leader_mean']:.3f}, fuzzy shorter in {v['fuzzy_shorter']} of {v['views']}")
+    return out
+
+
+def compare_views(buffers: Sequence[Any], texts: Sequence[str], layout: str) -> dict[str, Any]:
+    """Quality of the fuzzy and the two-step method over many views of one model.
+
+    Returns, per method: ``labels`` and ``unplaced`` (summed), ``clean`` (views with no
+    overlap, crossing, box over the model or bad anchor), ``leader_mean`` and
+    ``salience_mean`` (means over the views of each view's mean), ``box_ms`` (median);
+    and ``views``, ``fuzzy_shorter`` (views whose mean leader is shorter with fuzzy) and
+    ``common_leader`` (per method: summed leader length / d_S over the labels both
+    methods place in a view, summed over the views).
+    """
+    per: dict[str, list] = {"fuzzy": [], "two-step": []}
+    common = {"fuzzy": 0.0, "two-step": 0.0}
+    for ib in buffers:
+        res = {m: solve(ib, texts, layout=layout, method=m) for m in per}
+        lengths = {m: {lab.part: polyline_length(lab.leader) / r.sphere_diameter for lab in r.labels}
+                   for m, r in res.items()}
+        both = set(lengths["fuzzy"]) & set(lengths["two-step"])
+        for m, r in res.items():
+            per[m].append(r)
+            common[m] += sum(lengths[m][p] for p in both)
+    out: dict[str, Any] = {"views": len(buffers), "common_leader": common}
+    for m, rs in per.items():
+        out[m] = {"labels": int(sum(r.metrics["labels"] for r in rs)),
+                  "unplaced": int(sum(len(r.unplaced) for r in rs)),
+                  "clean": int(sum(is_clean(r.metrics) for r in rs)),
+                  "leader_mean": float(np.mean([r.metrics["leader_mean_norm"] for r in rs])),
+                  "salience_mean": float(np.mean([r.metrics["salience_mean"] for r in rs])),
+                  "box_ms": float(np.median([1000.0 * r.timings["boxes"] for r in rs]))}
+    out["fuzzy_shorter"] = int(sum(a.metrics["leader_mean_norm"] < b.metrics["leader_mean_norm"]
+                                   for a, b in zip(per["fuzzy"], per["two-step"])))
     return out
 
 
@@ -233,6 +284,20 @@ def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' co
             lines.append(f"{key:20s} {s['label_motion_mean']:6.2f} {s['anchor_motion_mean']:6.2f} {s['side_flips']:5d} "
                          f"{s['order_swaps']:5d} {s['clean_frames']:5d} {s['leader_mean_norm']:6.3f} "
                          f"{s['salience_mean']:8.3f} {s['layout_ms_mean']:6.1f}")
+    if result.get("views"):
+        n = next(iter(result["views"].values()))["views"]
+        lines += ["", f"{n} views (azimuths evenly spaced, elevations {result.get('view_elevations')}), "
+                  "per layout; leader = mean over the views of the mean leader / d_S; common = summed over "
+                  "the labels both methods place",
+                  f"{'layout':11s} {'fz_labels':>9s} {'2s_labels':>9s} {'fz_clean':>8s} {'2s_clean':>8s} "
+                  f"{'fz_leader':>9s} {'2s_leader':>9s} {'shorter':>7s} {'fz_common':>9s} {'2s_common':>9s} "
+                  f"{'fz_sal':>6s} {'fz_box':>6s} {'2s_box':>6s}"]
+        for layout, v in result["views"].items():
+            f, t = v["fuzzy"], v["two-step"]
+            lines.append(f"{layout:11s} {f['labels']:9d} {t['labels']:9d} {f['clean']:8d} {t['clean']:8d} "
+                         f"{f['leader_mean']:9.3f} {t['leader_mean']:9.3f} {v['fuzzy_shorter']:7d} "
+                         f"{v['common_leader']['fuzzy']:9.2f} {v['common_leader']['two-step']:9.2f} "
+                         f"{f['salience_mean']:6.3f} {f['box_ms']:6.1f} {t['box_ms']:6.1f}")
     return "\n".join(lines)
 
 
@@ -244,6 +309,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="image sizes of the quality-against-size curve")
     parser.add_argument("--layouts", nargs="+", choices=tuple(LAYOUTS), default=list(LAYOUTS))
     parser.add_argument("--orbit", type=int, default=12, help="frames of the orbit (0: skip)")
+    parser.add_argument("--views", type=int, default=12,
+                        help="azimuths of the many-views comparison, at elevations 20 and 45 (0: skip; default 12)")
     parser.add_argument("--repeat", type=int, default=5, help="runs per timing, median reported (default 5)")
     parser.add_argument("--no-adjusttext", action="store_true", help="skip the (slow) adjustText baseline")
     parser.add_argument("--up", choices=("x", "y", "z"), default="z", help="the model's up axis (default z)")
@@ -260,7 +327,7 @@ def main(args: argparse.Namespace) -> int:
     if args.model:
         model = args.model if len(args.model) > 1 else args.model[0]
     result = run(model, size=args.size, layouts=args.layouts, sizes=args.sizes, orbit_frames=args.orbit,
-                 repeat=args.repeat, adjusttext=not args.no_adjusttext, up=AXES[args.up],
+                 repeat=args.repeat, adjusttext=not args.no_adjusttext, up=AXES[args.up], views=args.views,
                  progress=lambda s: print(s, flush=True))
     print()
     print(format(result))
