@@ -31,6 +31,7 @@ import numpy as np
 from meshvis.rays import RayCaster
 
 from .baselines import adjust_text
+from .boxes import Spacing
 from .candidates import LAYOUTS
 from .frames import layout_frames, orbit
 from .idbuffer import id_buffer
@@ -82,6 +83,7 @@ def run(
     views: int = 12,
     view_elevations: Sequence[float] = (20.0, 45.0),
     d_e: float | None = None,
+    rotate: float | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
     """Run the labeling benchmark.
@@ -102,6 +104,7 @@ def run(
     views : azimuths of the many-views comparison (0 skips it), at each of ``view_elevations``
     d_e : endpoint distance threshold of the fuzzy method (fraction of ``d_S``; default:
         the paper's, see :func:`labeling.pipeline.solve`)
+    rotate : ``Spacing.rotate`` of both methods (pixels; default the Spacing default)
     progress : called with a line of text after each step
 
     Returns
@@ -114,6 +117,7 @@ def run(
         :func:`compare_views`).
     """
     say = progress or (lambda s: None)
+    spacing = Spacing() if rotate is None else Spacing(rotate=float(rotate))
     if model is None:
         soup, name = default_model()
     else:
@@ -124,7 +128,7 @@ def run(
     caster = RayCaster(soup)
     setup_s = time.perf_counter() - t0
     cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up)
-    out: dict[str, Any] = {"model": name, "d_e": d_e, "parts": soup.n_parts, "faces": soup.n_faces, "size": int(size),
+    out: dict[str, Any] = {"model": name, "d_e": d_e, "rotate": spacing.rotate, "parts": soup.n_parts, "faces": soup.n_faces, "size": int(size),
                            "repeat": int(repeat), "setup_s": setup_s, "layouts": {}, "sizes": {}, "orbit": {},
                            "views": {}, "view_elevations": [float(e) for e in view_elevations]}
 
@@ -139,8 +143,8 @@ def run(
     for layout in layouts:
         entry: dict[str, Any] = {}
         for method in ("fuzzy", "two-step"):
-            solve(ib, texts, layout=layout, method=method, d_e=d_e)  # warm-up (fonts, caches)
-            runs = [solve(ib, texts, layout=layout, method=method, d_e=d_e) for _ in range(max(1, repeat))]
+            solve(ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing)  # warm-up (fonts, caches)
+            runs = [solve(ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing) for _ in range(max(1, repeat))]
             entry[method] = {"timings": _median_timings([r.timings for r in runs]), "metrics": _pick(runs[-1].metrics)}
             ref = runs[-1]
             if method == "two-step" and adjusttext:
@@ -160,8 +164,8 @@ def run(
         ibn, idn = idbuf_at(n)
         rec: dict[str, Any] = {"idbuffer_s": idn}
         for method in ("fuzzy", "two-step"):
-            solve(ibn, texts, layout=size_layout, method=method, d_e=d_e)
-            runs = [solve(ibn, texts, layout=size_layout, method=method, d_e=d_e) for _ in range(max(1, repeat))]
+            solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing)
+            runs = [solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing) for _ in range(max(1, repeat))]
             r = runs[-1]
             lay_ms = float(statistics.median(x.timings["layout_ms"] for x in runs))
             scale = 1.0 / n  # anchors in fractions of the image, comparable across sizes
@@ -184,7 +188,7 @@ def run(
         variants = {"fuzzy": dict(method="fuzzy"), "fuzzy-no-coherence": dict(method="fuzzy", coherence=False),
                     "two-step": dict(method="two-step", coherence=False)}
         for key, kw in variants.items():
-            res = layout_frames(soup, cams, caster=caster, layout=orbit_layout, size=(size, size), d_e=d_e, **kw)
+            res = layout_frames(soup, cams, caster=caster, layout=orbit_layout, size=(size, size), d_e=d_e, spacing=spacing, **kw)
             seq = sequence_metrics(res)
             seq["clean_frames"] = int(sum(r.metrics["overlaps"] == 0 and r.metrics["crossings"] == 0
                                           and r.metrics["label_over_model"] == 0 for r in res))
@@ -201,14 +205,15 @@ def run(
                 for el in view_elevations for az in np.arange(views) * 360.0 / views]
         bufs = [id_buffer(soup, c, (size, size), caster=caster) for c in cams]
         for layout in layouts:
-            out["views"][layout] = compare_views(bufs, texts, layout, d_e)
+            out["views"][layout] = compare_views(bufs, texts, layout, d_e, spacing)
             v = out["views"][layout]
             say(f"views {layout:11s} leader fuzzy {v['fuzzy']['leader_mean']:.3f} two-step "
                 f"{v['two-step']['leader_mean']:.3f}, fuzzy shorter in {v['fuzzy_shorter']} of {v['views']}")
     return out
 
 
-def compare_views(buffers: Sequence[Any], texts: Sequence[str], layout: str, d_e: float | None = None) -> dict[str, Any]:
+def compare_views(buffers: Sequence[Any], texts: Sequence[str], layout: str, d_e: float | None = None,
+                  spacing: Spacing | None = None) -> dict[str, Any]:
     """Quality of the fuzzy and the two-step method over many views of one model.
 
     Returns, per method: ``labels`` and ``unplaced`` (summed), ``clean`` (views with no
@@ -216,19 +221,22 @@ def compare_views(buffers: Sequence[Any], texts: Sequence[str], layout: str, d_e
     ``salience_mean`` (means over the views of each view's mean), ``box_ms`` (median);
     and ``views``, ``fuzzy_shorter`` (views whose mean leader is shorter with fuzzy) and
     ``common_leader`` (per method: summed leader length / d_S over the labels both
-    methods place in a view, summed over the views).  ``d_e``: as in :func:`solve`.
+    methods place in a view, summed over the views) and ``common_first_segment`` (the
+    same for the leaders' first segments: anchor to endpoint in the silhouette layout).
+    ``d_e``, ``spacing``: as in :func:`solve`.
     """
     per: dict[str, list] = {"fuzzy": [], "two-step": []}
     common = {"fuzzy": 0.0, "two-step": 0.0}
+    inside = {"fuzzy": 0.0, "two-step": 0.0}
     for ib in buffers:
-        res = {m: solve(ib, texts, layout=layout, method=m, d_e=d_e) for m in per}
-        lengths = {m: {lab.part: polyline_length(lab.leader) / r.sphere_diameter for lab in r.labels}
-                   for m, r in res.items()}
-        both = set(lengths["fuzzy"]) & set(lengths["two-step"])
+        res = {m: solve(ib, texts, layout=layout, method=m, d_e=d_e, spacing=spacing) for m in per}
+        both = set.intersection(*({lab.part for lab in r.labels} for r in res.values()))
         for m, r in res.items():
             per[m].append(r)
-            common[m] += sum(lengths[m][p] for p in both)
-    out: dict[str, Any] = {"views": len(buffers), "common_leader": common}
+            mine = [lab for lab in r.labels if lab.part in both]
+            common[m] += sum(polyline_length(lab.leader) for lab in mine) / r.sphere_diameter
+            inside[m] += sum(polyline_length(lab.leader[:2]) for lab in mine) / r.sphere_diameter
+    out: dict[str, Any] = {"views": len(buffers), "common_leader": common, "common_first_segment": inside}
     for m, rs in per.items():
         out[m] = {"labels": int(sum(r.metrics["labels"] for r in rs)),
                   "unplaced": int(sum(len(r.unplaced) for r in rs)),
@@ -245,7 +253,7 @@ def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' co
     """Plain-text tables of a :func:`run` result."""
     lines = [f"labeling benchmark: {result['model']} ({result['parts']} parts, {result['visible_parts']} visible), "
              f"{result['size']} x {result['size']}, median of {result['repeat']} runs, d_e "
-             f"{'paper default' if result.get('d_e') is None else result['d_e']}",
+             f"{'paper default' if result.get('d_e') is None else result['d_e']}, rotate {result.get('rotate')} px",
              f"ray caster build {result['setup_s'] * 1000:.1f} ms, ID buffer {result['idbuffer_s'] * 1000:.1f} ms", ""]
     stages = [s for s in LAYOUT_STAGES]
     head = f"{'layout':11s} {'method':10s} " + " ".join(f"{s[:6]:>6s}" for s in stages) + f" {'layout':>7s}"
@@ -320,6 +328,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--up", choices=("x", "y", "z"), default="z", help="the model's up axis (default z)")
     parser.add_argument("--d-e", type=float, default=None,
                         help="d_e of the fuzzy method, fraction of d_S (default: the paper's, from the box size)")
+    parser.add_argument("--rotate", type=float, default=None,
+                        help="largest endpoint move of a rotated leader, pixels (silhouette layout; 0: none)")
     parser.add_argument("--json", metavar="FILE", help="also write the numbers as JSON")
 
 
@@ -333,7 +343,7 @@ def main(args: argparse.Namespace) -> int:
     if args.model:
         model = args.model if len(args.model) > 1 else args.model[0]
     result = run(model, size=args.size, layouts=args.layouts, sizes=args.sizes, orbit_frames=args.orbit,
-                 repeat=args.repeat, adjusttext=not args.no_adjusttext, up=AXES[args.up], views=args.views, d_e=args.d_e,
+                 repeat=args.repeat, adjusttext=not args.no_adjusttext, up=AXES[args.up], views=args.views, d_e=args.d_e, rotate=args.rotate,
                  progress=lambda s: print(s, flush=True))
     print()
     print(format(result))

@@ -491,7 +491,7 @@ def test_bench_runs_small(scene):
     from labeling import bench
 
     r = bench.run(scene, size=128, layouts=("left-right", "silhouette"), sizes=(96, 128), orbit_frames=3,
-                  repeat=1, adjusttext=False, views=3, d_e=0.1)
+                  repeat=1, adjusttext=False, views=3, d_e=0.1, rotate=32)
     assert set(r["layouts"]) == {"left-right", "silhouette"}
     assert r["layouts"]["left-right"]["fuzzy"]["metrics"]["overlaps"] == 0
     assert r["sizes"][128]["fuzzy"]["error"] == 0.0  # the largest size is the reference
@@ -500,8 +500,10 @@ def test_bench_runs_small(scene):
     assert v["views"] == 6 and 0 <= v["fuzzy_shorter"] <= 6
     assert v["fuzzy"]["clean"] == v["two-step"]["clean"] == 6
     assert v["fuzzy"]["labels"] + v["fuzzy"]["unplaced"] == v["two-step"]["labels"] + v["two-step"]["unplaced"]
+    for m in ("fuzzy", "two-step"):
+        assert 0 < v["common_first_segment"][m] <= v["common_leader"][m]
     text = bench.format(r)
-    assert "per-stage time" in text and "orbit of 3 frames" in text and "6 views" in text and "d_e 0.1" in text
+    assert "per-stage time" in text and "orbit of 3 frames" in text and "6 views" in text and "d_e 0.1, rotate 32.0 px" in text
 
 
 def test_coherent_order_keeps_last_frames_order_only_between_close_neighbours():
