@@ -17,7 +17,8 @@ overlaps, no leader crossings and no box over the model:
   side; labels left of the centre extend left and fill tiers outside-in, those right of it
   extend right, which keeps every extended leader clear of the other boxes.
 * **radial** (silhouette layout): labels are taken in order along the boundary of
-  ``A_I``; each box goes on the ray of the boundary's outward normal at its endpoint,
+  ``A_I``, their endpoints first moved apart to at least ``Spacing.endpoint_gap`` (labels
+  of small neighbouring parts often share one); each box goes on the ray of the boundary's outward normal at its endpoint,
   just outside ``A_I``, and is pushed further out in tiers where it collides (the
   "extruded" leaders of Fig. 4b).  A box may hang off its port at any corner or edge
   middle; the cheapest valid place that blocks no later label's ray wins.  Normals of a
@@ -57,6 +58,8 @@ class Spacing:
     rotate : largest move of an endpoint along the boundary of ``A_I`` that turns a
         leader towards free space, instead of pushing its box out (silhouette layout;
         0 = never)
+    endpoint_gap : least distance along the boundary of ``A_I`` between the endpoints of
+        the silhouette layout (closer ones are moved apart; 0 = never)
     """
 
     gap: float = 3.0
@@ -64,6 +67,7 @@ class Spacing:
     port_gap: float = 5.0
     inset: float = 2.0
     rotate: float = 64.0
+    endpoint_gap: float = 3.0
 
 
 @dataclass
@@ -202,7 +206,7 @@ class _Context:
         self.anchors = np.asarray(anchors, np.float64).reshape(-1, 2)
         # per label: its box centre along each side in the previous frame (NaN: elsewhere)
         self.previous = np.full((len(self.anchors), 4), np.nan) if previous is None else np.asarray(previous, np.float64)
-        self.endpoints = np.asarray(endpoints, np.float64).reshape(-1, 2)
+        self.endpoints = np.array(endpoints, np.float64).reshape(-1, 2)  # a copy: parting moves them
         self.sides = np.asarray(sides, np.int64)
         self.widths = np.asarray(widths, np.float64)
         self.height = float(height)
@@ -392,6 +396,32 @@ def _ring_order(ctx: _Context, idx: np.ndarray) -> np.ndarray:
     return np.roll(idx, -((int(np.argmax(gaps)) + 1) % len(idx)))
 
 
+def _part_endpoints(ctx: _Context, order: np.ndarray) -> None:
+    """Move the silhouette layout's endpoints apart along the boundary of ``A_I``.
+
+    Labels of small neighbouring parts often get the same or nearly the same endpoint
+    (their candidates all end on one short stretch of the boundary).  Boxes on rays that
+    coincide cannot be stacked: every place of one blocks the other.  So endpoints
+    closer than ``Spacing.endpoint_gap`` along the boundary are spread apart, in ring
+    order ``order``, by the least squared moves (:func:`pack_1d` on the arc length).
+    """
+    if len(order) < 2 or ctx.sp.endpoint_gap <= 0:
+        return
+    pts, normals = ctx.boundary
+    m = len(pts)
+    ctx.ray_direction(0)
+    q = ctx._nearest[order]
+    arc = ((q - q[0]) % m) * ctx.boundary_step
+    packed = pack_1d(arc, np.zeros(len(arc)), ctx.sp.endpoint_gap, arc[0] - m * ctx.boundary_step, arc[-1] + m * ctx.boundary_step)
+    if np.allclose(packed, arc):
+        return
+    new_q = (q[0] + np.round(packed / ctx.boundary_step).astype(np.int64)) % m
+    moved = new_q != q
+    ctx.endpoints[order[moved]] = pts[new_q[moved]]
+    ctx._nearest[order] = new_q
+    ctx._rays[order] = normals[new_q]
+
+
 def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
     """Place the boxes of the silhouette layout around ``A_I`` (Fig. 4b of appendix I).
 
@@ -404,7 +434,9 @@ def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
     """
     if len(idx) == 0:
         return
-    order = [int(k) for k in _ring_order(ctx, idx)]
+    ring = _ring_order(ctx, idx)
+    _part_endpoints(ctx, ring)
+    order = [int(k) for k in ring]
     for n, k in enumerate(order):
         ctx.future = tuple(order[n + 1:])
         if not _search(ctx, k):

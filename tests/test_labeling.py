@@ -544,3 +544,37 @@ def test_rotated_leaders_shorten_the_silhouette_layout(request, which):
 
     assert len(rotated.labels) >= len(plain.labels)
     assert total(rotated) / len(rotated.labels) < total(plain) / len(plain.labels)
+
+
+def test_silhouette_endpoints_that_coincide_are_parted():
+    """Labels sharing one endpoint get distinct rays, so their boxes stack next to A_I."""
+    mask = np.zeros((120, 160), bool)
+    mask[40:80, 50:110] = True
+    ia = internal_area(mask, "rectangle", margin=2.0)
+    x0, y0, x1, y1 = ia.bbox
+    anchors = np.array([[78.5, 50.5], [80.5, 52.5], [82.5, 50.5], [60.5, 70.5]])
+    endpoints = np.array([[80.0, y0], [80.0, y0], [80.0, y0], [x0, 70.5]])
+    sides = np.full(4, RADIAL)
+    widths = np.full(4, 30.0)
+
+    def place(gap):
+        return boxes.place_boxes(anchors, endpoints, sides, widths, 10.0, ia, (160, 120),
+                                 spacing=boxes.Spacing(endpoint_gap=gap))
+
+    placed, stats = place(3.0)
+    assert not stats.unplaced and all(p is not None for p in placed)
+    bends = np.array([p.leader[1] for p in placed[:3]])
+    along = np.sort(bends[:, 0])
+    assert np.all(np.diff(along) >= 3.0 - 1e-9) and np.allclose(bends[:, 1], y0, atol=1.0)
+    assert np.array_equal(endpoints[:3], np.array([[80.0, y0]] * 3))  # the caller's array is not touched
+    bx = np.array([p.box for p in placed])
+    overlap = geometry2d.boxes_overlap(bx, bx, 0.0)
+    np.fill_diagonal(overlap, False)
+    assert not overlap.any()
+    segs = np.concatenate([np.stack([p.leader[:-1], p.leader[1:]], axis=1) for p in placed])
+    owner = np.concatenate([[i] * (len(p.leader) - 1) for i, p in enumerate(placed)])
+    cross = geometry2d.segments_intersect(segs, segs) & (owner[:, None] != owner[None, :])
+    assert not cross.any()
+    # without parting, the labels on the shared ray block each other: one is left out here
+    placed0, stats0 = place(0.0)
+    assert stats0.unplaced and any(p is None for p in placed0[:3])
