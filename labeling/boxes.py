@@ -652,38 +652,26 @@ def _cheapest(ctx: _Context, k: int, cands: tuple, rays: np.ndarray,
               paths: np.ndarray | None) -> tuple[int | None, int | None]:
     """Cheapest valid radial candidate that blocks no future ray, and the cheapest valid one.
 
-    ``cands`` = (boxes, leaders, lid, cost, ...) of :func:`_radial_candidates`, where
-    the boxes of one leader share it, so a leader is tested once for all its boxes.  Candidates are tested in order of cost, a first chunk and
-    then the rest, so a label that fits near ``A_I`` costs few tests.  ``paths``: leader
-    paths of labels still to come that the leaders must not cut (for moved endpoints).
-    Returns indices into ``cands``
-    (None: no such candidate); the second ranks blocking candidates by cost + 1e5 x rays
-    blocked and is only computed when no free candidate exists.
+    ``cands`` = (boxes, leaders, lid, cost, ...) of :func:`_radial_candidates`, where the
+    boxes of one leader share it, so each leader is tested once for all its boxes (the
+    box tests run first and drop most candidates).  ``rays``: rays of the labels still
+    to come; ``paths``: their leader paths, which the leaders must not cut (for moved
+    endpoints).  Returns indices into ``cands`` (None: no such candidate): the first
+    free one in order of cost (stable: the lower index on ties), else None and the
+    valid one of least cost + 1e5 x rays blocked.
     """
     boxes, leaders, leader_of, cost = cands[:4]
     pboxes, psegs = _placed_arrays(ctx, k)
-    order = np.argsort(cost, kind="stable")
-    leader_ok = np.full(len(leaders), -1, np.int8)  # -1: not tested yet
-    fallback, fallback_cost = None, np.inf
-    start, chunk = 0, 256
-    while start < len(order):
-        idx = order[start:start + chunk]
-        start, chunk = start + chunk, 4 * chunk
-        idx = idx[_boxes_free(ctx, boxes[idx], pboxes, psegs)]
-        lid = leader_of[idx]
-        todo = np.unique(lid[leader_ok[lid] < 0])
-        if len(todo):
-            leader_ok[todo] = _leaders_free(leaders[todo], pboxes, psegs, paths)
-        idx = idx[leader_ok[lid] == 1]
-        if len(idx) == 0:
-            continue
-        blocks = segment_hits_box(rays, boxes[idx]).sum(axis=0) if len(rays) else np.zeros(len(idx))
-        if (blocks == 0).any():
-            return int(idx[np.argmax(blocks == 0)]), None  # the first free one in cost order
-        j = int(np.argmin(cost[idx] + 1e5 * blocks))
-        if cost[idx[j]] + 1e5 * blocks[j] < fallback_cost:
-            fallback, fallback_cost = int(idx[j]), cost[idx[j]] + 1e5 * blocks[j]
-    return None, fallback
+    idx = np.argsort(cost, kind="stable")
+    idx = idx[_boxes_free(ctx, boxes[idx], pboxes, psegs)]
+    used, inverse = np.unique(leader_of[idx], return_inverse=True)
+    idx = idx[_leaders_free(leaders[used], pboxes, psegs, paths)[inverse.ravel()]]
+    if len(idx) == 0:
+        return None, None
+    blocks = segment_hits_box(rays, boxes[idx]).sum(axis=0) if len(rays) else np.zeros(len(idx))
+    if (blocks == 0).any():
+        return int(idx[np.argmax(blocks == 0)]), None
+    return None, int(idx[np.argmin(cost[idx] + 1e5 * blocks)])
 
 
 def _search_radial(ctx: _Context, k: int) -> bool:
