@@ -202,22 +202,24 @@ def leader_candidates(area: InternalArea, layout: str) -> Candidates:
                 # the EDT ran on the box: back to the padded grid's pixel indices
                 k = (k // wb + r0) * wp + k % wb + c0
                 offer(code, length, bx, by, 2 * hp + 2 * wp + k.reshape(hb, wb))
-    # back to the padded grid
-    def paste(a: np.ndarray, fill) -> np.ndarray:
-        out = np.full((hp, wp), fill, a.dtype)
-        out[r0:r1, c0:c1] = a
+    best[~mask] = np.nan
+    d_max = float(np.nanmax(best)) if mask.any() else 1.0
+    # out to the image: the part of the box inside it (the padding is cut off)
+    H, W = hp - 2 * p, wp - 2 * p
+    i0, i1, j0, j1 = max(r0, p), min(r1, hp - p), max(c0, p), min(c1, wp - p)
+    src = (slice(i0 - r0, i1 - r0), slice(j0 - c0, j1 - c0))
+    dst = (slice(i0 - p, i1 - p), slice(j0 - p, j1 - p))
+
+    def image(a: np.ndarray, fill) -> np.ndarray:
+        out = np.full((H, W), fill, a.dtype)
+        out[dst] = a[src]
         return out
 
-    best, ex, ey = paste(best, np.inf), paste(ex, np.nan), paste(ey, np.nan)
-    side, key = paste(side, -1), paste(key, -1)
-    best[~full] = np.nan
-    d_max = float(np.nanmax(best)) if mask.any() else 1.0
-    sl = (slice(p, hp - p), slice(p, wp - p))
-    key_img = key[sl]
+    exi, eyi, length = image(ex, np.nan), image(ey, np.nan), image(best, np.nan)
+    side_img, key_img = image(side, -1), image(key, -1)
     inside = key_img >= 0
     uniq, first, inv = np.unique(key_img[inside], return_index=True, return_inverse=True)
     eid = np.full(key_img.shape, -1, np.int64)
     eid[inside] = inv
-    exi, eyi = ex[sl], ey[sl]
     endpoints = np.column_stack([exi[inside][first], eyi[inside][first]])
-    return Candidates(exi.copy(), eyi.copy(), best[sl].copy(), side[sl].copy(), eid, endpoints, max(d_max, 1e-9))
+    return Candidates(exi, eyi, length, side_img, eid, endpoints, max(d_max, 1e-9))
