@@ -128,7 +128,8 @@ def run(
     caster = RayCaster(soup)
     setup_s = time.perf_counter() - t0
     cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up)
-    out: dict[str, Any] = {"model": name, "d_e": d_e, "rotate": spacing.rotate, "parts": soup.n_parts, "faces": soup.n_faces, "size": int(size),
+    out: dict[str, Any] = {"model": name, "d_e": d_e, "rotate": spacing.rotate, "parts": soup.n_parts,
+                           "faces": soup.n_faces, "size": int(size),
                            "repeat": int(repeat), "setup_s": setup_s, "layouts": {}, "sizes": {}, "orbit": {},
                            "views": {}, "view_elevations": [float(e) for e in view_elevations]}
 
@@ -144,7 +145,8 @@ def run(
         entry: dict[str, Any] = {}
         for method in ("fuzzy", "two-step"):
             solve(ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing)  # warm-up (fonts, caches)
-            runs = [solve(ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing) for _ in range(max(1, repeat))]
+            runs = [solve(ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing)
+                    for _ in range(max(1, repeat))]
             entry[method] = {"timings": _median_timings([r.timings for r in runs]), "metrics": _pick(runs[-1].metrics)}
             ref = runs[-1]
             if method == "two-step" and adjusttext:
@@ -165,7 +167,8 @@ def run(
         rec: dict[str, Any] = {"idbuffer_s": idn}
         for method in ("fuzzy", "two-step"):
             solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing)
-            runs = [solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing) for _ in range(max(1, repeat))]
+            runs = [solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing)
+                    for _ in range(max(1, repeat))]
             r = runs[-1]
             lay_ms = float(statistics.median(x.timings["layout_ms"] for x in runs))
             scale = 1.0 / n  # anchors in fractions of the image, comparable across sizes
@@ -188,7 +191,8 @@ def run(
         variants = {"fuzzy": dict(method="fuzzy"), "fuzzy-no-coherence": dict(method="fuzzy", coherence=False),
                     "two-step": dict(method="two-step", coherence=False)}
         for key, kw in variants.items():
-            res = layout_frames(soup, cams, caster=caster, layout=orbit_layout, size=(size, size), d_e=d_e, spacing=spacing, **kw)
+            res = layout_frames(soup, cams, caster=caster, layout=orbit_layout, size=(size, size), d_e=d_e,
+                                spacing=spacing, **kw)
             seq = sequence_metrics(res)
             seq["clean_frames"] = int(sum(r.metrics["overlaps"] == 0 and r.metrics["crossings"] == 0
                                           and r.metrics["label_over_model"] == 0 for r in res))
@@ -343,7 +347,8 @@ def main(args: argparse.Namespace) -> int:
     if args.model:
         model = args.model if len(args.model) > 1 else args.model[0]
     result = run(model, size=args.size, layouts=args.layouts, sizes=args.sizes, orbit_frames=args.orbit,
-                 repeat=args.repeat, adjusttext=not args.no_adjusttext, up=AXES[args.up], views=args.views, d_e=args.d_e, rotate=args.rotate,
+                 repeat=args.repeat, adjusttext=not args.no_adjusttext, up=AXES[args.up], views=args.views,
+                 d_e=args.d_e, rotate=args.rotate,
                  progress=lambda s: print(s, flush=True))
     print()
     print(format(result))

@@ -18,11 +18,11 @@ overlaps, no leader crossings and no box over the model:
   extend right, which keeps every extended leader clear of the other boxes.
 * **radial** (silhouette layout): labels are taken in order along the boundary of
   ``A_I``, their endpoints first moved apart to at least ``Spacing.endpoint_gap`` (labels
-  of small neighbouring parts often share one); each box goes on the ray of the boundary's outward normal at its endpoint,
-  just outside ``A_I``, and is pushed further out in tiers where it collides (the
-  "extruded" leaders of Fig. 4b).  A box may hang off its port at any corner or edge
-  middle; the cheapest valid place that blocks no later label's ray wins.  Normals of a
-  convex boundary diverge, so the rays never meet.  A box that would be pushed out is
+  of small neighbouring parts often share one); each box goes on the ray of the
+  boundary's outward normal at its endpoint, just outside ``A_I``, and is pushed further
+  out in tiers where it collides (the "extruded" leaders of Fig. 4b).  A box may hang
+  off its port at any corner or edge middle; the cheapest valid place that blocks no
+  later label's ray wins.  Normals of a convex boundary diverge, so the rays never meet.  A box that would be pushed out is
   instead hung, when that makes a shorter leader, off a *rotated* leader: endpoint moved
   up to ``Spacing.rotate`` pixels along the boundary to a stretch with room within two
   tiers.  A label whose own leader is blocked (e.g. it shares its endpoint with a placed
@@ -409,10 +409,11 @@ def _part_endpoints(ctx: _Context, order: np.ndarray) -> None:
         return
     pts, normals = ctx.boundary
     m = len(pts)
-    ctx.ray_direction(0)
+    ctx.ray_direction(0)  # fills ctx._nearest: each endpoint's boundary point
     q = ctx._nearest[order]
-    arc = ((q - q[0]) % m) * ctx.boundary_step
-    packed = pack_1d(arc, np.zeros(len(arc)), ctx.sp.endpoint_gap, arc[0] - m * ctx.boundary_step, arc[-1] + m * ctx.boundary_step)
+    arc = ((q - q[0]) % m) * ctx.boundary_step  # ring order: increasing from the first
+    room = m * ctx.boundary_step
+    packed = pack_1d(arc, np.zeros(len(arc)), ctx.sp.endpoint_gap, arc[0] - room, arc[-1] + room)
     if np.allclose(packed, arc):
         return
     new_q = (q[0] + np.round(packed / ctx.boundary_step).astype(np.int64)) % m
