@@ -563,7 +563,7 @@ def _radial_candidates(ctx: _Context, k: int, reach: float, moves: tuple[float, 
         q = (ctx.boundary_index(k) + js[(js != 0) & (np.abs(js) <= m // 2)]) % m
         E, N = np.concatenate([E, pts[q]]), np.concatenate([N, normals[q]])
     tier_step = 0.5 * h + ctx.sp.gap
-    n_t, n_a = _radial_tiers(ctx, reach), len(_ATTACH)
+    n_t = _radial_tiers(ctx, reach)
     t = np.arange(n_t)
     off = _ATTACH * np.array([w / 2, h / 2])  # (A, 2)
     along = N @ (off / np.hypot(off[:, 0], off[:, 1])[:, None]).T  # (E, A)
