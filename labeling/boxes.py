@@ -285,9 +285,17 @@ class _Context:
         if len(js) == 0:
             return np.zeros((0, 2, 2))
         self.ray_direction(0)
-        far = 2.0 * (self.W + self.H)
+        # longer than any push-out the search may choose (a box beyond a ray's end would
+        # count as leaving it free), plus the widest box
+        far = 2.0 * self.reach + float(self.widths.max()) + self.height
         e = self.endpoints[js]
         return np.stack([e, e + far * self._rays[js]], axis=1)
+
+    @property
+    def reach(self) -> float:
+        """Farthest push-out of a box (pixels) the candidate searches consider."""
+        size = max(self.W, self.H)
+        return max(1.2 * size, 3.0 * len(self.anchors) * (self.height + self.sp.gap))
 
     def future_insides(self, k: int) -> np.ndarray:
         """Inside parts (m, 2, 2), anchor to endpoint, of the radial labels not placed yet (other than k)."""
@@ -423,6 +431,28 @@ def _part_endpoints(ctx: _Context, order: np.ndarray) -> None:
     ctx._rays[order] = normals[new_q]
 
 
+def _uncross_endpoints(ctx: _Context, idx: np.ndarray) -> int:
+    """Swap the endpoints of silhouette labels whose inside parts (anchor -> endpoint) cross.
+
+    Segments to the nearest boundary points of a convex area never cross, but parted
+    endpoints and the boundary's 2 px sampling can make two long, nearly parallel ones
+    do, and then no push-out can place the later label.  The swap of §5.5 of appendix I
+    (:func:`uncross`) fixes it: it keeps the set of endpoints, so their spacing, and
+    shortens the leaders.  Returns the number of swaps.
+    """
+    if len(idx) < 2:
+        return 0
+    ctx.ray_direction(0)  # fills ctx._nearest and ctx._rays
+    assign, swaps = uncross(ctx.anchors[idx], ctx.endpoints[idx])
+    if swaps:
+        src = idx[assign]
+        ctx.endpoints[idx] = ctx.endpoints[src]
+        ctx._nearest[idx] = ctx._nearest[src]
+        ctx._rays[idx] = ctx._rays[src]
+        ctx.stats.swaps += swaps
+    return swaps
+
+
 def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
     """Place the boxes of the silhouette layout around ``A_I`` (Fig. 4b of appendix I).
 
@@ -437,6 +467,8 @@ def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
         return
     ring = _ring_order(ctx, idx)
     _part_endpoints(ctx, ring)
+    if _uncross_endpoints(ctx, idx):
+        ring = _ring_order(ctx, idx)
     order = [int(k) for k in ring]
     for n, k in enumerate(order):
         ctx.future = tuple(order[n + 1:])
@@ -611,8 +643,7 @@ def _search(ctx: _Context, k: int) -> bool:
     if ctx.sides[k] == RADIAL:
         return _search_radial(ctx, k)
     size = max(ctx.W, ctx.H)
-    far = max(1.2 * size, 3.0 * len(ctx.anchors) * (ctx.height + ctx.sp.gap))
-    for reach in (24.0, 96.0, 0.4 * size, far):
+    for reach in (24.0, 96.0, 0.4 * size, ctx.reach):
         boxes, leaders, cost, tiers, shifts = _candidates(ctx, k, reach)
         ok = _valid(ctx, k, boxes, np.stack([leaders[:, :-1], leaders[:, 1:]], axis=2))
         if ok.any():
@@ -687,7 +718,7 @@ def _search_radial(ctx: _Context, k: int) -> bool:
     come; a box that would block the ray of one is taken only when no candidate avoids it.
     """
     size = max(ctx.W, ctx.H)
-    far = max(1.2 * size, 3.0 * len(ctx.anchors) * (ctx.height + ctx.sp.gap))
+    far = ctx.reach
     rays = ctx.future_rays(k)
     paths = np.concatenate([ctx.future_insides(k), rays]) if len(rays) else rays
     tier_step = 0.5 * ctx.height + ctx.sp.gap

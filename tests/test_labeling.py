@@ -578,3 +578,24 @@ def test_silhouette_endpoints_that_coincide_are_parted():
     # without parting, the labels on the shared ray block each other: one is left out here
     placed0, stats0 = place(0.0)
     assert stats0.unplaced and any(p is None for p in placed0[:3])
+
+
+def test_silhouette_inside_parts_that_cross_are_swapped():
+    """Two silhouette leaders whose anchor-to-endpoint parts cross get their endpoints swapped."""
+    mask = np.zeros((120, 160), bool)
+    mask[40:80, 50:110] = True
+    ia = internal_area(mask, "rectangle", margin=2.0)
+    x0, y0, x1, y1 = ia.bbox
+    # long, nearly parallel inside parts that cross (as parted endpoints can make them)
+    anchors = np.array([[70.5, 75.5], [76.5, 60.5]])
+    endpoints = np.array([[80.0, y0], [66.0, y0]])
+    assert geometry2d.segments_intersect(np.stack([anchors, endpoints], axis=1)[:1],
+                                         np.stack([anchors, endpoints], axis=1)[1:]).all()
+    placed, stats = boxes.place_boxes(anchors, endpoints, np.full(2, RADIAL), np.full(2, 30.0), 10.0, ia,
+                                      (160, 120))
+    assert not stats.unplaced and stats.swaps == 1
+    segs = [np.stack([p.leader[:-1], p.leader[1:]], axis=1) for p in placed]
+    assert not geometry2d.segments_intersect(segs[0], segs[1]).any()
+    # the swap keeps the set of endpoints: each leader bends at the other's candidate endpoint
+    assert np.allclose(placed[0].leader[1], [66.0, y0], atol=2.0)
+    assert np.allclose(placed[1].leader[1], [80.0, y0], atol=2.0)
