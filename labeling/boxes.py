@@ -41,7 +41,7 @@ from functools import cached_property
 import numpy as np
 
 from .candidates import EAST, NORTH, RADIAL, SOUTH, WEST
-from .geometry2d import boxes_overlap, segment_hits_box, segments_intersect
+from .geometry2d import boxes_overlap, polyline_length, segment_hits_box, segments_intersect
 from .internal_area import InternalArea, resample_boundary
 
 
@@ -453,15 +453,62 @@ def _uncross_endpoints(ctx: _Context, idx: np.ndarray) -> int:
     return swaps
 
 
+def _run_order(ctx: _Context, ring: np.ndarray) -> list[int]:
+    """Placement order of the silhouette labels: crowded runs from both ends inwards.
+
+    A run is a stretch of labels, consecutive along the boundary, whose boxes next to
+    ``A_I`` would collide with the next one's (box on box, or box on the next ray).  In a
+    run the boxes become a staircase; placed from one end only, every box has to clear
+    all the earlier ones and the stairs grow with the run's length.  Taken alternately
+    from both ends, each box hangs towards the end it comes from and the stairs meet in
+    the middle at half the height (the same idea as the flags of the top/bottom rows).
+    """
+    n = len(ring)
+    if n < 3:
+        return [int(k) for k in ring]
+    e, nrm = ctx.endpoints[ring], ctx._rays[ring]
+    half = np.column_stack([ctx.widths[ring] / 2, np.full(n, ctx.height / 2)])
+    # each box next to A_I, at the attach point that faces its ray most (as the search prefers)
+    off = _ATTACH[None, :, :] * half[:, None, :]  # (n, A, 2)
+    along = np.einsum("nj,naj->na", nrm, off) / np.hypot(off[..., 0], off[..., 1])
+    c = e + ctx.sp.clearance * nrm + off[np.arange(n), np.argmax(along, axis=1)]
+    bx = np.concatenate([c - half, c + half], axis=1)
+    rays = np.stack([e, e + 2.0 * ctx.reach * nrm], axis=1)
+    a, b = np.arange(n - 1), np.arange(1, n)
+    clash = (boxes_overlap(bx[a], bx[b], ctx.sp.gap).diagonal()
+             | segment_hits_box(rays[b], bx[a]).diagonal() | segment_hits_box(rays[a], bx[b]).diagonal())
+    order: list[int] = []
+    for run in np.split(np.asarray(ring), np.flatnonzero(~clash) + 1):
+        lo, hi = 0, len(run) - 1
+        while lo <= hi:  # first, last, second, second to last, ...
+            order.extend(int(k) for k in dict.fromkeys((run[lo], run[hi])))
+            lo, hi = lo + 1, hi - 1
+    return order
+
+
+def _place_in_order(ctx: _Context, order: list[int]) -> list[int]:
+    """Search a place for each silhouette label in ``order``; the labels left out."""
+    unplaced = []
+    for n, k in enumerate(order):
+        ctx.future = tuple(order[n + 1:])
+        if not _search(ctx, k):
+            unplaced.append(k)
+    ctx.future = ()
+    return unplaced
+
+
 def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
     """Place the boxes of the silhouette layout around ``A_I`` (Fig. 4b of appendix I).
 
     Labels are taken in their order along the boundary of ``A_I``, starting after the
-    widest gap between endpoints, and each gets its cheapest valid candidate
-    (:func:`_search`): the box just outside ``A_I`` on its endpoint's normal ray, else
-    pushed out in tiers, preferring places that leave the rays of the labels still to
-    come free.  A box may hang off its port at any corner or edge middle, so that a
-    crowded stretch of the boundary becomes a staircase of boxes instead of a pile.
+    widest gap between endpoints, crowded runs from both ends (:func:`_run_order`), and
+    each gets its cheapest valid candidate (:func:`_search`): the box just outside
+    ``A_I`` on its endpoint's normal ray, else pushed out in tiers, preferring places that
+    leave the rays of the labels still to come free.  A box may hang off its port at any
+    corner or edge middle, so that a crowded stretch of the boundary becomes a staircase
+    of boxes instead of a pile.  If that order leaves a label out, the plain order along
+    the boundary is tried too, and the layout that places more labels (then the one with
+    shorter leaders) is kept.
     """
     if len(idx) == 0:
         return
@@ -469,12 +516,27 @@ def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
     _part_endpoints(ctx, ring)
     if _uncross_endpoints(ctx, idx):
         ring = _ring_order(ctx, idx)
-    order = [int(k) for k in ring]
-    for n, k in enumerate(order):
-        ctx.future = tuple(order[n + 1:])
-        if not _search(ctx, k):
-            ctx.stats.unplaced.append(int(k))
-    ctx.future = ()
+    first = _run_order(ctx, ring)
+    shifted = ctx.stats.shifted
+    unplaced = _place_in_order(ctx, first)
+    plain = [int(k) for k in ring]
+    if unplaced and plain != first:
+        kept = ([ctx.placed[k] for k in plain], ctx.stats.shifted)
+        for k in plain:
+            ctx.placed[k] = None
+        ctx.stats.shifted = shifted
+        again = _place_in_order(ctx, plain)
+
+        def length(placements):
+            return sum(polyline_length(p.leader) for p in placements if p is not None)
+
+        if (len(again), length(ctx.placed[k] for k in plain)) >= (len(unplaced), length(kept[0])):
+            for k, p in zip(plain, kept[0]):  # ties keep the first order
+                ctx.placed[k] = p
+            ctx.stats.shifted = kept[1]
+        else:
+            unplaced = again
+    ctx.stats.unplaced.extend(unplaced)
 
 
 #: endpoint moves along the boundary (step, largest; pixels) that part leaders sharing an endpoint
