@@ -222,7 +222,9 @@ def compare_views(buffers: Sequence[Any], texts: Sequence[str], layout: str, d_e
 
     Returns, per method: ``labels`` and ``unplaced`` (summed), ``clean`` (views with no
     overlap, crossing, box over the model or bad anchor), ``leader_mean`` and
-    ``salience_mean`` (means over the views of each view's mean), ``box_ms`` (median);
+    ``salience_mean`` (means over the views of each view's mean), ``box_ms`` and
+    ``layout_ms`` (medians over the views), ``layout_ms_max`` (the slowest view) and
+    ``labels_max`` (the most labels in one view);
     and ``views``, ``fuzzy_shorter`` (views whose mean leader is shorter with fuzzy) and
     ``common_leader`` (per method: summed leader length / d_S over the labels both
     methods place in a view, summed over the views) and ``common_first_segment`` (the
@@ -247,7 +249,10 @@ def compare_views(buffers: Sequence[Any], texts: Sequence[str], layout: str, d_e
                   "clean": int(sum(is_clean(r.metrics) for r in rs)),
                   "leader_mean": float(np.mean([r.metrics["leader_mean_norm"] for r in rs])),
                   "salience_mean": float(np.mean([r.metrics["salience_mean"] for r in rs])),
-                  "box_ms": float(np.median([1000.0 * r.timings["boxes"] for r in rs]))}
+                  "box_ms": float(np.median([1000.0 * r.timings["boxes"] for r in rs])),
+                  "layout_ms": float(np.median([r.timings["layout_ms"] for r in rs])),
+                  "layout_ms_max": float(max(r.timings["layout_ms"] for r in rs)),
+                  "labels_max": int(max(r.metrics["labels"] for r in rs))}
     out["fuzzy_shorter"] = int(sum(a.metrics["leader_mean_norm"] < b.metrics["leader_mean_norm"]
                                    for a, b in zip(per["fuzzy"], per["two-step"])))
     return out
@@ -304,16 +309,18 @@ def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' co
         n = next(iter(result["views"].values()))["views"]
         lines += ["", f"{n} views (azimuths evenly spaced, elevations {result.get('view_elevations')}), "
                   "per layout; leader = mean over the views of the mean leader / d_S; common = summed over "
-                  "the labels both methods place",
+                  "the labels both methods place; box = median box-stage ms; fz_ms, fz_max = median and "
+                  "slowest layout ms of the fuzzy method; most = most labels in one view",
                   f"{'layout':11s} {'fz_labels':>9s} {'2s_labels':>9s} {'fz_clean':>8s} {'2s_clean':>8s} "
                   f"{'fz_leader':>9s} {'2s_leader':>9s} {'shorter':>7s} {'fz_common':>9s} {'2s_common':>9s} "
-                  f"{'fz_sal':>6s} {'fz_box':>6s} {'2s_box':>6s}"]
+                  f"{'fz_sal':>6s} {'fz_box':>6s} {'2s_box':>6s} {'fz_ms':>6s} {'fz_max':>6s} {'most':>4s}"]
         for layout, v in result["views"].items():
             f, t = v["fuzzy"], v["two-step"]
             lines.append(f"{layout:11s} {f['labels']:9d} {t['labels']:9d} {f['clean']:8d} {t['clean']:8d} "
                          f"{f['leader_mean']:9.3f} {t['leader_mean']:9.3f} {v['fuzzy_shorter']:7d} "
                          f"{v['common_leader']['fuzzy']:9.2f} {v['common_leader']['two-step']:9.2f} "
-                         f"{f['salience_mean']:6.3f} {f['box_ms']:6.1f} {t['box_ms']:6.1f}")
+                         f"{f['salience_mean']:6.3f} {f['box_ms']:6.1f} {t['box_ms']:6.1f} "
+                         f"{f['layout_ms']:6.1f} {f['layout_ms_max']:6.1f} {f['labels_max']:4d}")
     return "\n".join(lines)
 
 
