@@ -202,12 +202,15 @@ def coherent_order(desired: np.ndarray, previous: np.ndarray, pitch: float) -> n
 class _Context:
     """Everything the placement of one frame shares."""
 
-    def __init__(self, anchors, endpoints, sides, widths, height, area, image_size, spacing, rank, previous=None):
+    def __init__(self, anchors, endpoints, sides, widths, height, area, image_size, spacing, rank, previous=None,
+                 directions=None):
         self.anchors = np.asarray(anchors, np.float64).reshape(-1, 2)
         # per label: its box centre along each side in the previous frame (NaN: elsewhere)
         self.previous = np.full((len(self.anchors), 4), np.nan) if previous is None else np.asarray(previous, np.float64)
         self.endpoints = np.array(endpoints, np.float64).reshape(-1, 2)  # a copy: parting moves them
-        self.sides = np.asarray(sides, np.int64)
+        self.sides = np.array(sides, np.int64)  # a copy: a label may change side
+        # the layout's principal directions (a label may move to another one of them)
+        self.directions = tuple(sorted(set(self.sides.tolist()))) if directions is None else tuple(directions)
         self.widths = np.asarray(widths, np.float64)
         self.height = float(height)
         self.area = area
@@ -701,9 +704,39 @@ def _place(ctx: _Context, k: int, leader: np.ndarray, box: np.ndarray, tier: int
 
 
 def _search(ctx: _Context, k: int) -> bool:
-    """Place label k at its cheapest valid candidate; widen the search until one is found."""
+    """Place label k at its cheapest valid candidate; widen the search until one is found.
+
+    A column or row label with no valid place on its side tries the layout's other
+    side (left-right, top-bottom), leaving from its anchor straight to that side.
+    """
     if ctx.sides[k] == RADIAL:
         return _search_radial(ctx, k)
+    side, endpoint = int(ctx.sides[k]), ctx.endpoints[k].copy()
+    for alt in [side] + [d for d in ctx.directions if d != side]:
+        if alt != side:
+            ctx.sides[k], ctx.endpoints[k] = alt, _endpoint_towards(ctx, k, alt)
+        if _search_side(ctx, k):
+            return True
+    ctx.sides[k], ctx.endpoints[k] = side, endpoint
+    return False
+
+
+def _endpoint_towards(ctx: _Context, k: int, side: int) -> np.ndarray:
+    """Where label k's leader meets the boundary of ``A_I`` leaving straight towards ``side``."""
+    ax, ay = ctx.anchors[k]
+    area, p = ctx.area, ctx.area.pad
+    row, col = int(np.floor(ay)) + p, int(np.floor(ax)) + p
+    if side == WEST:
+        return np.array([area.left[row], ay])
+    if side == EAST:
+        return np.array([area.right[row], ay])
+    if side == NORTH:
+        return np.array([ax, area.top[col]])
+    return np.array([ax, area.bottom[col]])
+
+
+def _search_side(ctx: _Context, k: int) -> bool:
+    """Place column/row label k on its current side, at the cheapest valid candidate."""
     size = max(ctx.W, ctx.H)
     for reach in (24.0, 96.0, 0.4 * size, ctx.reach):
         boxes, leaders, cost, tiers, shifts = _candidates(ctx, k, reach)
@@ -861,6 +894,7 @@ def place_boxes(
     rank: np.ndarray | None = None,
     spacing: Spacing | None = None,
     previous: np.ndarray | None = None,
+    directions: tuple[int, ...] | None = None,
 ) -> tuple[list[Placement | None], BoxStats]:
     """Lay out the boxes and leaders of all labels of one frame.
 
@@ -876,6 +910,8 @@ def place_boxes(
     previous : (n, 4) float, optional: each label's box centre along the west, east,
         north and south side in the previous frame (y for west/east, x for north/south;
         NaN where it was not on that side), for :func:`coherent_order`
+    directions : side codes of the layout (default: those in ``sides``); a label with no
+        room on its side may move to another one of them
 
     Returns
     -------
@@ -884,7 +920,8 @@ def place_boxes(
     """
     n = len(anchors)
     rank = np.arange(n) if rank is None else np.asarray(rank)
-    ctx = _Context(anchors, endpoints, sides, widths, height, area, image_size, spacing or Spacing(), rank, previous)
+    ctx = _Context(anchors, endpoints, sides, widths, height, area, image_size, spacing or Spacing(), rank, previous,
+                   directions)
     for side in (WEST, EAST):
         _place_column(ctx, np.flatnonzero(ctx.sides == side), side)
     for side in (NORTH, SOUTH):

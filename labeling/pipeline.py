@@ -224,7 +224,7 @@ def solve(
     sides = side[pick_of].astype(np.int64)
     prev_box = None if previous is None else _previous_frame(previous, slot, len(labelled))[2]
     placements, stats = place_boxes(anchors, endpoints, sides, widths, style.box_height, ia, (w, h), rank, spacing,
-                                    prev_box)
+                                    prev_box, LAYOUTS[layout])
     t = tick("boxes", t)
 
     feas_of = np.full(len(labelled), np.nan)

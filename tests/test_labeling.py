@@ -648,3 +648,32 @@ def test_silhouette_crowded_small_views_place_every_label_near(azimuth, elevatio
         assert r.metrics["labelling_rate"] == 1.0, (method, r.unplaced)
         if method == "fuzzy":
             assert r.metrics["leader_max_norm"] < 3.0
+
+
+def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
+    """top-bottom at azimuth 270: the alternator's leader to the top crosses others; it goes down."""
+    import labeling.pipeline
+
+    soup = load_models(os.path.join(ROOT, "models", "assembly.obj"))
+    ib = id_buffer(soup, fit_camera(soup, azimuth=270.0, elevation=20.0, up=(0, 0, 1)), (512, 512))
+    texts = label_texts(soup.part_names)
+    r = solve(ib, texts, layout="top-bottom")
+    assert is_clean(r.metrics) and r.metrics["leaders_through_labels"] == 0
+    assert r.metrics["labelling_rate"] == 1.0, r.unplaced
+    moved = [lab for lab in r.labels if (lab.side == "south") != (lab.endpoint[1] > lab.anchor[1])]
+    assert [lab.name for lab in moved] == ["alternator"]
+    assert moved[0].leader[-1][1] > moved[0].anchor[1]  # its leader leaves downwards
+    # kept on its own side, it has no room
+    monkeypatch.setattr(labeling.pipeline, "place_boxes", lambda *a: boxes.place_boxes(*a[:10], ()))
+    assert [name for _, name in solve(ib, texts, layout="top-bottom").unplaced] == ["alternator"]
+
+
+def test_endpoint_towards_each_side_of_a_rectangle():
+    mask = np.zeros((100, 120), bool)
+    mask[30:70, 20:100] = True
+    ia = internal_area(mask, "rectangle", margin=2.0)
+    x0, y0, x1, y1 = ia.bbox
+    ctx = boxes._Context([[50.5, 40.5]], [[50.5, y0]], [NORTH], [20.0], 8.0, ia, (120, 100), boxes.Spacing(),
+                         [0])
+    for side, want in ((WEST, (x0, 40.5)), (EAST, (x1, 40.5)), (NORTH, (50.5, y0)), (SOUTH, (50.5, y1))):
+        assert np.allclose(boxes._endpoint_towards(ctx, 0, side), want, atol=1.0)
