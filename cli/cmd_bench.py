@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|labeling``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|labeling|labeling-sweep``: reproducible measurements."""
 from __future__ import annotations
 
 import argparse
@@ -24,10 +24,10 @@ def add_parser(sub) -> None:
     c.add_argument("--json", metavar="FILE")
     c.set_defaults(func=run_classify)
 
-    for name in ("accuracy", "stability", "labeling", "compare"):
+    outside = {"labeling": "labeling.bench", "labeling-sweep": "labeling.sweep"}
+    for name in ("accuracy", "stability", "labeling", "labeling-sweep", "compare"):
         try:
-            mod = __import__(f"meshvis.bench.{name}", fromlist=["add_arguments"]) if name != "labeling" \
-                else __import__("labeling.bench", fromlist=["add_arguments"])
+            mod = __import__(outside.get(name, f"meshvis.bench.{name}"), fromlist=["add_arguments"])
         except ModuleNotFoundError:
             continue
         if hasattr(mod, "add_arguments"):

@@ -505,6 +505,20 @@ def test_bench_runs_small(scene):
     assert "per-stage time" in text and "orbit of 3 frames" in text and "6 views" in text and "d_e 0.1, rotate 32.0 px" in text
 
 
+def test_sweep_runs_small(scene):
+    from labeling import sweep
+
+    r = sweep.run([("scene", scene, (0, 0, 1))], azimuths=2, elevations=(30.0,), sizes=(128,),
+                  layouts=("left", "silhouette"))
+    assert len(r["cases"]) == 2 * 2 * 2  # views x layouts x methods
+    assert all(c["clean"] and c["unplaced"] == 0 and c["labels"] > 0 for c in r["cases"].values())
+    rows = {(row["layout"], row["method"]): row for row in r["summary"]}
+    assert set(rows) == {(lay, m) for lay in ("left", "silhouette") for m in ("fuzzy", "two-step")}
+    row = rows[("silhouette", "fuzzy")]
+    assert row["layouts"] == row["clean"] == 2 and row["leader_max_p90"] <= row["leader_max"]
+    assert "labeling sweep: 8 layouts" in sweep.format(r)
+
+
 def test_coherent_order_keeps_last_frames_order_only_between_close_neighbours():
     from labeling.boxes import coherent_order
 
