@@ -519,26 +519,23 @@ def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
     _part_endpoints(ctx, ring)
     if _uncross_endpoints(ctx, idx):
         ring = _ring_order(ctx, idx)
-    first = _run_order(ctx, ring)
-    shifted = ctx.stats.shifted
-    unplaced = _place_in_order(ctx, first)
     plain = [int(k) for k in ring]
-    if unplaced and plain != first:
-        kept = ([ctx.placed[k] for k in plain], ctx.stats.shifted)
+    orders = [_run_order(ctx, ring), plain]
+    shifted = ctx.stats.shifted
+    best = None
+    for order in orders[:1] if orders[0] == plain else orders:
+        ctx.stats.shifted = shifted
         for k in plain:
             ctx.placed[k] = None
-        ctx.stats.shifted = shifted
-        again = _place_in_order(ctx, plain)
-
-        def length(placements):
-            return sum(polyline_length(p.leader) for p in placements if p is not None)
-
-        if (len(again), length(ctx.placed[k] for k in plain)) >= (len(unplaced), length(kept[0])):
-            for k, p in zip(plain, kept[0]):  # ties keep the first order
-                ctx.placed[k] = p
-            ctx.stats.shifted = kept[1]
-        else:
-            unplaced = again
+        unplaced = _place_in_order(ctx, order)
+        score = (len(unplaced), sum(polyline_length(ctx.placed[k].leader) for k in plain if ctx.placed[k]))
+        if best is None or score < best[0]:  # ties keep the first order
+            best = (score, [ctx.placed[k] for k in plain], ctx.stats.shifted, unplaced)
+        if not unplaced:
+            break
+    _, placements, ctx.stats.shifted, unplaced = best
+    for k, p in zip(plain, placements):
+        ctx.placed[k] = p
     ctx.stats.unplaced.extend(unplaced)
 
 
