@@ -348,8 +348,6 @@ def main(args: argparse.Namespace) -> int:
     """Entry point of ``meshvis bench labeling``."""
     from meshvis.camera import AXES
 
-    from .output import write_json
-
     model = None
     if args.model:
         model = args.model if len(args.model) > 1 else args.model[0]
@@ -357,8 +355,15 @@ def main(args: argparse.Namespace) -> int:
                  repeat=args.repeat, adjusttext=not args.no_adjusttext, up=AXES[args.up], views=args.views,
                  d_e=args.d_e, rotate=args.rotate,
                  progress=lambda s: print(s, flush=True))
+    return report(result, format(result), args.json)
+
+
+def report(result: dict[str, Any], text: str, json_path: str | None) -> int:
+    """Print a benchmark's tables after its progress lines and write its JSON; exit status 0."""
+    from .output import write_json
+
     print()
-    print(format(result))
-    if args.json:
-        write_json(result, args.json)
+    print(text)
+    if json_path:
+        write_json(result, json_path)
     return 0

@@ -260,7 +260,7 @@ def solve(
     return result
 
 
-def _load_once() -> None:
+def warm_up() -> None:
     """Import the modules and load the font the layout stages use lazily (about 0.2 s
     once per process), so that they count as set-up, not as the first frame's layout."""
     import scipy.spatial  # noqa: F401 - the convex hull of the internal area
@@ -328,7 +328,7 @@ def layout(
     (['ball', 'box'], 0)
     """
     t0 = time.perf_counter()
-    _load_once()
+    warm_up()
     soup = load_models(model)
     caster = caster or RayCaster(soup)
     if camera is None:
