@@ -288,17 +288,21 @@ class _Context:
         if len(js) == 0:
             return np.zeros((0, 2, 2))
         self.ray_direction(0)
-        # longer than any push-out the search may choose (a box beyond a ray's end would
-        # count as leaving it free), plus the widest box
-        far = 2.0 * self.reach + float(self.widths.max()) + self.height
         e = self.endpoints[js]
-        return np.stack([e, e + far * self._rays[js]], axis=1)
+        return np.stack([e, e + self.ray_length * self._rays[js]], axis=1)
 
     @property
     def reach(self) -> float:
         """Farthest push-out of a box (pixels) the candidate searches consider."""
         size = max(self.W, self.H)
         return max(1.2 * size, 3.0 * len(self.anchors) * (self.height + self.sp.gap))
+
+    @property
+    def ray_length(self) -> float:
+        """Length of a label's push-out ray in the tests against boxes: longer than any
+        push-out the search may choose plus the widest box (a box beyond a ray's end
+        would count as leaving it free)."""
+        return 2.0 * self.reach + float(self.widths.max()) + self.height
 
     def future_insides(self, k: int) -> np.ndarray:
         """Inside parts (m, 2, 2), anchor to endpoint, of the radial labels not placed yet (other than k)."""
@@ -473,10 +477,10 @@ def _run_order(ctx: _Context, ring: np.ndarray) -> list[int]:
     half = np.column_stack([ctx.widths[ring] / 2, np.full(n, ctx.height / 2)])
     # each box next to A_I, at the attach point that faces its ray most (as the search prefers)
     off = _ATTACH[None, :, :] * half[:, None, :]  # (n, A, 2)
-    along = np.einsum("nj,naj->na", nrm, off) / np.hypot(off[..., 0], off[..., 1])
+    along = _facing(nrm[:, None, :], off)  # (n, A)
     c = e + ctx.sp.clearance * nrm + off[np.arange(n), np.argmax(along, axis=1)]
     bx = np.concatenate([c - half, c + half], axis=1)
-    rays = np.stack([e, e + 2.0 * ctx.reach * nrm], axis=1)
+    rays = np.stack([e, e + ctx.ray_length * nrm], axis=1)
     a, b = np.arange(n - 1), np.arange(1, n)
     clash = (boxes_overlap(bx[a], bx[b], ctx.sp.gap).diagonal()
              | segment_hits_box(rays[b], bx[a]).diagonal() | segment_hits_box(rays[a], bx[b]).diagonal())
@@ -524,9 +528,10 @@ def _place_ring(ctx: _Context, idx: np.ndarray) -> None:
     shifted = ctx.stats.shifted
     best = None
     for order in orders[:1] if orders[0] == plain else orders:
-        ctx.stats.shifted = shifted
-        for k in plain:
-            ctx.placed[k] = None
+        if best is not None:  # start the second order from the same state as the first
+            ctx.stats.shifted = shifted
+            for k in plain:
+                ctx.placed[k] = None
         unplaced = _place_in_order(ctx, order)
         score = (len(unplaced), sum(polyline_length(ctx.placed[k].leader) for k in plain if ctx.placed[k]))
         if best is None or score < best[0]:  # ties keep the first order
@@ -547,6 +552,12 @@ _ROTATE_TIERS = 3
 
 #: attach points of a box: offsets of the box centre from the port, in half widths/heights
 _ATTACH = np.array([[1, 0], [-1, 0], [0, 1], [0, -1], [1, 1], [1, -1], [-1, 1], [-1, -1]], np.float64)
+
+
+def _facing(normals: np.ndarray, offsets: np.ndarray) -> np.ndarray:
+    """Cosine between a ray ``normals[..., :]`` and the direction of each box-centre offset
+    ``offsets[..., :]`` from the port (broadcast): 1 = the box sits straight on the ray."""
+    return np.einsum("...j,...j->...", normals, offsets) / np.hypot(offsets[..., 0], offsets[..., 1])
 
 
 # ---------------------------------------------------------------------------- candidate search
@@ -660,7 +671,7 @@ def _radial_candidates(ctx: _Context, k: int, reach: float, moves: tuple[float, 
     n_t = _radial_tiers(ctx, reach)
     t = np.arange(n_t)
     off = _ATTACH * np.array([w / 2, h / 2])  # (A, 2)
-    along = N @ (off / np.hypot(off[:, 0], off[:, 1])[:, None]).T  # (E, A)
+    along = _facing(N[:, None, :], off[None])  # (E, A)
     moved = np.hypot(*(E - ctx.endpoints[k]).T)
     longer = np.hypot(*(E - a).T) - np.hypot(*(ctx.endpoints[k] - a))
     cost = (t * tier_step)[None, :, None] + ((moved > 0) * (h + longer))[:, None, None] \
