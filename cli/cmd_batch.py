@@ -12,7 +12,7 @@ import os
 import sys
 import time
 
-from cli.common import positive_int
+from .common import positive_int
 
 EPILOG = """\
 outputs: DIR/<input path without extension>.<op>.<ext> and DIR/<...>.<op>.report.json,
@@ -35,8 +35,8 @@ def _positive_float(text: str) -> float:
 
 
 def _algorithm_dests() -> list[str]:
-    """``dest`` names of the options added by :func:`cli.cmd_repair.algorithm_options`."""
-    from cli.cmd_repair import algorithm_options
+    """``dest`` names of the options added by :func:`meshvis.cli.cmd_repair.algorithm_options`."""
+    from .cmd_repair import algorithm_options
 
     p = argparse.ArgumentParser(add_help=False)
     algorithm_options(p)
@@ -44,8 +44,8 @@ def _algorithm_dests() -> list[str]:
 
 
 def add_parser(sub) -> None:
-    from cli.cmd_repair import algorithm_options
-    from meshvis.batch import OPERATIONS
+    from .cmd_repair import algorithm_options
+    from meshvis.batch.runner import OPERATIONS
 
     p = sub.add_parser(
         "batch", help="run orient / remove-interior / layers over many files (local processes or Dask)",
@@ -156,7 +156,7 @@ def _summary_table(result, out_dir: str, limit: int = 60):
 
 
 def run(args: argparse.Namespace) -> int:
-    from meshvis.batch import default_jobs, plan, run_batch, write_summary
+    from meshvis.batch.runner import default_jobs, plan, run_batch, write_summary
     from meshvis.io import ensure_folder
     from meshvis.errors import ParameterError
 

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from cli.common import positive_int, write_json
+from .common import positive_int, write_json
 
 
 def add_parser(sub) -> None:
@@ -24,10 +24,10 @@ def add_parser(sub) -> None:
     c.add_argument("--json", metavar="FILE")
     c.set_defaults(func=run_classify)
 
-    outside = {"labeling": "labeling.bench", "labeling-sweep": "labeling.sweep"}
+    outside = {"labeling": "meshvis.labeling.bench", "labeling-sweep": "meshvis.labeling.sweep"}
     for name in ("accuracy", "stability", "labeling", "labeling-sweep", "compare"):
         try:
-            mod = __import__(outside.get(name, f"meshvis.bench.{name}"), fromlist=["add_arguments"])
+            mod = __import__(outside.get(name, f"meshvis.eval.bench.{name}"), fromlist=["add_arguments"])
         except ModuleNotFoundError:
             continue
         if hasattr(mod, "add_arguments"):
@@ -38,7 +38,7 @@ def add_parser(sub) -> None:
 
 
 def run_rays(args: argparse.Namespace) -> int:
-    from meshvis.bench import rays
+    from meshvis.eval.bench import rays
     from meshvis.io import load
 
     r = rays.run(load(args.model), n_rays=args.rays, repeat=args.repeat)
@@ -49,7 +49,7 @@ def run_rays(args: argparse.Namespace) -> int:
 
 
 def run_classify(args: argparse.Namespace) -> int:
-    from meshvis.bench import classify as bc
+    from meshvis.eval.bench import classify as bc
 
     results = bc.run(args.models or None, rays_per_node=args.rays_per_node, seed=args.seed)
     print(bc.format(results))

@@ -4,7 +4,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from cli.common import say
+from .common import say
 from meshvis.errors import OutputError
 
 
@@ -19,7 +19,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from meshvis.demo import DEMO_FILES, run_demo
+    from meshvis.repair.demo import DEMO_FILES, run_demo
 
     if os.path.exists(args.out) and not os.path.isdir(args.out):
         raise OutputError("exists and is not a folder", args.out)

@@ -23,7 +23,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from meshvis.diagnostics import diagnose, format_report
+    from meshvis.geometry.diagnostics import diagnose, format_report
     from meshvis.io import load
 
     if not (1e-9 <= args.eps < 1):

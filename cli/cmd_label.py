@@ -4,14 +4,14 @@ from __future__ import annotations
 import argparse
 import os
 
-from cli.common import check_output, positive_int, say
+from .common import check_output, positive_int, say
 
 UP_AXES = ("auto", "x", "y", "z")
 
 
 def add_parser(sub) -> None:
-    from labeling.candidates import LAYOUTS
-    from labeling.internal_area import SHAPES
+    from meshvis.labeling.candidates import LAYOUTS
+    from meshvis.labeling.internal_area import SHAPES
 
     p = sub.add_parser(
         "label",
@@ -63,13 +63,13 @@ def add_parser(sub) -> None:
 
 
 def _up(args: argparse.Namespace) -> tuple[float, float, float]:
-    from meshvis.camera import up_axis
+    from meshvis.rays.camera import up_axis
 
     return up_axis(args.up, args.inputs)
 
 
 def _weights(text: str | None):
-    from labeling.membership import Weights
+    from meshvis.labeling.membership import Weights
     from meshvis.errors import ParameterError
 
     if not text:
@@ -93,11 +93,11 @@ def _frame_paths(output: str, n: int) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     import json
 
-    from labeling import frames as fr
-    from labeling import output as out
-    from labeling.inputs import load_models, read_texts
-    from labeling.metrics import sequence_metrics
-    from meshvis.camera import Camera
+    from meshvis.labeling import frames as fr
+    from meshvis.labeling import output as out
+    from meshvis.labeling.inputs import load_models, read_texts
+    from meshvis.labeling.metrics import sequence_metrics
+    from meshvis.rays.camera import Camera
     from meshvis.errors import OutputError, ParameterError
 
     ext = os.path.splitext(args.output)[1].lower()

@@ -3,7 +3,7 @@ from __future__ import annotations
 
 import argparse
 
-from cli.common import check_output, positive_int, say
+from .common import check_output, positive_int, say
 
 
 def add_parser(sub) -> None:
@@ -24,16 +24,16 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from meshvis.camera import Camera, up_axis
+    from meshvis.rays.camera import Camera, up_axis
     from meshvis.io import load
-    from meshvis.render import render, save_png
+    from meshvis.rays.render import render, save_png
 
     check_output(args.output, [args.input], args.force)
     soup = load(args.input)
     values = None
     color_by = None if args.color_by == "none" else args.color_by
     if color_by == "layer":
-        from meshvis.layering import layers
+        from meshvis.repair.layers import layers
 
         values = layers(soup, seed=args.seed).layer
     camera = Camera.fit(soup, azimuth=args.azimuth, elevation=args.elevation, up=up_axis(args.up, [args.input]))

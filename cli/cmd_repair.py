@@ -6,9 +6,9 @@ import os
 import time
 
 
-from cli.common import check_output, point, positive_int, say, write_json
+from .common import check_output, point, positive_int, say, write_json
 from meshvis.errors import ParameterError
-from meshvis.operations import CLASSIFY_DEFAULTS, OPERATION_DEFAULTS
+from meshvis.repair.operation import CLASSIFY_DEFAULTS, OPERATION_DEFAULTS
 
 
 def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
@@ -85,7 +85,7 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from meshvis.io import load
-    from cli.progress import stage_progress
+    from .progress import stage_progress
 
     outputs = [x for x in (getattr(args, "output", None), args.report, args.preview,
                            getattr(args, "removed", None), getattr(args, "graphml", None)) if x]
@@ -107,6 +107,6 @@ def run(args: argparse.Namespace) -> int:
 
 def run_op(op: str, soup, args: argparse.Namespace, progress=None) -> dict:
     """Run one operation on a loaded soup through the library and write its outputs."""
-    from meshvis.operations import run_operation
+    from meshvis.repair.operation import run_operation
 
     return run_operation(op, soup, args, progress, say=lambda text: say(args, text))

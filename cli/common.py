@@ -7,7 +7,7 @@ from typing import Any
 
 from meshvis.errors import ParameterError
 from meshvis.io import check_output  # noqa: F401  (re-exported for the commands)
-from meshvis.jsonfile import write_json  # noqa: F401  (re-exported for the commands)
+from meshvis.io.jsonfile import write_json  # noqa: F401  (re-exported for the commands)
 
 
 def point(text: str) -> tuple[float, float, float]:

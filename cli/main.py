@@ -14,16 +14,16 @@ import warnings
 
 # subcommand name -> module in this package
 COMMANDS = {
-    "demo": "cli.cmd_demo",
-    "info": "cli.cmd_info",
-    "render": "cli.cmd_render",
-    "classify": "cli.cmd_repair",
-    "orient": "cli.cmd_repair",
-    "remove-interior": "cli.cmd_repair",
-    "layers": "cli.cmd_repair",
-    "label": "cli.cmd_label",
-    "batch": "cli.cmd_batch",
-    "bench": "cli.cmd_bench",
+    "demo": "meshvis.cli.cmd_demo",
+    "info": "meshvis.cli.cmd_info",
+    "render": "meshvis.cli.cmd_render",
+    "classify": "meshvis.cli.cmd_repair",
+    "orient": "meshvis.cli.cmd_repair",
+    "remove-interior": "meshvis.cli.cmd_repair",
+    "layers": "meshvis.cli.cmd_repair",
+    "label": "meshvis.cli.cmd_label",
+    "batch": "meshvis.cli.cmd_batch",
+    "bench": "meshvis.cli.cmd_bench",
 }
 
 

@@ -6,9 +6,9 @@ convex internal area, fuzzy membership functions aggregated per candidate, a gre
 placement order, label-box stacking with shift-and-swap corrections, frame-to-frame
 coherence, and the measures and baselines to judge the result.
 
->>> import labeling
->>> result = labeling.layout("model.glb", layout="left-right")      # doctest: +SKIP
->>> labeling.write(result, "labels.svg")                             # doctest: +SKIP
+>>> import meshvis.labeling
+>>> result = meshvis.labeling.layout("model.glb", layout="left-right")      # doctest: +SKIP
+>>> meshvis.labeling.write(result, "labels.svg")                             # doctest: +SKIP
 """
 from __future__ import annotations
 

@@ -28,7 +28,7 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from meshvis.rays import RayCaster
+from meshvis.rays.caster import RayCaster
 
 from .baselines import adjust_text
 from .boxes import Spacing
@@ -51,9 +51,9 @@ def default_model() -> tuple[Any, str]:
     path = os.path.join(here, "models", "assembly.obj")
     if os.path.exists(path):
         return load_models(path), path
-    from meshvis.generators import assembly
+    from meshvis.eval.generators import assembly
 
-    return assembly().soup, "meshvis.generators.assembly()"
+    return assembly().soup, "meshvis.eval.generators.assembly()"
 
 
 def _pick(metrics: dict[str, Any]) -> dict[str, Any]:
@@ -90,7 +90,7 @@ def run(
 
     Parameters
     ----------
-    model : anything :func:`labeling.layout` takes; default :func:`default_model`
+    model : anything :func:`meshvis.labeling.layout` takes; default :func:`default_model`
     size : image width = height of the layout comparison (pixels)
     layouts : layouts to compare
     sizes : image sizes of the quality-against-size curve
@@ -103,7 +103,7 @@ def run(
     up, azimuth, elevation : the camera (fitted to the model)
     views : azimuths of the many-views comparison (0 skips it), at each of ``view_elevations``
     d_e : endpoint distance threshold of the fuzzy method (fraction of ``d_S``; default:
-        the paper's, see :func:`labeling.pipeline.solve`)
+        the paper's, see :func:`meshvis.labeling.pipeline.solve`)
     rotate : ``Spacing.rotate`` of both methods (pixels; default the Spacing default)
     progress : called with a line of text after each step
 
@@ -346,7 +346,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Entry point of ``meshvis bench labeling``."""
-    from meshvis.camera import AXES
+    from meshvis.rays.camera import AXES
 
     model = None
     if args.model:

@@ -3,7 +3,7 @@
 Each frame is laid out with the previous frame's result, so the coherence terms
 ``f6`` (anchor) and ``f7`` (endpoint) pull the new leaders towards the old ones.  The
 model is loaded and its ray caster built once for the whole path.  Every frame after the
-first gets ``metrics["motion"]`` (:func:`labeling.metrics.motion_metrics`) against its
+first gets ``metrics["motion"]`` (:func:`meshvis.labeling.metrics.motion_metrics`) against its
 predecessor.
 """
 from __future__ import annotations
@@ -12,9 +12,9 @@ import json
 import os
 from typing import Any, Mapping, Sequence
 
-from meshvis.camera import Camera
+from meshvis.rays.camera import Camera
 from meshvis.errors import ParameterError
-from meshvis.rays import RayCaster
+from meshvis.rays.caster import RayCaster
 
 from .inputs import load_models
 from .metrics import motion_metrics
@@ -73,11 +73,11 @@ def layout_frames(
 
     Parameters
     ----------
-    model : as for :func:`labeling.layout`
+    model : as for :func:`meshvis.labeling.layout`
     cameras : the cameras, in order
     coherence : pass each frame the previous result (f6, f7); False lays frames out alone
     caster : a RayCaster of the model to reuse
-    **options : passed to :func:`labeling.layout` (layout, size, texts, method, weights, ...)
+    **options : passed to :func:`meshvis.labeling.layout` (layout, size, texts, method, weights, ...)
 
     Returns
     -------

@@ -1,7 +1,7 @@
 """The object-ID buffer: which part every pixel sees (appendix I, §6.1 step 1).
 
-One primary ray per pixel is traced through the shared :class:`meshvis.rays.RayCaster`
-(via :func:`meshvis.render.render`, which also gives the shaded picture the labels are drawn
+One primary ray per pixel is traced through the shared :class:`meshvis.rays.caster.RayCaster`
+(via :func:`meshvis.rays.render.render`, which also gives the shaded picture the labels are drawn
 on).  The part id of the first hit is the pixel's object id; the visible area ``A_i`` of
 part *i* is its pixel count.  Parts with no pixel (or fewer than ``min_pixels``) are
 invisible: they are reported and not labelled.
@@ -11,9 +11,9 @@ from __future__ import annotations
 from dataclasses import dataclass
 import numpy as np
 
-from meshvis.camera import Camera
+from meshvis.rays.camera import Camera
 from meshvis.errors import ParameterError
-from meshvis.rays import RayCaster
+from meshvis.rays.caster import RayCaster
 from meshvis.soup import Soup
 
 
@@ -114,13 +114,13 @@ def id_buffer(
     camera : Camera
     size : (width, height) in pixels
     caster : RayCaster, optional, reused between frames
-    color_by : colouring of the shaded picture (see :func:`meshvis.render.render`)
+    color_by : colouring of the shaded picture (see :func:`meshvis.rays.render.render`)
 
     Returns
     -------
     IdBuffer
     """
-    from meshvis.render import render
+    from meshvis.rays.render import render
 
     width, height = (int(s) for s in size)
     if width < 8 or height < 8:

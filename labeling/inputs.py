@@ -18,7 +18,8 @@ from typing import Any, Mapping, Sequence
 
 from meshvis.errors import ModelError, ParameterError
 from meshvis.io import unique_names
-from meshvis.soup import Soup, as_soup
+from meshvis.io import as_soup
+from meshvis.soup import Soup
 
 
 def _generic(name: str, index: int) -> bool:

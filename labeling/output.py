@@ -177,7 +177,7 @@ def write_gif(results: Sequence[LayoutResult], path: str, *, duration_ms: int = 
 
 def write_json(data: Any, path: str) -> None:
     """Write JSON atomically (NaN written as null)."""
-    from meshvis.jsonfile import write_json as _write
+    from meshvis.io.jsonfile import write_json as _write
 
     _write(_check_path(path), data)
 

@@ -22,9 +22,9 @@ from typing import Any, Mapping, Sequence
 
 import numpy as np
 
-from meshvis.camera import Camera
+from meshvis.rays.camera import Camera
 from meshvis.errors import ParameterError
-from meshvis.rays import RayCaster
+from meshvis.rays.caster import RayCaster
 from meshvis.soup import Soup
 
 from .boxes import Spacing, place_boxes

@@ -6,7 +6,7 @@ from typing import Any
 
 import numpy as np
 
-from meshvis.camera import Camera
+from meshvis.rays.camera import Camera
 
 
 @dataclass

@@ -19,8 +19,8 @@ from typing import Any, Callable, Sequence
 
 import numpy as np
 
-from meshvis.generators import real_models_dir
-from meshvis.rays import RayCaster
+from meshvis.eval.generators import real_models_dir
+from meshvis.rays.caster import RayCaster
 
 from .candidates import LAYOUTS
 from .idbuffer import id_buffer

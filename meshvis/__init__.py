@@ -1,39 +1,79 @@
 """meshvis: visibility questions about real, broken 3D models.
 
-The public API is imported lazily so that ``import meshvis`` stays fast for the CLI.
+The package is layered; each subpackage uses only the ones above it in this list:
+
+* :mod:`meshvis.soup`, :mod:`meshvis.errors` -- the in-memory model and the exceptions;
+* :mod:`meshvis.io` -- reading and writing files, one module per format;
+* :mod:`meshvis.rays` -- the Embree ray caster, random samples, cameras and previews;
+* :mod:`meshvis.geometry` -- connectivity, welding, intersection tests, diagnostics;
+* :mod:`meshvis.graphcut` -- inside/outside by visibility graph cut (appendix H);
+* :mod:`meshvis.repair` -- orientation, inside removal and layers built on the cut;
+* :mod:`meshvis.batch` -- one repair over many files;
+* :mod:`labeling` -- external labels (appendix I), on :mod:`meshvis.rays`;
+* :mod:`meshvis.eval` -- generated models with known answers, baselines, benchmarks;
+* :mod:`cli` -- the ``meshvis`` command.
+
+The public API below is imported lazily, so that ``import meshvis`` stays fast.
+
+>>> import meshvis
+>>> soup = meshvis.as_soup(([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]))
+>>> soup.n_faces
+1
 """
+
 from __future__ import annotations
 
 import importlib
+from typing import Any
 
 __version__ = "0.1.0"
 
-from .errors import MeshvisError, ModelError, ModelFormatError, OutputError, ParameterError  # noqa: E402
-from .soup import Soup, as_soup  # noqa: E402
-from .render import render  # noqa: E402  (eager: the function shadows its module's name)
+from meshvis.errors import (  # noqa: E402
+    MeshvisError,
+    ModelError,
+    ModelFormatError,
+    OutputError,
+    ParameterError,
+)
+from meshvis.soup import Soup  # noqa: E402
 
-# name -> module that defines it
+#: public name -> module that defines it
 _LAZY = {
     "load": "meshvis.io",
     "save": "meshvis.io",
-    "RayCaster": "meshvis.rays",
-    "Hits": "meshvis.rays",
-    "diagnose": "meshvis.diagnostics",
-    "classify": "meshvis.classification",
-    "orient": "meshvis.orientation",
-    "remove_interior": "meshvis.removal",
-    "layers": "meshvis.layering",
-    "Camera": "meshvis.camera",
-    "Hints": "meshvis.hints",
+    "as_soup": "meshvis.io",
+    "RayCaster": "meshvis.rays.caster",
+    "Hits": "meshvis.rays.caster",
+    "Camera": "meshvis.rays.camera",
+    "render": "meshvis.rays.render",
+    "diagnose": "meshvis.geometry.diagnostics",
+    "classify": "meshvis.graphcut.classify",
+    "Classification": "meshvis.graphcut.classify",
+    "Hints": "meshvis.graphcut.hints",
+    "orient": "meshvis.repair.orient",
+    "remove_interior": "meshvis.repair.remove",
+    "layers": "meshvis.repair.layers",
 }
 
 __all__ = [
-    "__version__", "render", "MeshvisError", "ModelError", "ModelFormatError", "OutputError",
-    "ParameterError", "Soup", "as_soup", *_LAZY,
+    "__version__",
+    "MeshvisError",
+    "ModelError",
+    "ModelFormatError",
+    "OutputError",
+    "ParameterError",
+    "Soup",
+    *_LAZY,
 ]
 
 
-def __getattr__(name: str):
+def __getattr__(name: str) -> Any:
     if name in _LAZY:
-        return getattr(importlib.import_module(_LAZY[name]), name)
+        value = getattr(importlib.import_module(_LAZY[name]), name)
+        globals()[name] = value
+        return value
     raise AttributeError(f"module 'meshvis' has no attribute {name!r}")
+
+
+def __dir__() -> list[str]:
+    return sorted(set(globals()) | set(__all__))

@@ -1,5 +1,5 @@
 """``python -m meshvis`` is the ``meshvis`` command."""
-from cli.main import main
+from meshvis.cli.main import main
 
 if __name__ == "__main__":
     raise SystemExit(main())

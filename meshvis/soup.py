@@ -18,7 +18,7 @@ from typing import Any, Sequence
 
 import numpy as np
 
-from .errors import ModelError
+from meshvis.errors import ModelError
 
 
 @dataclass(eq=False)
@@ -290,35 +290,3 @@ def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -
     used = vertices[np.unique(faces)]
     if np.abs(used).max() > 1e300:
         raise ModelError("coordinates too large to compute with (above 1e300)", path)
-
-
-def as_soup(model: Any, *, name: str | None = None) -> Soup:
-    """Coerce what users have into a validated :class:`Soup`.
-
-    Accepts a :class:`Soup`, a ``trimesh.Trimesh``, a ``trimesh.Scene``, a
-    ``(vertices, faces)`` pair, or a path (loaded with :func:`meshvis.io.load`).
-    """
-    if isinstance(model, Soup):
-        validate(model.vertices, model.faces, model.path)
-        return model
-    if isinstance(model, (str, os.PathLike)):
-        from .io import load
-
-        return load(model)
-    try:
-        import trimesh
-    except ImportError:  # pragma: no cover - trimesh is a dependency
-        trimesh = None
-    if trimesh is not None and isinstance(model, trimesh.Scene):
-        from .io import soup_from_scene
-
-        return soup_from_scene(model, path=name)
-    if trimesh is not None and isinstance(model, trimesh.Trimesh):
-        validate(model.vertices, model.faces, name)
-        return Soup(np.asarray(model.vertices), np.asarray(model.faces), path=name)
-    if isinstance(model, (tuple, list)) and len(model) == 2:
-        v, f = model
-        v, f = np.asarray(v), np.asarray(f)
-        validate(v, f, name)
-        return Soup(v, f.astype(np.int64), path=name)
-    raise ModelError(f"cannot use a {type(model).__name__} as a model", name)

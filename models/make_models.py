@@ -5,9 +5,9 @@ Usage::
     python models/make_models.py            # (re)write models/
     python models/make_models.py --out DIR  # write somewhere else
 
-Every model comes from a generator of :mod:`meshvis.generators` with small size
+Every model comes from a generator of :mod:`meshvis.eval.generators` with small size
 parameters, so that the folder stays well below 1 MB.  Next to every ``<stem>.obj`` the
-script writes ``<stem>.truth.npz`` (see :meth:`meshvis.generators.GroundTruth.save_arrays`),
+script writes ``<stem>.truth.npz`` (see :meth:`meshvis.eval.generators.GroundTruth.save_arrays`),
 whose arrays are indexed like the faces of the OBJ file in file order.  Coordinates are
 rounded to 6 decimals before writing (shorter files; rounding keeps coincident corners
 and coplanar walls coincident, so no truth changes).  The output is identical byte for
@@ -28,8 +28,8 @@ HERE = Path(__file__).resolve().parent
 if str(HERE.parent) not in sys.path:  # run from a checkout without installing
     sys.path.insert(0, str(HERE.parent))
 
-from meshvis import generators as g  # noqa: E402
-from meshvis.generators import GroundTruth  # noqa: E402
+from meshvis.eval import generators as g  # noqa: E402
+from meshvis.eval.generators import GroundTruth  # noqa: E402
 
 #: file name -> how to make it; documented one by one in models/README.md
 MODELS: dict[str, Callable[[], GroundTruth]] = {

@@ -1,4 +1,4 @@
-"""Tests of meshvis.batch and ``meshvis batch``: discovery, output names, per-file tasks,
+"""Tests of meshvis.batch.runner and ``meshvis batch``: discovery, output names, per-file tasks,
 worker processes with time limit and crash recovery, resume, Ctrl-C, and Dask."""
 from __future__ import annotations
 
@@ -7,6 +7,7 @@ import errno
 import glob
 import json
 import os
+import tempfile
 import signal
 import subprocess
 import sys
@@ -15,9 +16,9 @@ import time
 import numpy as np
 import pytest
 
-import meshvis.batch as mb
+import meshvis.batch.runner as mb
 import meshvis.io as mio
-from cli.main import main
+from meshvis.cli.main import main
 from meshvis.errors import ParameterError
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -358,7 +359,7 @@ def test_usage_errors(tmp_path, capsys, monkeypatch):
     def refuse(*args, **kwargs):
         raise PermissionError(errno.EACCES, "Permission denied")
 
-    monkeypatch.setattr(mio.tempfile, "mkstemp", refuse)
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
     one_line(["batch", src, "--op", "orient", "--out", str(tmp_path / "ro")], "not writable")
     monkeypatch.undo()
     with pytest.raises(SystemExit) as exc:

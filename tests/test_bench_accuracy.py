@@ -6,11 +6,11 @@ import numpy as np
 import pytest
 import trimesh
 
-from meshvis import baselines as B
-from meshvis import generators as gen
+from meshvis.eval import baselines as B
+from meshvis.eval import generators as gen
 from meshvis.errors import ParameterError
-from meshvis.generators import GroundTruth
-from meshvis.metrics import layer_accuracy, layer_error, orientation_error, removal_scores
+from meshvis.eval.generators import GroundTruth
+from meshvis.eval.metrics import layer_accuracy, layer_error, orientation_error, removal_scores
 from meshvis.soup import Soup
 
 
@@ -167,8 +167,8 @@ def test_library_exception_is_a_failed_result():
 
 # ====================================================================== benchmarks
 def test_compare_one_case_and_its_checks():
-    from meshvis.bench import cases as C
-    from meshvis.bench import compare
+    from meshvis.eval.bench import cases as C
+    from meshvis.eval.bench import compare
 
     t = two_spheres()
     pts = compare.compare_case(t, "two_spheres", log=lambda *a: None, peel_timeout=60)
@@ -185,7 +185,7 @@ def test_compare_one_case_and_its_checks():
 
 
 def test_accuracy_quick_writes_finite_errors(tmp_path):
-    from cli.main import main
+    from meshvis.cli.main import main
 
     out = tmp_path / "acc"
     assert main(["bench", "accuracy", "--quick", "--quiet", "--out", str(out)]) == 0
@@ -214,7 +214,7 @@ def test_accuracy_quick_writes_finite_errors(tmp_path):
     for r in ok_mv:
         if r["case"] in ("sphere_pair", "nested_shells"):
             assert float(r["error"]) == 0.0, r
-    from meshvis.bench.accuracy import read_csv
+    from meshvis.eval.bench.accuracy import read_csv
 
     back = read_csv(str(out / "accuracy.csv"))
     assert len(back) == len(rows) and all(isinstance(p.ok, bool) and isinstance(p.faces, int) for p in back)

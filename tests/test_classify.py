@@ -5,8 +5,8 @@ import trimesh
 
 from meshvis import classify
 from meshvis.errors import ParameterError
-from meshvis.graphcut import cut_value, rounding_bound
-from meshvis.hints import Hints
+from meshvis.graphcut.mincut import cut_value, rounding_bound
+from meshvis.graphcut.hints import Hints
 from meshvis.soup import Soup
 
 
@@ -131,7 +131,7 @@ def test_filter_switch_and_networkx_export():
 
 
 def test_cosine_filter_endpoints():
-    from meshvis.weights import cosine_filter
+    from meshvis.graphcut.weights import cosine_filter
 
     w = np.array([0.0, 0.5, 1.0])
     assert np.allclose(cosine_filter(w, np.ones(3)), [0.0, 0.25, 1.0])
@@ -139,7 +139,7 @@ def test_cosine_filter_endpoints():
 
 def test_cosine_filter_damps_weak_links_without_cutting_them():
     # the literal 1 + cos(pi - x) rounds to 0 for x below ~1e-8; a damped link must stay positive
-    from meshvis.weights import cosine_filter
+    from meshvis.graphcut.weights import cosine_filter
 
     w = np.array([1e-12, 1e-9, 1e-6])
     f = cosine_filter(w, np.ones(3))

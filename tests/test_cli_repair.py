@@ -6,8 +6,8 @@ import os
 import numpy as np
 import pytest
 
-from cli.main import main
-from meshvis import generators as G
+from meshvis.cli.main import main
+from meshvis.eval import generators as G
 from meshvis.io import load, save
 
 REAL = G.real_models_dir()
@@ -119,7 +119,7 @@ def test_orient_cli_options_two_sided_duplicate(tmp_path):
 
 
 def test_demo_writes_everything(tmp_path):
-    from meshvis.demo import DEMO_FILES
+    from meshvis.repair.demo import DEMO_FILES
 
     folder = tmp_path / "demo"
     assert main(["demo", "--out", str(folder), "--size", "96", "-q"]) == 0
@@ -158,7 +158,7 @@ def test_parity_side_reads_the_winding_of_each_face_against_its_own_body():
     # nested spheres, a third of the faces turned over: ray parity against the face's own
     # body tells which side faces out of it, for the hidden inner sphere too
     from meshvis import classify
-    from meshvis.orientation import parity_side
+    from meshvis.repair.orient import parity_side
 
     t = G.nested_shells(n=2, subdivisions=2)
     flip = np.zeros(t.n_faces, bool)
@@ -177,7 +177,7 @@ def test_parity_side_counts_both_copies_where_solids_touch():
     import trimesh
 
     from meshvis import classify
-    from meshvis.orientation import parity_side
+    from meshvis.repair.orient import parity_side
 
     a = trimesh.creation.box(bounds=[[0, 0, 0], [0.1, 1, 1]])  # thin slabs: most rays cross the contact
     v_b = a.vertices.copy()
@@ -191,7 +191,7 @@ def test_parity_side_counts_both_copies_where_solids_touch():
     # both slabs are seen from outside, so orient itself needs no parity here; the function
     # is checked directly.  The copies lie inside the two slabs together: which way they face
     # is a question of ownership (ambiguous), not of parity; every other face is checked
-    from meshvis.adjacency import duplicate_faces
+    from meshvis.geometry.adjacency import duplicate_faces
 
     first = duplicate_faces(c.pre.faces_welded)
     copy = np.bincount(first, minlength=len(F))[first] > 1

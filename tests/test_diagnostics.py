@@ -8,8 +8,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from meshvis import adjacency
-from meshvis.diagnostics import diagnose, format_report
+from meshvis.geometry import adjacency
+from meshvis.geometry.diagnostics import diagnose, format_report
 from meshvis.errors import ModelError
 from meshvis.soup import Soup
 
@@ -192,7 +192,7 @@ def test_diagnose_rejects_bad_input():
 
 # --------------------------------------------------------------------------- command line
 def test_cli_info_json(tmp_path, capsys):
-    from cli.main import main
+    from meshvis.cli.main import main
 
     path = tmp_path / "box.obj"
     box = trimesh.creation.box()
@@ -207,7 +207,7 @@ def test_cli_info_json(tmp_path, capsys):
 
 
 def test_cli_info_errors(tmp_path, capsys):
-    from cli.main import main
+    from meshvis.cli.main import main
 
     assert main(["info", str(tmp_path / "missing.obj")]) == 2
     assert "missing.obj" in capsys.readouterr().err

@@ -15,10 +15,10 @@ import igl
 import numpy as np
 import pytest
 
-from meshvis import generators as g
-from meshvis.adjacency import weld
+from meshvis.eval import generators as g
+from meshvis.geometry.adjacency import weld
 from meshvis.errors import ModelError, ParameterError
-from meshvis.generators import GroundTruth
+from meshvis.eval.generators import GroundTruth
 from meshvis.soup import Soup, validate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -399,7 +399,7 @@ def test_from_closed_real_model():
     s = t.soup
     assert t.outward.all() and t.check() == []
     # cow.obj crosses itself: crossing faces have no single answer
-    from meshvis.intersect import intersection_flags
+    from meshvis.geometry.intersect import intersection_flags
 
     crossing = intersection_flags(s.vertices, s.faces)["intersects"]
     assert crossing.sum() > 50 and np.all(t.ambiguous[crossing])

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 
 from meshvis import classify, orient
-from meshvis import generators as G
-from meshvis.hints import Hints
+from meshvis.eval import generators as G
+from meshvis.graphcut.hints import Hints
 from meshvis.io import load
 
 REAL = G.real_models_dir()
@@ -45,7 +45,7 @@ def test_generator_classified(name):
 
 def test_opening_none_reproduces_the_paper_prior():
     """With the paper's prior unchanged, a cup's inside is pulled inside: the reason for
-    the ``opening`` threshold (meshvis.weights.inside_prior)."""
+    the ``opening`` threshold (meshvis.graphcut.weights.inside_prior)."""
     truth = G.cup()
     paper = classify(truth.soup, seed=0, opening=None)
     assert side_accuracy(truth, paper) < 0.9

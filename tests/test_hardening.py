@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 import meshvis.io as mio
-from cli.main import build_parser, main
+from meshvis.cli.main import build_parser, main
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FORMATS = ("obj", "ply", "stl", "off", "glb", "gltf", "3mf")
@@ -322,7 +322,7 @@ def test_unreadable_file(tmp_path, capsys, monkeypatch, good_files):
         def refuse(*args, **kwargs):
             raise PermissionError(errno.EACCES, "Permission denied")
 
-        monkeypatch.setattr(mio, "open", refuse, raising=False)
+        monkeypatch.setattr(mio.reading, "open", refuse, raising=False)
     else:
         os.chmod(path, 0)
     rc, _, err = _cli(capsys, _argv("orient", path, tmp_path))
@@ -448,6 +448,6 @@ def test_io_error_while_reading(tmp_path, capsys, monkeypatch, good_files):
     def broken(*args, **kwargs):
         raise OSError(errno.EIO, os.strerror(errno.EIO), good_files["obj"])
 
-    monkeypatch.setattr(mio, "sniff", broken)
+    monkeypatch.setattr(mio.reading, "sniff", broken)
     rc, _, err = _cli(capsys, _argv("orient", good_files["obj"], tmp_path))
     _assert_one_line_error(rc, err, good_files["obj"], "input/output error")

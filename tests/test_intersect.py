@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 
 from meshvis.errors import ParameterError
-from meshvis.intersect import EPS, candidate_pairs, intersection_flags, too_close
+from meshvis.geometry.intersect import EPS, candidate_pairs, intersection_flags, too_close
 
 
 def soup(*triangles) -> tuple[np.ndarray, np.ndarray]:
@@ -246,7 +246,7 @@ def test_real_model_agrees_with_meshlab():
         pytest.skip("real models not available")
     import trimesh
 
-    from meshvis.adjacency import weld
+    from meshvis.geometry.adjacency import weld
 
     mesh = trimesh.load(path, process=False, force="mesh")
     v, f = np.asarray(mesh.vertices), np.asarray(mesh.faces)

@@ -2,6 +2,7 @@
 from __future__ import annotations
 
 import os
+import tempfile
 import re
 import warnings
 
@@ -10,10 +11,11 @@ import pytest
 
 import meshvis.io as mio
 from meshvis.errors import ModelError, ModelFormatError, OutputError, ParameterError
-from meshvis.io_obj import MtlSource
-from meshvis.io_ply import read_elements
-from meshvis.io_triangulate import ear_clip, triangulate
-from meshvis.soup import Material, Soup, as_soup
+from meshvis.io.obj import MtlSource
+from meshvis.io.ply import read_elements
+from meshvis.io.triangulate import ear_clip, triangulate
+from meshvis.io import as_soup
+from meshvis.soup import Material, Soup
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 REAL = os.path.normpath(os.path.join(ROOT, "..", "shared", "models", "real"))
@@ -522,7 +524,7 @@ def test_folder_missing_and_unreadable(tmp_path, monkeypatch):
         def refuse(*args, **kwargs):
             raise PermissionError(13, "Permission denied")
 
-        monkeypatch.setattr(mio, "open", refuse, raising=False)
+        monkeypatch.setattr(mio.reading, "open", refuse, raising=False)
     err = _check(path, ModelError, "permission denied")
     assert type(err) is ModelError
 
@@ -544,7 +546,7 @@ def test_atomic_write_keeps_old_file_on_error(tmp_path):
 
 
 def test_failed_save_leaves_existing_file(tmp_path, monkeypatch):
-    import meshvis.io_obj as io_obj
+    import meshvis.io.obj as io_obj
 
     soup = _colour_soup()
     path = tmp_path / "keep.obj"
@@ -553,7 +555,7 @@ def test_failed_save_leaves_existing_file(tmp_path, monkeypatch):
     def fail(*args, **kwargs):
         raise RuntimeError("disk on fire")
 
-    monkeypatch.setattr(io_obj, "_fmt_floats", fail)
+    monkeypatch.setattr(io_obj, "fmt_floats", fail)
     with pytest.raises(RuntimeError):
         mio.save(soup, path)
     assert path.read_text() == "original"
@@ -570,7 +572,7 @@ def test_save_errors(tmp_path, monkeypatch):
     def refuse(*args, **kwargs):
         raise PermissionError(13, "Permission denied")
 
-    monkeypatch.setattr(mio.tempfile, "mkstemp", refuse)
+    monkeypatch.setattr(tempfile, "mkstemp", refuse)
     with pytest.raises(OutputError, match="not writable"):
         mio.save(soup, tmp_path / "x.ply")
     assert not (tmp_path / "x.ply").exists()

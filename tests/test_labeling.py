@@ -9,19 +9,19 @@ import numpy as np
 import pytest
 import trimesh
 
-import labeling
-from labeling import boxes, geometry2d, membership
-from labeling.baselines import adjust_text, two_step
-from labeling.candidates import EAST, NORTH, RADIAL, SOUTH, WEST, leader_candidates
-from labeling.frames import layout_frames, orbit, read_camera_path
-from labeling.greedy import greedy_layout
-from labeling.idbuffer import id_buffer, pixel_rays
-from labeling.inputs import label_texts, load_models, read_texts
-from labeling.internal_area import internal_area
-from labeling.metrics import frame_metrics, is_clean, motion_metrics
-from labeling.output import to_svg, write, write_gif, write_json, write_png
-from labeling.pipeline import fit_camera, solve
-from meshvis.camera import Camera
+from meshvis import labeling
+from meshvis.labeling import boxes, geometry2d, membership
+from meshvis.labeling.baselines import adjust_text, two_step
+from meshvis.labeling.candidates import EAST, NORTH, RADIAL, SOUTH, WEST, leader_candidates
+from meshvis.labeling.frames import layout_frames, orbit, read_camera_path
+from meshvis.labeling.greedy import greedy_layout
+from meshvis.labeling.idbuffer import id_buffer, pixel_rays
+from meshvis.labeling.inputs import label_texts, load_models, read_texts
+from meshvis.labeling.internal_area import internal_area
+from meshvis.labeling.metrics import frame_metrics, is_clean, motion_metrics
+from meshvis.labeling.output import to_svg, write, write_gif, write_json, write_png
+from meshvis.labeling.pipeline import fit_camera, solve
+from meshvis.rays.camera import Camera
 from meshvis.errors import MeshvisError, ParameterError
 from meshvis.soup import Soup
 
@@ -67,7 +67,7 @@ def models(scene):
     if os.path.exists(assembly):
         out.append(("assembly", load_models(assembly), (0, 0, 1)))
     else:  # the generator is the source of the file
-        from meshvis.generators import assembly as make_assembly
+        from meshvis.eval.generators import assembly as make_assembly
 
         out.append(("assembly", make_assembly().soup, (0, 0, 1)))
     out.append(("truck", load_models(_real("CesiumMilkTruck.glb")), (0, 1, 0)))
@@ -472,7 +472,7 @@ def test_parameter_errors(buffers):
 
 
 def test_cli(tmp_path, scene):
-    from cli.main import main
+    from meshvis.cli.main import main
 
     model = tmp_path / "scene.obj"
     scene.to_trimesh().export(model)  # one part: a single label named after the file
@@ -487,7 +487,7 @@ def test_cli(tmp_path, scene):
 
 
 def test_bench_runs_small(scene):
-    from labeling import bench
+    from meshvis.labeling import bench
 
     r = bench.run(scene, size=128, layouts=("left-right", "silhouette"), sizes=(96, 128), orbit_frames=3,
                   repeat=1, adjusttext=False, views=3, d_e=0.1, rotate=32)
@@ -506,7 +506,7 @@ def test_bench_runs_small(scene):
 
 
 def test_sweep_runs_small(scene):
-    from labeling import sweep
+    from meshvis.labeling import sweep
 
     r = sweep.run([("scene", scene, (0, 0, 1))], azimuths=2, elevations=(30.0,), sizes=(128,),
                   layouts=("left", "silhouette"))
@@ -520,7 +520,7 @@ def test_sweep_runs_small(scene):
 
 
 def test_coherent_order_keeps_last_frames_order_only_between_close_neighbours():
-    from labeling.boxes import coherent_order
+    from meshvis.labeling.boxes import coherent_order
 
     nan = np.nan
     # labels 0 and 1 are closer than one pitch and were in the other order last frame
@@ -666,7 +666,7 @@ def test_silhouette_crowded_small_views_place_every_label_near(azimuth, elevatio
 
 def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
     """top-bottom at azimuth 270: the alternator's leader to the top crosses others; it goes down."""
-    import labeling.pipeline
+    import meshvis.labeling.pipeline  # noqa: F401  (makes labeling.pipeline an attribute)
 
     soup = load_models(os.path.join(ROOT, "models", "assembly.obj"))
     ib = id_buffer(soup, fit_camera(soup, azimuth=270.0, elevation=20.0, up=(0, 0, 1)), (512, 512))

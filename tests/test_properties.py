@@ -26,13 +26,13 @@ from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 from hypothesis.extra import numpy as hnp  # noqa: E402
 
-from meshvis.adjacency import degenerate_faces  # noqa: E402
-from meshvis.classification import classify  # noqa: E402
+from meshvis.geometry.adjacency import degenerate_faces  # noqa: E402
+from meshvis.graphcut.classify import classify  # noqa: E402
 from meshvis.errors import MeshvisError, ModelError  # noqa: E402
-from meshvis.layering import layers  # noqa: E402
-from meshvis.orientation import orient  # noqa: E402
-from meshvis.preprocess import DEGENERATE_TOL  # noqa: E402
-from meshvis.removal import remove_interior  # noqa: E402
+from meshvis.repair.layers import layers  # noqa: E402
+from meshvis.repair.orient import orient  # noqa: E402
+from meshvis.graphcut.preprocess import DEGENERATE_TOL  # noqa: E402
+from meshvis.repair.remove import remove_interior  # noqa: E402
 from meshvis.soup import Soup  # noqa: E402
 
 # small budgets: the properties do not depend on the ray count

@@ -4,8 +4,8 @@ import numpy as np
 import pytest
 import trimesh
 
-from meshvis.rays import RayCaster
-from meshvis.sampling import uniform_sphere
+from meshvis.rays.caster import RayCaster
+from meshvis.rays.samples import uniform_sphere
 from meshvis.soup import Soup
 
 

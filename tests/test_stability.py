@@ -6,12 +6,12 @@ import numpy as np
 import pytest
 import trimesh
 
-from cli.main import main as cli_main
-from meshvis import generators
-from meshvis.bench import stability as st
-from meshvis.classification import classify
+from meshvis.cli.main import main as cli_main
+from meshvis.eval import generators
+from meshvis.eval.bench import stability as st
+from meshvis.graphcut.classify import classify
 from meshvis.errors import ModelError
-from meshvis.graphcut import min_cut, rounding_bound
+from meshvis.graphcut.mincut import min_cut, rounding_bound
 
 
 def test_quick_run_passes_through_the_command_line(tmp_path, capsys):
@@ -163,7 +163,7 @@ def test_sample_origin_next_to_a_perpendicular_wall_stays_on_its_side():
     # 1e-5 from a perpendicular partner wall B (plane y = 0).  The normals cannot say on
     # which side of B the origin belongs; it must stay on the point's own side (y > 0)
     # instead of being pushed through B.
-    from meshvis.nodes import _pushed_origins
+    from meshvis.graphcut.nodes import _pushed_origins
 
     tri = np.array([[[0, 0, 0], [0, 1, 0], [0, 0, 1]],
                     [[-1, 0, -1], [1, 0, -1], [0, 0, 2]]], float)

@@ -1,0 +1,170 @@
+"""Side by side: meshvis against the baselines on the same inputs, default settings.
+
+``meshvis bench compare [--quick] [--out DIR]`` runs, in one process and on the same
+soupified inputs (:mod:`meshvis.eval.bench.cases`: the sphere pair with a crack and a hidden
+inner sphere, the skin + rib cage composite, soupified real models):
+
+* normal orientation: ``meshvis.orient`` against libigl ``reorient_facets_raycast``,
+  trimesh ``fix_normals`` and MeshLab's re-orientation by geometry;
+* inside removal: ``meshvis.remove_interior`` against MeshLab ambient occlusion with the
+  ``fq == 0`` selection (front side only, and on both sides);
+* layers: ``meshvis.layers`` against libigl ``peel_outer_hull_layers``.
+
+Every method runs with its default settings and end to end (meshvis classifies once per
+command, as the commands do).  Printed: a table of error and time per method, the time
+of each method divided by meshvis' time on the same task and input, and the targets of
+issue 4 checked on the numbers: meshvis at least as accurate as the best baseline,
+≥ 99.5 % of the hidden shell correct, ≥ 3× faster than libigl's default orientation.
+"""
+from __future__ import annotations
+
+import argparse
+import os
+import sys
+import time
+
+import numpy as np
+
+from meshvis.eval.baselines import BASELINES
+from meshvis.eval.bench import cases as C
+from meshvis.eval.bench.accuracy import prepare_out
+
+#: inputs of the full and the quick comparison
+FULL = ("sphere_pair", "skin_ribcage", "cow", "spot", "dog_skin")
+QUICK = ("sphere_pair", "cow")
+TASKS = ("orient", "remove", "layers")
+OUTPUTS = ("compare.csv", "compare.md")
+#: the targets of issue 4
+HIDDEN_TARGET = 0.995
+SPEED_TARGET = 3.0
+
+
+def _best_of(repeat: int, run):
+    """The run with the smallest time among ``repeat`` runs (errors of that run)."""
+    best = None
+    for _ in range(max(1, repeat)):
+        p = run()
+        if best is None or (p.ok and p.seconds < best.seconds):
+            best = p
+    return best
+
+
+def compare_case(truth, case: str, *, seed: int = 0, repeat: int = 1, peel_timeout: float = 300.0,
+                 log=print) -> list[C.Point]:
+    """All methods at default settings on one case; one :class:`Point` per (method, task)."""
+    points: list[C.Point] = []
+    for task in TASKS:
+        def run_meshvis(task=task):
+            sec, values, info = C.meshvis_run(truth, (task,), seed=seed, share=False)[task]
+            return C.Point(case, truth.n_faces, task, "meshvis", "meshvis (defaults)", "rays_per_node", 32, sec,
+                           load1=C.load1(), default=True, extra=info, **C.score(truth, task, values))
+
+        p = _best_of(repeat, run_meshvis)
+        points.append(p)
+        log(f"  meshvis {task}: {p.seconds:.3f} s, error {p.error:.2e}")
+    for name, b in BASELINES.items():
+        p = _best_of(repeat, lambda: C.baseline_point(truth, case, name, None, timeout=peel_timeout))
+        points.append(p)
+        log(f"  {name}: {p.seconds:.3f} s, " + (f"error {p.error:.2e}" if p.ok else f"FAILED: {p.message}"))
+    return points
+
+
+def checks(points: list[C.Point], case: str) -> list[str]:
+    """The targets of issue 4 on one case, each as 'yes'/'NO' with its numbers."""
+    out = []
+    get = lambda task, method: next((p for p in points if p.case == case and p.task == task  # noqa: E731
+                                     and p.method == method), None)
+    for task in TASKS:
+        mv = get(task, "meshvis")
+        base = [p for p in points if p.case == case and p.task == task and p.method != "meshvis" and p.ok]
+        if mv is None or not base:
+            continue
+        best = min(base, key=lambda p: p.error)
+        ok = mv.error <= best.error
+        out.append(f"{C.TASK_TITLES[task]}: meshvis error {C.fmt_err(mv.error)} vs best baseline "
+                   f"{best.method} {C.fmt_err(best.error)} — at least as accurate: {'yes' if ok else 'NO'}")
+    mv, ig = get("orient", "meshvis"), get("orient", "libigl_reorient")
+    if mv is not None and not np.isnan(mv.error_hidden):
+        acc = 1 - mv.error_hidden
+        ig_txt = f"; libigl {100 * (1 - ig.error_hidden):.2f} %" if ig is not None and ig.ok else ""
+        out.append(f"hidden shell correctly oriented: meshvis {100 * acc:.2f} % "
+                   f"(target ≥ {100 * HIDDEN_TARGET:g} %: {'yes' if acc >= HIDDEN_TARGET else 'NO'}){ig_txt}")
+    if mv is not None and ig is not None and ig.ok:
+        r = ig.seconds / mv.seconds
+        out.append(f"speed: time(libigl default) / time(meshvis orient) = {ig.seconds:.3f} s / {mv.seconds:.3f} s "
+                   f"= {r:.1f}× (target ≥ {SPEED_TARGET:g}×: {'yes' if r >= SPEED_TARGET else 'NO'})")
+    return out
+
+
+def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: str, seconds: float) -> str:
+    lines = ["# meshvis bench compare", "", f"Command: `{command}` — {seconds:.0f} s in all.", ""]
+    lines += C.machine_lines(machine) + [
+        f"- load average at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}", ""]
+    if skipped:
+        lines += ["Skipped cases:", ""] + [f"- {s}" for s in skipped] + [""]
+    lines += ["| case | faces | task | method | error | hidden-shell error | precision | recall | time (s) "
+              "| time / meshvis | load |",
+              "|---|---:|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    for case in dict.fromkeys(p.case for p in points):
+        for task in TASKS:
+            tp = [p for p in points if p.case == case and p.task == task]
+            mv = next((p for p in tp if p.method == "meshvis"), None)
+            for p in tp:
+                ratio = p.seconds / mv.seconds if mv is not None and mv.seconds > 0 else float("nan")
+                err = C.fmt_err(p.error) if p.ok else f"failed: {p.message}"
+                lines.append(f"| {case} | {p.faces} | {task} | {p.label} | {err} | {C.fmt_err(p.error_hidden)} | "
+                             f"{C.fmt_err(p.precision)} | {C.fmt_err(p.recall)} | {C.fmt_time(p.seconds)} | "
+                             f"{ratio:.2f} | {p.load1:.1f} |")
+    lines += ["", "## Targets (issue 4)", ""]
+    for case in dict.fromkeys(p.case for p in points):
+        lines.append(f"- **{case}**")
+        lines += [f"  - {c}" for c in checks(points, case)]
+    return "\n".join(lines) + "\n"
+
+
+def write_csv(path: str, points: list[C.Point]) -> None:
+    from meshvis.eval.bench.accuracy import write_csv as _w
+
+    _w(path, points)
+
+
+# ====================================================================== command
+def add_arguments(p: argparse.ArgumentParser) -> None:
+    p.add_argument("--quick", action="store_true", help=f"only {', '.join(QUICK)}")
+    p.add_argument("--cases", metavar="A,B,...", help=f"inputs (default {','.join(FULL)}); "
+                   f"choose from {','.join(C.CASES)}")
+    p.add_argument("--out", metavar="DIR", help="also write compare.md and compare.csv into DIR")
+    p.add_argument("--repeat", type=int, default=1, metavar="N", help="keep the fastest of N runs per method")
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--peel-timeout", type=float, default=300.0, metavar="S")
+    p.add_argument("--force", action="store_true", help="overwrite earlier results in DIR")
+    p.add_argument("--quiet", action="store_true")
+
+
+def main(args: argparse.Namespace) -> int:
+    chosen = C.select_cases(args.cases, QUICK if args.quick else FULL)
+    if args.out:
+        prepare_out(args.out, OUTPUTS, args.force)
+    log = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
+    m = C.machine()
+    t0 = time.perf_counter()
+    C.warm_up()
+    points: list[C.Point] = []
+    skipped: list[str] = []
+    for case, truth in C.built_cases(chosen, skipped, log):
+        points += compare_case(truth, case.name, seed=args.seed, repeat=args.repeat,
+                               peel_timeout=args.peel_timeout, log=log)
+    command = "meshvis bench compare " + " ".join(
+        x for x in ["--quick" if args.quick else "", f"--cases {args.cases}" if args.cases else "",
+                    f"--repeat {args.repeat}" if args.repeat != 1 else "", f"--seed {args.seed}" if args.seed else "",
+                    f"--out {args.out}" if args.out else ""] if x)
+    text = markdown(points, skipped, m, command.strip(), time.perf_counter() - t0)
+    if args.out:
+        from meshvis.io import atomic_write
+
+        write_csv(os.path.join(args.out, "compare.csv"), points)
+        with atomic_write(os.path.join(args.out, "compare.md"), "w") as fh:
+            fh.write(text)
+    if not args.quiet:
+        print(text)
+    return 0

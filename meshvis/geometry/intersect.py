@@ -1,0 +1,494 @@
+"""Conservative triangle–triangle intersection and coplanarity tests (appendix H §2).
+
+Appendix H flags every triangle that intersects another one (``inters_i``) and every
+triangle that is coplanar with an overlapping one (``cpl_i``); the sampling stage then
+treats those triangles with extra care (point nodes instead of clusters).  Both tests must
+be *conservative*: a pair closer than ``eps`` may be reported, a pair that really
+intersects must never be missed.
+
+Pipeline
+--------
+1. Normalise: centre on the bounding-box centre, scale to unit diagonal.  Every tolerance
+   below is then a plain number, and the flags do not change under scaling or translation.
+2. Broad phase (:func:`candidate_pairs`): axis-aligned boxes inflated by ``eps``, sorted
+   into a *hierarchical uniform grid*.  Level ``L`` has cells of size ``h0 * 2**L`` (``h0``
+   the median box size); a triangle lives on the finest level where its box covers at most
+   27 cells, whatever its size (a huge triangle cannot blow up memory, a flat wall stays on
+   a fine level).  Pairs on one level meet in a shared cell, where entries are also swept
+   along x; a triangle meets the coarser levels by looking up its own cells there.  Each
+   pair is emitted once, from the cell that holds the lower corner of the two boxes'
+   overlap.  Cell keys are int64 (21 bits per axis), matched by sorting and
+   ``searchsorted``; large outputs are produced in bounded chunks.
+3. Narrow phase (:func:`classify_pairs`, vectorised over chunks of pairs): a
+   separating-axis test on the 17 axes that separate two triangles — the two normals, the
+   six in-plane edge normals (precomputed per face) and the 9 edge x edge directions.  Each
+   axis gives a gap between the two projected intervals; a gap along a unit axis is a lower
+   bound of the true distance, so "no axis shows a gap above ``eps``" holds for every pair
+   closer than ``eps`` (conservative).  Axes that are numerically unreliable (a cross
+   product of nearly parallel edges) are skipped, which can only add reports, never drop one.
+4. Coplanarity: normals parallel within ``angle_eps`` (either orientation), every corner of
+   each triangle within ``eps`` of the other's plane, and the two triangles overlap in that
+   plane by more than ``eps`` along each of the six in-plane edge normals (a 2D
+   separating-axis test with a negative margin).  Two faces lying side by side — sharing
+   an edge or only touching — therefore do not count; duplicates and folded-over faces do.
+
+Adjacency
+---------
+Appendix H excludes triangles sharing a vertex or an edge from the intersection test.  Here
+(after welding, :func:`meshvis.geometry.adjacency.weld`):
+
+* pairs sharing an edge (two corners) are never intersecting nor too close: two triangles
+  on one edge can only overlap by folding into one plane, which the coplanarity test sees;
+* pairs sharing exactly one corner are intersecting only when they cross *beyond* it (their
+  tangent wedges at the shared corner share a direction, :func:`_cross_beyond_vertex`) —
+  MeshLab counts these too; the plain exclusion of the paper would miss them;
+* coplanar overlap is tested for adjacent pairs as well (duplicates and folded faces
+  share their corners).
+
+Pairs that lie in one plane are reported as coplanar or not at all, never as
+intersecting; two faces touching side by side in one plane without a shared corner show up
+in ``too_close`` only.  Faces without a reliable normal (degenerate: collapsed or
+collinear) are never coplanar and never cross a neighbour beyond a shared corner; they can
+still be flagged against non-adjacent faces.
+
+Tolerances (fractions of the bounding-box diagonal unless stated)
+------------------------------------------------------------------
+``eps`` = 1e-6 (distance), ``angle_eps`` = 1e-3 rad (parallel planes; loose on purpose:
+the distance condition is the real test, the angle only guards tiny triangles for which
+every corner is trivially within ``eps`` of any plane), weld tolerance 1e-7.  ``eps`` below
+about 1e-9 approaches float64 round-off of the normalised coordinates and is refused.
+"""
+from __future__ import annotations
+
+import functools
+
+import numpy as np
+
+from meshvis.geometry.adjacency import WELD_TOL, weld
+from meshvis.errors import ParameterError
+
+#: default distance tolerance, as a fraction of the bounding-box diagonal
+EPS = 1e-6
+#: default angle tolerance between two planes (radians) for the coplanarity test
+ANGLE_EPS = 1e-3
+#: candidate pairs per narrow-phase chunk (bounds the temporary memory to ~100 MB)
+NARROW_CHUNK = 1 << 15
+#: pairs expanded at once in the broad phase
+BROAD_CHUNK = 1 << 20
+_BITS = 21  # bits per axis of a cell key
+#: most grid cells one box may cover; larger boxes move to a coarser level
+MAX_CELLS = 27
+
+
+# --------------------------------------------------------------------------- broad phase
+def _expand(starts: np.ndarray, counts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Concatenation of ``arange(s, s + c)`` over (s, c), with the owner row of each value."""
+    owner = np.repeat(np.arange(len(counts)), counts)
+    first = np.cumsum(counts) - counts
+    return owner, np.repeat(starts - first, counts) + np.arange(int(counts.sum()))
+
+
+def _chunks(counts: np.ndarray, budget: int = BROAD_CHUNK):
+    """Slices of rows whose counts add up to about ``budget`` (at least one row each)."""
+    total = np.cumsum(counts)
+    begin = 0
+    while begin < len(counts):
+        base = total[begin - 1] if begin else 0
+        end = int(np.searchsorted(total, base + budget, side="right"))
+        end = max(end, begin + 1)
+        yield slice(begin, end)
+        begin = end
+
+
+def _key(cell: np.ndarray) -> np.ndarray:
+    return (cell[..., 0] << (2 * _BITS)) | (cell[..., 1] << _BITS) | cell[..., 2]
+
+
+def _cells(lo: np.ndarray, hi: np.ndarray, h: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Cells covered by boxes on a grid of size ``h``: (owner row, cell key, lower cell)."""
+    top = (1 << _BITS) - 1
+    c0 = np.clip(np.floor(lo / h), 0, top).astype(np.int64)
+    c1 = np.clip(np.floor(hi / h), 0, top).astype(np.int64)
+    span = c1 - c0 + 1
+    owner, local = _expand(np.zeros(len(lo), np.int64), span.prod(axis=1))
+    sx, sy = span[owner, 0], span[owner, 1]
+    cell = c0[owner] + np.stack([local % sx, (local // sx) % sy, local // (sx * sy)], axis=1)
+    return owner, _key(cell), c0
+
+
+def _keep(a, b, ca, cb, key, lo, hi) -> np.ndarray:
+    """Mask of pairs met in their lowest common cell whose boxes really overlap."""
+    own = _key(np.maximum(ca, cb)) == key
+    a, b = a[own], b[own]
+    ok = _lmin((lo[a] <= hi[b]) & (lo[b] <= hi[a]))
+    return np.flatnonzero(own)[ok]
+
+
+def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+    """All pairs of overlapping axis-aligned boxes, through a hierarchical uniform grid.
+
+    Parameters
+    ----------
+    lower, upper : (m, 3) float arrays, box corners (inflate them by the tolerance first)
+
+    Returns
+    -------
+    (p, 2) int64, pairs ``i < j`` whose closed boxes overlap, sorted
+    """
+    lower = np.asarray(lower, np.float64)
+    upper = np.asarray(upper, np.float64)
+    m = len(lower)
+    if m < 2:
+        return np.zeros((0, 2), np.int64)
+    origin = lower.min(axis=0)
+    lo, hi = lower - origin, upper - origin
+    size = float((hi.max(axis=0)).max())
+    if size <= 0:  # every box is the same point
+        i, j = np.triu_indices(m, 1)
+        return np.stack([i, j], axis=1).astype(np.int64)
+    # finest cell: the median box size (at least 2**-20 of the whole: 21-bit keys)
+    h0 = max(float(np.median((hi - lo).max(axis=1))), size * 2.0**-20)
+    # each box goes to the finest level where it covers at most MAX_CELLS cells; levels
+    # are nested (cell size doubles), so the cell count only falls with the level
+    top = int(np.ceil(np.log2(size / h0))) + 1
+    level = np.full(m, top, np.int64)
+    for L in range(top - 1, -1, -1):
+        h = h0 * 2.0**L
+        covered = (np.floor(hi / h) - np.floor(lo / h) + 1).prod(axis=1)
+        level[covered <= MAX_CELLS] = L
+    # within a cell, entries are sorted by the lower x of their box (sweep and prune): the
+    # sort value is "cell rank + x scaled into [0, 0.5]", so that one searchsorted finds,
+    # for every entry, the end of the entries of its cell that start before its box ends
+    # (the margin keeps the float rounding of that value on the safe side)
+    xs = 0.5 / size
+    out = []
+    levels = np.unique(level)
+    grids = {}
+    own_low = np.zeros((m, 3), np.int64)  # lower cell of each box on its own level
+    for L in levels:
+        tri = np.flatnonzero(level == L)
+        owner, key, c0 = _cells(lo[tri], hi[tri], h0 * 2.0**L)
+        ent = tri[owner]
+        order = np.lexsort((lo[ent, 0], key))
+        key, ent = key[order], ent[order]
+        rank = np.concatenate([[0], np.cumsum(key[1:] != key[:-1])])
+        sweep = rank + lo[ent, 0] * xs
+        margin = 8 * np.spacing(rank[-1] + 1.0)  # above the rounding of rank + x
+        own_low[tri] = c0
+        grids[L] = (key, ent, rank, sweep, margin)
+        # pairs within one level: the later entries of the same cell starting before x ends
+        pos = np.arange(len(key))
+        counts = np.searchsorted(sweep, rank + hi[ent, 0] * xs + margin, side="right") - pos - 1
+        for sl in _chunks(counts):
+            row, other = _expand(pos[sl] + 1, counts[sl])
+            row = row + sl.start
+            a, b = ent[row], ent[other]
+            keep = _keep(a, b, own_low[a], own_low[b], key[row], lo, hi)
+            out.append(np.stack([a[keep], b[keep]], axis=1))
+    # pairs across levels: finer boxes look up their cells on each coarser level
+    for L in levels[1:]:
+        key_c, ent_c, rank_c, sweep_c, margin = grids[L]
+        fine = np.flatnonzero(level < L)
+        if len(fine) == 0:
+            continue
+        owner, key_f, c0f = _cells(lo[fine], hi[fine], h0 * 2.0**L)
+        start = np.searchsorted(key_c, key_f, side="left")
+        found = key_c[np.minimum(start, len(key_c) - 1)] == key_f
+        r = rank_c[np.minimum(start, len(key_c) - 1)]
+        end = np.searchsorted(sweep_c, r + hi[fine[owner], 0] * xs + margin, side="right")
+        counts = np.where(found, np.maximum(end - start, 0), 0)
+        low_f = np.zeros((m, 3), np.int64)
+        low_f[fine] = c0f
+        for sl in _chunks(counts):
+            row, other = _expand(start[sl], counts[sl])
+            row = row + sl.start
+            a, b = fine[owner[row]], ent_c[other]
+            keep = _keep(a, b, low_f[a], own_low[b], key_f[row], lo, hi)
+            out.append(np.stack([a[keep], b[keep]], axis=1))
+    pairs = np.concatenate(out) if out else np.zeros((0, 2), np.int64)
+    keys = np.sort(pairs.min(axis=1) * np.int64(m) + pairs.max(axis=1))
+    return np.stack([keys // m, keys % m], axis=1)
+
+
+# --------------------------------------------------------------------------- narrow phase
+def _lmin(x: np.ndarray) -> np.ndarray:
+    """Minimum over a short last axis (numpy's own reduction is slow on tiny rows)."""
+    return functools.reduce(np.minimum, [x[..., t] for t in range(x.shape[-1])])
+
+
+def _lmax(x: np.ndarray) -> np.ndarray:
+    """Maximum over a short last axis."""
+    return functools.reduce(np.maximum, [x[..., t] for t in range(x.shape[-1])])
+
+
+def _dot(axes: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """(k, a, v) projections of ``points`` (k, v, 3) on ``axes`` (k, a, 3)."""
+    return np.matmul(axes, points.transpose(0, 2, 1))
+
+
+def _gap(pa: np.ndarray, pb: np.ndarray) -> np.ndarray:
+    """Signed gap between projected intervals (positive: separated; negative: overlap)."""
+    return np.maximum(_lmin(pb) - _lmax(pa), _lmin(pa) - _lmax(pb))
+
+
+class _FaceAxes:
+    """Per-face separating axes, computed once: unit normal and three in-plane edge normals."""
+
+    def __init__(self, tri: np.ndarray, tau: float):
+        self.edges = np.roll(tri, -1, axis=1) - tri  # side s: corner s -> s+1
+        self.edge_len = np.linalg.norm(self.edges, axis=2)
+        n = np.cross(self.edges[:, 0], self.edges[:, 1])
+        n_len = np.linalg.norm(n, axis=1)
+        # a normal is reliable when sin(angle between two sides) exceeds tau
+        self.has_normal = n_len > tau * self.edge_len[:, 0] * self.edge_len[:, 1]
+        unit = np.zeros_like(n)
+        unit[self.has_normal] = n[self.has_normal] / n_len[self.has_normal, None]
+        w = np.cross(unit[:, None], self.edges)
+        w_len = np.linalg.norm(w, axis=2)
+        ok = w_len > 0
+        w[ok] /= w_len[ok, None]
+        self.axes = np.concatenate([unit[:, None], w], axis=1)  # (m, 4, 3), zero rows = unusable
+        self.valid = np.concatenate([self.has_normal[:, None], ok], axis=1)
+        proj = _dot(self.axes, tri)
+        self.low, self.high = _lmin(proj), _lmax(proj)
+
+
+def _cross_beyond_vertex(fi, fj, Ti, Tj, fa: "_FaceAxes", i, j, tau: float) -> np.ndarray:
+    """(k,) bool: two non-coplanar triangles sharing exactly one corner meet beyond it.
+
+    Both triangles are convex and contain the shared corner ``v``, so they share another
+    point exactly when their *tangent wedges* at ``v`` (the cones spanned by the two sides
+    leaving ``v``) share a direction.  Two wedges in different planes can only share the
+    direction ``±L``, ``L = n_i x n_j`` (the planes' common line): the test is whether ``L``
+    or ``-L`` lies in both wedges.  A direction on a wedge's border counts (touching along a
+    side is reported: conservative).  Pairs sharing two corners (an edge) cannot cross unless
+    they are folded into one plane, which the coplanarity test handles.
+    """
+    out = np.zeros(len(fi), bool)
+    eq = fi[:, :, None] == fj[:, None, :]
+    one = eq.sum(axis=(1, 2)) == 1
+    one &= fa.has_normal[i] & fa.has_normal[j]
+    k = np.flatnonzero(one)
+    if len(k) == 0:
+        return out
+    eq = eq[k]
+    ci = eq.any(axis=2).argmax(axis=1)  # corner of the shared vertex in each triangle
+    cj = eq.any(axis=1).argmax(axis=1)
+    ni, nj = fa.axes[i[k], 0], fa.axes[j[k], 0]
+    line = np.cross(ni, nj)
+    length = np.linalg.norm(line, axis=1)
+    reliable = length > tau
+    line[reliable] /= length[reliable, None]
+    rows = np.arange(len(k))
+
+    def sides(T, c):
+        v = T[rows, c]
+        u1 = T[rows, (c + 1) % 3] - v
+        u2 = T[rows, (c + 2) % 3] - v
+        u1 /= np.linalg.norm(u1, axis=1, keepdims=True)
+        u2 /= np.linalg.norm(u2, axis=1, keepdims=True)
+        return u1, u2
+
+    def inside(u1, u2, n, d):
+        # d between u1 and u2 (counter-clockwise about n), with a small angular slack
+        slack = -1e-9
+        a = np.einsum("kd,kd->k", np.cross(u1, d), n)
+        b = np.einsum("kd,kd->k", np.cross(d, u2), n)
+        return (a >= slack) & (b >= slack)
+
+    ui1, ui2 = sides(Ti[k], ci)
+    uj1, uj2 = sides(Tj[k], cj)
+    meet = (inside(ui1, ui2, ni, line) & inside(uj1, uj2, nj, line)) | (
+        inside(ui1, ui2, ni, -line) & inside(uj1, uj2, nj, -line)
+    )
+    # planes parallel to working precision but not within eps of each other: report
+    out[k] = np.where(reliable, meet, True)
+    return out
+
+
+def classify_pairs(
+    triangles: np.ndarray,
+    faces_welded: np.ndarray,
+    pairs: np.ndarray,
+    eps: float,
+    near: float,
+    angle_eps: float = ANGLE_EPS,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Narrow phase on candidate pairs of *normalised* triangles (unit diagonal).
+
+    Two stages, vectorised over chunks of pairs.  Stage 1 uses the 8 face axes (two unit
+    normals, six in-plane edge normals, precomputed per face); it also decides coplanarity.
+    Stage 2 adds the 9 edge x edge axes for the non-adjacent pairs stage 1 could not
+    separate by more than ``max(eps, near)``.  The gap along a unit axis never exceeds the
+    distance between the triangles, so ``max gap <= eps`` holds for every pair closer than
+    ``eps``.
+
+    Parameters
+    ----------
+    triangles : (m, 3, 3) float64 corners, normalised to unit bounding-box diagonal
+    faces_welded : (m, 3) int64, welded corner ids (adjacency)
+    pairs : (p, 2) int64 candidate pairs
+    eps : float, distance tolerance for intersection and coplanarity (absolute, unit diagonal)
+    near : float, distance below which a non-adjacent pair is "too close"
+    angle_eps : float, radians
+
+    Returns
+    -------
+    intersects, coplanar, too_close : (p,) bool, per pair (see the module notes)
+    """
+    p = len(pairs)
+    inter = np.zeros(p, bool)
+    copl = np.zeros(p, bool)
+    close = np.zeros(p, bool)
+    # cross products of factors at an angle below tau are skipped: their round-off
+    # (~ machine eps / tau, relative to unit coordinates) must stay far below eps
+    tau = min(1e-3, 100 * np.finfo(np.float64).eps / min(eps, near))
+    cos_angle = np.cos(angle_eps)
+    pad = max(eps, near)
+    fa = _FaceAxes(triangles, tau)
+    for s in range(0, p, NARROW_CHUNK):
+        i, j = pairs[s : s + NARROW_CHUNK, 0], pairs[s : s + NARROW_CHUNK, 1]
+        fi, fj = faces_welded[i], faces_welded[j]
+        shared = _lmax((fi[:, :, None] == fj[:, None, :]).reshape(-1, 9))
+        Ti, Tj = triangles[i], triangles[j]
+        # stage 1: j's corners on i's axes and i's corners on j's axes
+        pj = _dot(fa.axes[i], Tj)  # (k, 4, 3)
+        pi = _dot(fa.axes[j], Ti)
+        gap = np.concatenate(
+            [
+                np.maximum(_lmin(pj) - fa.high[i], fa.low[i] - _lmax(pj)),
+                np.maximum(_lmin(pi) - fa.high[j], fa.low[j] - _lmax(pi)),
+            ],
+            axis=1,
+        )
+        gap[~np.concatenate([fa.valid[i], fa.valid[j]], axis=1)] = -np.inf
+        max_gap = _lmax(gap)
+        # coplanar: parallel, every corner within eps of the other plane, and the two
+        # triangles overlap by more than eps along each in-plane edge normal
+        flat = fa.has_normal[i] & fa.has_normal[j]
+        flat &= np.abs(np.einsum("kd,kd->k", fa.axes[i, 0], fa.axes[j, 0])) >= cos_angle
+        mid_i = 0.5 * (fa.low[i, 0] + fa.high[i, 0])
+        mid_j = 0.5 * (fa.low[j, 0] + fa.high[j, 0])
+        flat &= _lmax(np.abs(pj[:, 0] - mid_i[:, None])) <= eps
+        flat &= _lmax(np.abs(pi[:, 0] - mid_j[:, None])) <= eps
+        in_plane = _lmax(gap[:, [1, 2, 3, 5, 6, 7]])
+        c = flat & (in_plane < -eps)
+        # stage 2: edge x edge axes for the non-adjacent pairs still within reach
+        k = np.flatnonzero(~shared & (max_gap <= pad))
+        if len(k):
+            ei, ej = fa.edges[i[k]], fa.edges[j[k]]
+            axes = np.cross(ei[:, :, None], ej[:, None, :]).reshape(-1, 9, 3)
+            length = np.linalg.norm(axes, axis=2)
+            ok = length > tau * (fa.edge_len[i[k]][:, :, None] * fa.edge_len[j[k]][:, None, :]).reshape(-1, 9)
+            length[~ok] = 1.0
+            g = _gap(_dot(axes, Ti[k]), _dot(axes, Tj[k])) / length
+            g[~ok] = -np.inf
+            max_gap[k] = np.maximum(max_gap[k], _lmax(g))
+        hit = ~shared & ~flat & (max_gap <= eps)
+        near_pair = ~shared & (max_gap <= near)
+        # pairs sharing exactly one corner: do they cross beyond it?
+        k = np.flatnonzero(shared & ~flat)
+        if len(k):
+            cross = _cross_beyond_vertex(fi[k], fj[k], Ti[k], Tj[k], fa, i[k], j[k], tau)
+            hit[k] = cross
+            near_pair[k] = cross
+        sl = slice(s, s + len(i))
+        copl[sl] = c
+        # pairs in one plane are coplanar (overlapping) or nothing, never "intersecting"
+        inter[sl] = hit
+        close[sl] = near_pair
+    return inter, copl, close
+
+
+def _normalised(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
+    t = np.asarray(vertices, np.float64)[faces]
+    flat = t.reshape(-1, 3)
+    lo, hi = flat.min(axis=0), flat.max(axis=0)
+    diag = float(np.linalg.norm(hi - lo))
+    scale = 1.0 / diag if diag > 0 else 1.0
+    return (t - 0.5 * (lo + hi)) * scale, diag
+
+
+def intersection_flags(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    eps: float | None = None,
+    *,
+    near: float | None = None,
+    angle_eps: float = ANGLE_EPS,
+    faces_welded: np.ndarray | None = None,
+    weld_tol: float = WELD_TOL,
+) -> dict:
+    """Per-face flags of appendix H §2: intersects another face, coplanar with one, too close.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+    faces : (m, 3) int array
+    eps : float, optional
+        Distance tolerance as a fraction of the bounding-box diagonal (default :data:`EPS`,
+        1e-6).  Pairs closer than this may be flagged; pairs that intersect always are.
+    near : float, optional
+        "Too close" distance, fraction of the diagonal (default ``eps``).
+    angle_eps : float
+        Largest angle between two planes still called parallel (radians, default 1e-3).
+    faces_welded : (m, 3) int array, optional
+        Welded faces (:func:`meshvis.geometry.adjacency.weld`), to skip welding here.
+    weld_tol : float
+        Weld tolerance used when ``faces_welded`` is not given.
+
+    Returns
+    -------
+    dict with
+        ``intersects``, ``coplanar``, ``too_close`` : (m,) bool per face;
+        ``intersect_pairs``, ``coplanar_pairs``, ``close_pairs`` : (k, 2) int64 face pairs
+        (i < j) behind the flags; ``candidates`` : number of broad-phase pairs;
+        ``eps``, ``near`` : absolute tolerances used (input units); ``diagonal``.
+
+    Notes
+    -----
+    ``too_close`` marks faces with a non-adjacent face (no shared welded vertex) within
+    ``near`` — the clustering rule "triangle too close to a non-adjacent triangle" of
+    appendix H §2.  It includes the intersecting faces whenever ``near >= eps``.
+    """
+    eps = EPS if eps is None else float(eps)
+    near = eps if near is None else float(near)
+    if not (1e-9 <= eps < 1) or not (1e-9 <= near < 1):
+        raise ParameterError(f"eps and near must lie in [1e-9, 1) (fractions of the diagonal), got {eps}, {near}")
+    if not (0 <= angle_eps < np.pi / 2):
+        raise ParameterError(f"angle_eps must lie in [0, pi/2), got {angle_eps}")
+    faces = np.asarray(faces, np.int64).reshape(-1, 3)
+    m = len(faces)
+    if faces_welded is None:
+        faces_welded = weld(vertices, faces, weld_tol)[1]
+    tri, diag = _normalised(vertices, faces)
+    pad = max(eps, near)
+    lower = tri.min(axis=1) - pad
+    upper = tri.max(axis=1) + pad
+    pairs = candidate_pairs(lower, upper)
+    inter, copl, close = classify_pairs(tri, np.asarray(faces_welded, np.int64), pairs, eps, near, angle_eps)
+
+    def flags(mask):
+        return np.bincount(pairs[mask].ravel(), minlength=m) > 0
+
+    return {
+        "intersects": flags(inter),
+        "coplanar": flags(copl),
+        "too_close": flags(close),
+        "intersect_pairs": pairs[inter],
+        "coplanar_pairs": pairs[copl],
+        "close_pairs": pairs[close],
+        "candidates": int(len(pairs)),
+        "eps": eps * diag,
+        "near": near * diag,
+        "diagonal": diag,
+    }
+
+
+def too_close(vertices: np.ndarray, faces: np.ndarray, near: float | None = None, **kwargs) -> np.ndarray:
+    """(m,) bool: faces with a non-adjacent face within ``near`` (fraction of the diagonal).
+
+    A shortcut for ``intersection_flags(...)["too_close"]``; call
+    :func:`intersection_flags` directly to get every flag from one pass.
+    """
+    return intersection_flags(vertices, faces, near=near, **kwargs)["too_close"]

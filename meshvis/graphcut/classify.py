@@ -1,0 +1,369 @@
+"""Inside/outside classification of every triangle side by visibility graph cut (appendix H).
+
+Pipeline (DESIGN.md §4)::
+
+    soup → preprocess (flags, welding, clusters) → half-space nodes → visibility sampling
+         → weights (Eq. 5–9) → s-t min cut → per-(face, side) labels
+
+Sampling is *progressive*: rays are cast in rounds and the loop stops as soon as a round
+changes the labels of less than ``tolerance`` of the total area, when no node is left
+undecided, or when the ray budget ``rays_per_node`` is spent.  The first round samples
+every node; later rounds double the rays of the undecided nodes only — those whose label
+changed in the last round, those on the cut (linked to a node of the other label), those
+whose escape share is within a factor of two of the ``opening`` threshold and, after the
+first round, those whose two terminal links are within a factor of two — in the spirit of
+adaptive global visibility sampling (AGVS).  A clean closed model stops after
+one small round.  Stages a model does not need (point nodes when nothing is
+flagged, hint rays without hints) are skipped, and the result says so.
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Any, Callable
+
+import numpy as np
+
+from meshvis import __version__
+from meshvis.errors import ModelError, ParameterError
+from meshvis.graphcut.mincut import SOLVERS, Cut, VisibilityGraph
+from meshvis.graphcut.hints import Hints, hint_weights
+from meshvis.graphcut.nodes import NodeSet, build_nodes
+from meshvis.graphcut.preprocess import Preprocessed, preprocess
+from meshvis.rays.caster import RayCaster
+from meshvis.io import as_soup
+from meshvis.soup import Soup
+from meshvis.graphcut.sampling import VisibilityCounts, sample_round
+from meshvis.graphcut.weights import DEFAULT_OPENING, graph_weights
+
+#: rays of the first progressive round, per node (before the cluster-size factor)
+FIRST_ROUND_RAYS = 4
+#: upper bound of the per-node ray multiplier of large clusters
+CLUSTER_RAY_FACTOR_MAX = 64
+
+
+@dataclass
+class Stage:
+    """One pipeline stage in the report: whether it ran, why not, and its time."""
+
+    name: str
+    ran: bool
+    seconds: float = 0.0
+    note: str = ""
+
+
+@dataclass
+class Classification:
+    """Result of :func:`classify`.
+
+    Attributes
+    ----------
+    outside : (m, 2) float64
+        Per input face and side (0 = front/counter-clockwise, 1 = back): 1.0 outside,
+        0.0 inside; for flagged (intersecting/coplanar) faces, the outside fraction of the
+        side's sample-point area.
+    degenerate : (m,) bool, zero-area faces (not classified; both sides reported inside)
+    flagged : (m,) bool, faces classified through sample points
+    cluster : (m,) int64, cluster id (-1 for flagged and degenerate faces)
+    nodes, graph, counts, cut : the internals, for inspection and layer peeling
+    stages : list of Stage; rounds : per-round statistics
+    """
+
+    soup: Soup
+    outside: np.ndarray
+    degenerate: np.ndarray
+    flagged: np.ndarray
+    cluster: np.ndarray
+    nodes: NodeSet
+    graph: VisibilityGraph
+    counts: VisibilityCounts
+    cut: Cut
+    caster: RayCaster
+    pre: Preprocessed
+    stages: list[Stage] = field(default_factory=list)
+    rounds: list[dict] = field(default_factory=list)
+    params: dict = field(default_factory=dict)
+
+    # ---------------------------------------------------------------- derived per-face views
+    @property
+    def side_outside(self) -> np.ndarray:
+        """(m, 2) bool: a side counts as outside when more than half of it is."""
+        return self.outside > 0.5
+
+    @property
+    def hidden(self) -> np.ndarray:
+        """(m,) bool: no side outside."""
+        return ~self.side_outside.any(axis=1)
+
+    @property
+    def two_sided(self) -> np.ndarray:
+        """(m,) bool: both sides outside."""
+        return self.side_outside.all(axis=1)
+
+    def face_labels_from(self, node_outside: np.ndarray) -> np.ndarray:
+        """(m, 2) outside fractions for a node labelling (e.g. from a later cut)."""
+        return face_labels(self.nodes, node_outside, self.soup.n_faces, self.degenerate)
+
+    @property
+    def n_rays(self) -> int:
+        return int(self.counts.rays + self.counts.reverse_rays + self.params.get("hint_rays", 0))
+
+    def report(self, per_face: bool = True) -> dict:
+        """A JSON-ready dictionary: counts, stages, rounds, timings, parameters, arrays."""
+        d = {
+            "version": __version__,
+            "faces": self.soup.n_faces,
+            "nodes": self.graph.n,
+            "cluster_nodes": self.nodes.n_cluster,
+            "point_nodes": self.nodes.n - self.nodes.n_cluster,
+            "clusters": int(self.pre.clustering.n_clusters),
+            "edges": self.graph.n_edges,
+            "flagged_faces": int(self.flagged.sum()),
+            "intersecting_faces": int(self.pre.intersects.sum()),
+            "coplanar_faces": int(self.pre.coplanar.sum()),
+            "degenerate_faces": int(self.degenerate.sum()),
+            "rays": int(self.counts.rays),
+            "reverse_rays": int(self.counts.reverse_rays),
+            "hint_rays": int(self.params.get("hint_rays", 0)),
+            "discarded_rays": int(self.counts.discarded.sum()),
+            "rounds": self.rounds,
+            "cut_value": self.cut.value,
+            "solver": self.cut.solver,
+            "stages": [s.__dict__ for s in self.stages],
+            "embree_seconds": self.counts.time_embree,
+            "sampling_seconds": self.counts.time_total,
+            "embree_share_of_sampling": self.counts.time_embree / self.counts.time_total if self.counts.time_total else 0.0,
+            "params": self.params,
+            "outside_area_fraction": float(
+                (self.side_outside.any(axis=1) * self.soup.areas).sum() / max(self.soup.total_area, 1e-300)
+            ),
+        }
+        if per_face:
+            d["per_face"] = {
+                "outside_front": self.outside[:, 0],
+                "outside_back": self.outside[:, 1],
+                "flagged": self.flagged,
+                "degenerate": self.degenerate,
+                "cluster": self.cluster,
+            }
+        return d
+
+    def summary(self) -> str:
+        """A few lines for the terminal."""
+        r = self.report(per_face=False)
+        lines = [
+            f"{r['faces']} faces: {r['clusters']} clusters, {r['flagged_faces']} flagged "
+            f"({r['intersecting_faces']} intersecting, {r['coplanar_faces']} coplanar), {r['degenerate_faces']} degenerate",
+            f"graph: {r['nodes']} nodes ({r['cluster_nodes']} cluster, {r['point_nodes']} point), {r['edges']} edges",
+            f"rays: {r['rays']} + {r['reverse_rays']} reverse + {r['hint_rays']} hint in {len(self.rounds)} round(s); "
+            f"Embree share of sampling {100 * r['embree_share_of_sampling']:.0f}%",
+        ]
+        for s in self.stages:
+            lines.append(f"  {s.name:<12} {'%.3f s' % s.seconds if s.ran else 'skipped':>10}  {s.note}")
+        return "\n".join(lines)
+
+
+def face_labels(nodes: NodeSet, node_outside: np.ndarray, m: int, degenerate: np.ndarray) -> np.ndarray:
+    """Map node labels back to input faces: (m, 2) outside fractions (see Classification)."""
+    out = np.zeros((m, 2))
+    clustered = nodes.side_node[:, 0] >= 0
+    out[clustered] = node_outside[nodes.side_node[clustered]]
+    if len(nodes.flagged):
+        k = nodes.samples
+        for s in (0, 1):
+            lab = node_outside[nodes.n_cluster + 2 * np.arange(nodes.n_points) + s].reshape(-1, k)
+            out[nodes.flagged, s] = lab.mean(axis=1)
+    out[degenerate] = 0.0
+    return out
+
+
+def ray_allocation(nodes: NodeSet, rays: int) -> np.ndarray:
+    """Rays per node for one round: ``rays`` times a factor √(faces in node), capped.
+
+    A cluster node of many triangles gets more rays than a single sample point, so that
+    its origins cover its area, but not proportionally more (its weights are sums).
+    """
+    factor = np.clip(np.ceil(np.sqrt(nodes.n_faces)), 1, CLUSTER_RAY_FACTOR_MAX).astype(np.int64)
+    alloc = rays * factor
+    alloc[nodes.area <= 0] = 0
+    return alloc
+
+
+def classify(
+    model: Any,
+    *,
+    rays_per_node: int = 32,
+    seed: int = 0,
+    hints: Hints | dict | None = None,
+    samples_per_face: int = 4,
+    sampling_scheme: int = 2,
+    use_filter: bool = True,
+    opening: float | None = DEFAULT_OPENING,
+    progressive: bool = True,
+    tolerance: float = 1e-3,
+    solver: str = "pymaxflow",
+    offset: float | None = None,
+    caster: RayCaster | None = None,
+    progress: Callable[[str, float], None] | None = None,
+) -> Classification:
+    """Classify both sides of every triangle as inside or outside.
+
+    Parameters
+    ----------
+    model : Soup, trimesh.Trimesh, (vertices, faces) or path
+    rays_per_node : ray budget per half-space node (before the cluster factor, see
+        :func:`ray_allocation`); progressive sampling may stop earlier
+    seed : seed of the one random generator; same input and seed give identical output
+    hints : :class:`~meshvis.graphcut.hints.Hints` or dict of inside/outside points and boxes
+    samples_per_face : sample points per intersecting/coplanar face (appendix H §3.1)
+    sampling_scheme : 1 (uniform) or 2 (uniform + edges, default)
+    use_filter : apply the directed cosine filter (Eq. 8–9)
+    opening : a side whose escaping ray share exceeds this is not pulled inside by the
+        prior of its opposite side (an opening, not a crack; see
+        :func:`meshvis.graphcut.weights.inside_prior`); None follows the paper exactly
+    progressive : sample in rounds and stop when labels settle (else one full round)
+    tolerance : stop when a round changes less than this fraction of the total side area
+    solver : "pymaxflow" or "scipy"
+    offset : push of ray origins off surfaces, relative to the bounding-box diagonal
+    caster : reuse a prebuilt :class:`~meshvis.rays.caster.RayCaster` of the same model
+    progress : callback ``progress(stage, fraction)``
+
+    Returns
+    -------
+    Classification
+
+    Raises
+    ------
+    ModelError
+        The model is unusable, or every face is degenerate (nothing to classify).
+    ParameterError
+        An argument is out of its range.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> c = classify(trimesh.creation.icosphere(2), seed=1)
+    >>> bool(c.side_outside[:, 0].all() and not c.side_outside[:, 1].any())
+    True
+    """
+    if rays_per_node < 1:
+        raise ParameterError(f"rays_per_node must be at least 1, got {rays_per_node}")
+    if samples_per_face < 1:
+        raise ParameterError(f"samples_per_face must be at least 1, got {samples_per_face}")
+    if solver not in SOLVERS:
+        raise ParameterError(f"unknown solver {solver!r}; choose one of {', '.join(SOLVERS)}")
+    if opening is not None and not 0 < opening <= 1:
+        raise ParameterError(f"opening must be in (0, 1] or None, got {opening}")
+    if not 0 <= tolerance < 1:
+        raise ParameterError("tolerance must be in [0, 1)")
+    hints = Hints.coerce(hints)
+    soup = as_soup(model)
+    rng = np.random.default_rng(seed)
+    stages: list[Stage] = []
+    report = progress or (lambda stage, frac: None)
+
+    t = time.perf_counter()
+    if caster is None:
+        caster = RayCaster(soup) if offset is None else RayCaster(soup, offset=offset)
+    stages.append(Stage("scene", True, time.perf_counter() - t, "Embree scene on the normalised copy"))
+
+    t = time.perf_counter()
+    report("preprocess", 0.0)
+    pre = preprocess(soup)
+    if pre.degenerate.all():  # no side has an area: there is no graph to cut
+        what = "the only face is" if soup.n_faces == 1 else f"all {soup.n_faces} faces are"
+        raise ModelError(f"{what} degenerate (zero area): nothing to classify", soup.path)
+    stages.append(Stage("preprocess", True, time.perf_counter() - t,
+                        f"{pre.clustering.n_clusters} clusters, {int(pre.flagged.sum())} flagged faces"))
+
+    t = time.perf_counter()
+    off_abs = caster.offset * caster.diagonal
+    nodes = build_nodes(
+        soup.triangles, soup.normals, soup.areas, pre.clustering, pre.flagged, pre.partner_pairs,
+        samples=samples_per_face, scheme=sampling_scheme, offset=off_abs, proximity=2 * off_abs,
+    )
+    point_note = f"{nodes.n_points} sample points" if nodes.n_points else "skipped point nodes: no flagged faces"
+    stages.append(Stage("nodes", True, time.perf_counter() - t, f"{nodes.n} nodes; {point_note}"))
+
+    hint_out = hint_in = None
+    hint_rays = 0
+    if hints is not None and not hints.empty:
+        t = time.perf_counter()
+        hint_out, hint_in, hint_rays = hint_weights(caster, nodes, hints, rng)
+        stages.append(Stage("hints", True, time.perf_counter() - t, f"{hint_rays} rays from hints"))
+    else:
+        stages.append(Stage("hints", False, 0.0, "no hints given"))
+
+    counts = VisibilityCounts(nodes.n)
+    is_point = nodes.is_point
+    rounds: list[dict] = []
+    budget = ray_allocation(nodes, rays_per_node)
+    cast = np.zeros(nodes.n, np.int64)
+    give = ray_allocation(nodes, min(FIRST_ROUND_RAYS, rays_per_node) if progressive else rays_per_node)
+    prev = prev_nodes = None
+    t_sample = t_cut = 0.0
+    stop_reason = "single round"
+    while True:
+        t = time.perf_counter()
+        report("sampling", float(cast.sum()) / max(float(budget.sum()), 1.0))
+        sample_round(caster, nodes, give, rng, counts)
+        cast += give
+        t_sample += time.perf_counter() - t
+
+        t = time.perf_counter()
+        counted = counts.cast - counts.discarded
+        weights = graph_weights(counts.hits, counted, counts.escaped, nodes.area, nodes.opposite, is_point,
+                                hint_out=hint_out, hint_in=hint_in, use_filter=use_filter, opening=opening)
+        graph = VisibilityGraph(nodes.n, weights)
+        cut = graph.cut(solver)
+        labels = face_labels(nodes, cut.outside, soup.n_faces, pre.degenerate)
+        t_cut += time.perf_counter() - t
+
+        changed = None if prev is None else float(
+            (np.abs(labels - prev).sum(axis=1) * soup.areas).sum() / max(2 * soup.total_area, 1e-300)
+        )
+        rounds.append({"rays": int(counts.rays), "nodes_sampled": int((give > 0).sum()),
+                       "edges": graph.n_edges, "changed_area_fraction": changed})
+        if not progressive:
+            break
+        if changed is not None and changed <= tolerance:
+            stop_reason = f"converged after {len(rounds)} rounds (change {changed:.2e} <= {tolerance:g})"
+            break
+        # Next round: double the rays of the nodes that are still undecided.  After the
+        # first round every node is undecided; later only nodes whose label changed and
+        # nodes on the cut (an edge to a node of the other label) get more rays.
+        active = np.zeros(nodes.n, bool) if prev_nodes is None else cut.outside != prev_nodes
+        w = graph.weights
+        across = cut.outside[w.edges_i] != cut.outside[w.edges_j]
+        active[w.edges_i[across]] = True
+        active[w.edges_j[across]] = True
+        if prev_nodes is None:
+            # after the first round also every node whose terminal links are close to a tie
+            margin = np.abs(w.cap_out - w.cap_in) <= 0.5 * np.maximum(w.cap_out, w.cap_in)
+            active |= margin & (np.maximum(w.cap_out, w.cap_in) > 0)
+        if opening is not None:
+            # and every node whose escape share is too close to the opening threshold to tell
+            share = counts.escaped / np.maximum(counted, 1)
+            active |= (share > 0.5 * opening) & (share < 2 * opening)
+        give = np.where(active, np.minimum(cast, budget - cast), 0)
+        prev, prev_nodes = labels, cut.outside
+        if not active.any():
+            stop_reason = f"settled after {len(rounds)} round(s): no node left undecided"
+            break
+        if give.sum() == 0:
+            stop_reason = f"ray budget reached after {len(rounds)} rounds"
+            break
+
+    stages.append(Stage("sampling", True, t_sample, f"{counts.rays} rays + {counts.reverse_rays} reverse; {stop_reason}"))
+    stages.append(Stage("cut", True, t_cut, f"{graph.n_edges} edges, solver {cut.solver}, filter {'on' if use_filter else 'off'}"))
+    report("done", 1.0)
+    params = {
+        "rays_per_node": rays_per_node, "seed": seed, "samples_per_face": samples_per_face,
+        "sampling_scheme": sampling_scheme, "use_filter": use_filter, "opening": opening, "progressive": progressive,
+        "tolerance": tolerance, "solver": solver, "offset": caster.offset, "hint_rays": hint_rays,
+    }
+    return Classification(
+        soup=soup, outside=labels, degenerate=pre.degenerate, flagged=pre.flagged,
+        cluster=pre.clustering.cluster, nodes=nodes, graph=graph, counts=counts, cut=cut,
+        caster=caster, pre=pre, stages=stages, rounds=rounds, params=params,
+    )

@@ -1,0 +1,277 @@
+"""Half-space nodes of the visibility graph (appendix H §3.1).
+
+Node ids are laid out as:
+
+* ``0 .. n_cluster-1`` — cluster nodes, one per consistent side of a triangle cluster;
+* ``n_cluster + 2*p + s`` — point node of sample point ``p`` on side ``s`` of a flagged
+  (intersecting / coplanar / too close) triangle.
+
+The two virtual terminals OUTSIDE and INSIDE are not stored here; the cut adds them.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from meshvis.graphcut.clusters import Clustering
+from meshvis.rays.samples import cosine_hemisphere, sample_scheme_barycentric, tangent_frames, uniform_in_triangles
+
+
+@dataclass
+class NodeSet:
+    """All half-space nodes of one model.
+
+    Attributes
+    ----------
+    n : int, number of nodes
+    n_cluster : int, number of cluster nodes (they come first)
+    area : (n,) float64, A_i: sum of the node's triangle areas, or triangle area / samples
+    opposite : (n,) int64, the node on the other side of the same geometry
+    n_faces : (n,) int64, triangles in a cluster node (1 for point nodes)
+    side_node : (m, 2) int64, cluster node of each (face, side), -1 for flagged faces
+    entry_node, entry_face, entry_side, entry_cumarea : the (node, face, side) entries of
+        the cluster nodes sorted by node, with cumulative area for area-weighted picking
+    node_start : (n_cluster+1,) offsets of each cluster node's entries
+    flagged : (k,) int64, the flagged faces; sample points of flagged face q are
+        ``q*samples .. q*samples+samples-1``
+    samples : int, sample points per flagged face
+    point_face : (P,) int64, face of each sample point
+    point_pos : (P, 3) float64, sample point on its face
+    point_origin : (P, 2, 3) float64, ray origin of each side, pushed off the surface
+    flagged_index : (m,) int64, position of a face in ``flagged`` or -1
+    sample_bary : (samples, 3) barycentric pattern of the sample points (same on every face)
+    flagged_metric : (k, 3) float64, per flagged face ``(e1·e1, e1·e2, e2·e2)`` with
+        ``e1 = b - a``, ``e2 = c - a``: the metric of its barycentric coordinates
+    tangents : two (m, 3) arrays, a tangent frame of every face normal (for ray directions)
+    """
+
+    n: int
+    n_cluster: int
+    area: np.ndarray
+    opposite: np.ndarray
+    n_faces: np.ndarray
+    side_node: np.ndarray
+    entry_node: np.ndarray
+    entry_face: np.ndarray
+    entry_side: np.ndarray
+    entry_cumarea: np.ndarray
+    node_start: np.ndarray
+    flagged: np.ndarray
+    samples: int
+    point_face: np.ndarray
+    point_pos: np.ndarray
+    point_origin: np.ndarray
+    flagged_index: np.ndarray
+    sample_bary: np.ndarray
+    flagged_metric: np.ndarray
+    tangents: tuple[np.ndarray, np.ndarray]
+
+    @property
+    def n_points(self) -> int:
+        return len(self.point_face)
+
+    @property
+    def is_point(self) -> np.ndarray:
+        out = np.zeros(self.n, bool)
+        out[self.n_cluster:] = True
+        return out
+
+    def point_node(self, p: np.ndarray, side: np.ndarray) -> np.ndarray:
+        return self.n_cluster + 2 * np.asarray(p, np.int64) + np.asarray(side, np.int64)
+
+
+def side_normals(normals: np.ndarray, side: np.ndarray) -> np.ndarray:
+    """Normal of the given side (side 0: the face normal, side 1: its negation)."""
+    return normals * np.where(np.asarray(side) == 0, 1.0, -1.0)[:, None]
+
+
+def build_nodes(
+    triangles: np.ndarray,
+    normals: np.ndarray,
+    areas: np.ndarray,
+    clustering: Clustering,
+    flagged: np.ndarray,
+    partner_pairs: np.ndarray,
+    *,
+    samples: int = 4,
+    scheme: int = 2,
+    offset: float,
+    proximity: float,
+) -> NodeSet:
+    """Create the half-space nodes.
+
+    Parameters
+    ----------
+    triangles, normals, areas : per-face geometry (float64)
+    clustering : from :func:`meshvis.graphcut.clusters.cluster_sides`
+    flagged : (m,) bool, faces that get sample-point nodes
+    partner_pairs : (k, 2) int64, pairs of faces flagged together (intersecting, coplanar,
+        too close); used by the proximity adjustment of the sample points
+    samples : sample points per flagged face; scheme : 1 or 2 (appendix H §3.1)
+    offset : push of ray origins off their surface (absolute, model units)
+    proximity : a sample point closer than this to a partner's plane, and inside it,
+        is moved past that partner (appendix H Fig. 6)
+    """
+    m = len(triangles)
+    side_node = clustering.side_node
+    n_cluster = clustering.n_nodes
+
+    # -- cluster nodes: (node, face, side) entries sorted by node
+    faces_c = np.flatnonzero(side_node[:, 0] >= 0)
+    e_node = np.concatenate([side_node[faces_c, 0], side_node[faces_c, 1]])
+    e_face = np.concatenate([faces_c, faces_c])
+    e_side = np.concatenate([np.zeros(len(faces_c), np.int8), np.ones(len(faces_c), np.int8)])
+    order = np.lexsort((e_face, e_node))
+    e_node, e_face, e_side = e_node[order], e_face[order], e_side[order]
+    node_start = np.searchsorted(e_node, np.arange(n_cluster + 1))
+    c_area = np.bincount(e_node, areas[e_face], minlength=n_cluster)
+    c_faces = np.bincount(e_node, minlength=n_cluster)
+
+    # -- point nodes on flagged faces
+    flagged_faces = np.flatnonzero(flagged)
+    flagged_index = np.full(m, -1, np.int64)
+    flagged_index[flagged_faces] = np.arange(len(flagged_faces))
+    bary = sample_scheme_barycentric(samples, scheme)
+    pos = np.einsum("kc,fcd->fkd", bary, triangles[flagged_faces]).reshape(-1, 3)
+    point_face = np.repeat(flagged_faces, samples)
+    origin = np.empty((len(point_face), 2, 3))
+    for s in (0, 1):
+        origin[:, s] = _pushed_origins(pos, point_face, s, triangles, normals, flagged_index,
+                                       partner_pairs, samples, offset, proximity)
+
+    tf = triangles[flagged_faces]
+    e1, e2 = tf[:, 1] - tf[:, 0], tf[:, 2] - tf[:, 0]
+    metric = np.stack([np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2),
+                       np.einsum("ij,ij->i", e2, e2)], axis=1)
+    p_area = np.repeat(areas[flagged_faces] / samples, samples)
+    n_points = len(point_face)
+    n = n_cluster + 2 * n_points
+    area = np.concatenate([c_area, np.repeat(p_area, 2)])
+    opposite = np.concatenate([clustering.opposite, n_cluster + (np.arange(2 * n_points) ^ 1)])
+    n_faces = np.concatenate([c_faces, np.ones(2 * n_points, np.int64)])
+    return NodeSet(
+        n=n, n_cluster=n_cluster, area=area, opposite=opposite, n_faces=n_faces, side_node=side_node,
+        entry_node=e_node, entry_face=e_face, entry_side=e_side, entry_cumarea=np.cumsum(areas[e_face]),
+        node_start=node_start, flagged=flagged_faces, samples=samples, point_face=point_face,
+        point_pos=pos, point_origin=origin, flagged_index=flagged_index, sample_bary=bary,
+        flagged_metric=metric, tangents=tangent_frames(normals),
+    )
+
+
+#: |cos| between a partner's normal and a side normal below which the two are taken as
+#: perpendicular (about 0.06 degrees, like the parallel-plane tolerance of the flags)
+PERPENDICULAR_COS = 1e-3
+
+
+def _pushed_origins(pos, point_face, side, triangles, normals, flagged_index, pairs, samples, offset, proximity):
+    """Ray origins of sample points on one side, pushed off the surface (appendix H Fig. 6).
+
+    A point is first pushed by ``offset`` along its face's side normal.  If it also lies on a
+    partner triangle (closer than ``proximity`` to its plane and inside it), it is moved
+    along that partner's normal (oriented towards the same side) until it clears the
+    partner by ``offset``; among several partners the one needing the furthest move wins.
+    """
+    n_s = side_normals(normals[point_face], np.full(len(point_face), side))
+    origin = pos + offset * n_s
+    if len(pairs) == 0 or len(pos) == 0:
+        return origin
+    # (point, partner) candidates: every sample point of f against every partner g of f
+    both = np.concatenate([pairs, pairs[:, ::-1]])
+    both = both[flagged_index[both[:, 0]] >= 0]
+    f, g = both[:, 0], both[:, 1]
+    pt = (flagged_index[f][:, None] * samples + np.arange(samples)).ravel()
+    g = np.repeat(g, samples)
+    p = pos[pt]
+    ng = normals[g]
+    d = np.einsum("ij,ij->i", ng, p - triangles[g, 0])
+    near = np.abs(d) < proximity
+    if not near.any():
+        return origin
+    pt, g, p, ng, d = pt[near], g[near], p[near], ng[near], d[near]
+    inside = _inside_triangle(p - d[:, None] * ng, triangles[g], tol=proximity)
+    pt, ng, d = pt[inside], ng[inside], d[inside]
+    if len(pt) == 0:
+        return origin
+    cos = np.einsum("ij,ij->i", ng, n_s[pt])
+    orient = np.sign(cos)
+    # A partner at right angles (a face against a wall at a T-junction, a sliver along
+    # it): the normals do not tell which side of the partner the origin belongs to, and
+    # picking one at random can push it through the partner (e.g. out of a room).  Keep
+    # the side the sample point lies on; on the partner's plane itself, do not move.
+    square = np.abs(cos) < PERPENDICULAR_COS
+    orient[square] = np.sign(d[square])
+    moved = orient != 0
+    pt, ng, d, orient = pt[moved], ng[moved], d[moved], orient[moved]
+    if len(pt) == 0:
+        return origin
+    move = offset - orient * d  # distance to travel along orient*ng to clear g by offset
+    order = np.lexsort((move, pt))
+    last = np.r_[pt[order][1:] != pt[order][:-1], True]
+    sel = order[last]
+    origin[pt[sel]] = pos[pt[sel]] + (orient[sel] * move[sel])[:, None] * ng[sel] + offset * n_s[pt[sel]]
+    return origin
+
+
+def _inside_triangle(p: np.ndarray, tri: np.ndarray, tol: float) -> np.ndarray:
+    """Whether points (already in the triangles' planes) lie inside them, with tolerance."""
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    v0, v1, v2 = b - a, c - a, p - a
+    d00 = np.einsum("ij,ij->i", v0, v0)
+    d01 = np.einsum("ij,ij->i", v0, v1)
+    d11 = np.einsum("ij,ij->i", v1, v1)
+    d20 = np.einsum("ij,ij->i", v2, v0)
+    d21 = np.einsum("ij,ij->i", v2, v1)
+    den = d00 * d11 - d01 * d01
+    ok = den > 0
+    den = np.where(ok, den, 1.0)
+    v = (d11 * d20 - d01 * d21) / den
+    w = (d00 * d21 - d01 * d20) / den
+    u = 1 - v - w
+    scale = np.sqrt(np.maximum(d00, d11))
+    t = tol / np.where(scale > 0, scale, 1.0)
+    return ok & (u >= -t) & (v >= -t) & (w >= -t)
+
+
+def node_rays(nodes: NodeSet, normals: np.ndarray, triangles: np.ndarray, counts: np.ndarray,
+              rng: np.random.Generator, offset: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Origins and cosine-distributed directions of ``counts[i]`` rays from every node i.
+
+    Cluster nodes: pick a triangle of the node by area, a uniform point on it, push it off
+    along the side normal (appendix H §3.2.2).  Point nodes: rays start at the (pushed)
+    sample point.
+
+    Returns
+    -------
+    source : (n,) node id of each ray; origins, directions : (n, 3)
+    """
+    counts = np.asarray(counts, np.int64)
+    source = np.repeat(np.arange(nodes.n, dtype=np.int64), counts)
+    origins = np.empty((len(source), 3))
+    face = np.empty(len(source), np.int64)
+    side = np.empty(len(source), np.int8)
+
+    cl = source < nodes.n_cluster
+    src_c = source[cl]
+    if len(src_c):
+        start = nodes.node_start[src_c]
+        base = np.where(start > 0, nodes.entry_cumarea[np.maximum(start - 1, 0)], 0.0)
+        target = base + rng.random(len(src_c)) * nodes.area[src_c]
+        idx = np.searchsorted(nodes.entry_cumarea, target, side="right")
+        idx = np.clip(idx, start, nodes.node_start[src_c + 1] - 1)
+        f, s = nodes.entry_face[idx], nodes.entry_side[idx]
+        pts = uniform_in_triangles(triangles[f], rng)
+        origins[cl] = pts + offset * side_normals(normals[f], s)
+        face[cl], side[cl] = f, s
+
+    pn = ~cl
+    if pn.any():
+        k = source[pn] - nodes.n_cluster
+        p, s = k // 2, k % 2
+        origins[pn] = nodes.point_origin[p, s]
+        face[pn], side[pn] = nodes.point_face[p], s
+    # tangent frames depend on the face only (flipping the normal keeps them orthogonal)
+    t1, t2 = nodes.tangents
+    directions = cosine_hemisphere(side_normals(normals[face], side), rng, (t1[face], t2[face]))
+    return source, origins, directions
+

@@ -1,0 +1,133 @@
+"""Visibility sampling: cast rays from every node and count where they land (appendix H §3.2.2).
+
+The counts of one or more rounds are accumulated in a :class:`VisibilityCounts`:
+``hits[i, j] = n_ij`` (sparse), ``cast[i] = n_i`` (rays that count: cast minus discarded),
+``escaped[i]`` (misses, which link node *i* to the OUTSIDE terminal).
+"""
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse as sp
+
+from meshvis.graphcut.nodes import NodeSet, node_rays
+from meshvis.rays.caster import RayCaster
+
+#: rays traced per Embree batch (bounded memory: ~100 bytes per ray in flight)
+BATCH = 1 << 20
+
+
+@dataclass
+class VisibilityCounts:
+    """Accumulated ray statistics of all rounds so far."""
+
+    n: int
+    hits: sp.csr_matrix = None
+    cast: np.ndarray = None
+    escaped: np.ndarray = None
+    discarded: np.ndarray = None
+    rays: int = 0
+    reverse_rays: int = 0
+    time_embree: float = 0.0
+    time_total: float = 0.0
+
+    def __post_init__(self) -> None:
+        if self.hits is None:
+            self.hits = sp.csr_matrix((self.n, self.n), dtype=np.float64)
+            self.cast = np.zeros(self.n, np.int64)
+            self.escaped = np.zeros(self.n, np.int64)
+            self.discarded = np.zeros(self.n, np.int64)
+
+
+def snap_to_points(nodes: NodeSet, face: np.ndarray, bary: np.ndarray) -> np.ndarray:
+    """Index of the sample point of ``face`` (a flagged face) nearest to each hit.
+
+    Hits are given by their barycentric coordinates ``(u, v)`` on the face.  Every flagged
+    face carries the same barycentric sample pattern, so the squared 3D distance to sample
+    *k* is the quadratic form ``Δᵀ G Δ`` of the barycentric difference Δ = (u-u_k, v-v_k)
+    with the face's metric tensor ``G`` (dot products of its two edge vectors): no 3D
+    coordinates need to be gathered.
+    """
+    q = nodes.flagged_index[face]
+    g = nodes.flagged_metric[q]  # (n, 3): e1·e1, e1·e2, e2·e2
+    g0, g1, g2 = g[:, 0], g[:, 1], g[:, 2]
+    u, v = bary[:, 0], bary[:, 1]
+    best = np.zeros(len(face), np.int64)
+    best_d2 = None
+    # one pass per sample (K is small) keeps the temporaries at n values each
+    for k, (_, bu, bv) in enumerate(nodes.sample_bary):
+        du, dv = u - bu, v - bv
+        d2 = g0 * du * du + 2 * g1 * du * dv + g2 * dv * dv
+        if best_d2 is None:
+            best_d2 = d2
+        else:
+            closer = d2 < best_d2  # strict: ties keep the first sample, like argmin
+            best[closer] = k
+            best_d2 = np.where(closer, d2, best_d2)
+    return q * nodes.samples + best
+
+
+def sample_round(
+    caster: RayCaster,
+    nodes: NodeSet,
+    rays_per_node: np.ndarray,
+    rng: np.random.Generator,
+    counts: VisibilityCounts,
+    progress=None,
+) -> VisibilityCounts:
+    """Cast ``rays_per_node[i]`` rays from every node i and add the results to ``counts``.
+
+    A hit on a clustered face links to that cluster's node of the side hit.  A hit on a
+    flagged face is snapped to the nearest sample point on that face and kept only if a
+    reverse ray from the sample point (pushed to the side hit) reaches the ray's origin;
+    otherwise the ray is discarded (it counts neither as a hit nor as an escape).
+    """
+    t_start = time.perf_counter()
+    soup = caster.soup
+    normals, triangles = soup.normals, soup.triangles
+    offset = caster.offset * caster.diagonal
+    rays_per_node = np.asarray(rays_per_node, np.int64)
+    # process nodes in slices whose ray count stays near BATCH
+    cum = np.cumsum(rays_per_node)
+    edges = np.searchsorted(cum, np.arange(BATCH, cum[-1] + BATCH, BATCH) if len(cum) and cum[-1] else [])
+    bounds = np.unique(np.concatenate([[0], np.minimum(edges + 1, nodes.n), [nodes.n]]))
+    rows, cols = [], []
+    for a, b in zip(bounds[:-1], bounds[1:]):
+        per = np.zeros(nodes.n, np.int64)
+        per[a:b] = rays_per_node[a:b]
+        if per.sum() == 0:
+            continue
+        src, origins, dirs = node_rays(nodes, normals, triangles, per, rng, offset)
+        t0 = time.perf_counter()
+        h = caster.intersect(origins, dirs)
+        counts.time_embree += time.perf_counter() - t0
+        counts.rays += len(src)
+        hit = h.face >= 0
+        counts.escaped += np.bincount(src[~hit], minlength=nodes.n)
+        f, s, sr = h.face[hit], h.side[hit].astype(np.int64), src[hit]
+        dst = nodes.side_node[f, s]
+        keep = np.ones(len(f), bool)
+        idx = np.flatnonzero(dst < 0)  # hits on flagged faces: snap, then check the way back
+        if len(idx):
+            hit_idx = np.flatnonzero(hit)[idx]
+            p = snap_to_points(nodes, f[idx], h.bary[hit_idx])
+            t0 = time.perf_counter()
+            blocked = caster.occluded(nodes.point_origin[p, s[idx]], origins[hit_idx])
+            counts.time_embree += time.perf_counter() - t0
+            counts.reverse_rays += len(idx)
+            dst[idx] = nodes.point_node(p, s[idx])
+            keep[idx[blocked]] = False
+        counts.discarded += np.bincount(sr[~keep], minlength=nodes.n)
+        rows.append(sr[keep])
+        cols.append(dst[keep])
+        if progress is not None:
+            progress(len(src))
+    counts.cast += rays_per_node
+    if rows:
+        r, c = np.concatenate(rows), np.concatenate(cols)
+        add = sp.coo_matrix((np.ones(len(r)), (r, c)), shape=(nodes.n, nodes.n)).tocsr()
+        counts.hits = (counts.hits + add).tocsr()
+    counts.time_total += time.perf_counter() - t_start
+    return counts

@@ -1,0 +1,193 @@
+"""Helpers every format shares: one-line messages, atomic writes, output checks, welding
+corners into output vertices, unique names, float text.
+
+Format modules import from here and never from :mod:`meshvis.io.reading` or
+:mod:`meshvis.io.writing`, which import them: the dependency runs one way.
+"""
+from __future__ import annotations
+
+import contextlib
+import os
+import stat
+import struct
+import tempfile
+from typing import IO, Iterator
+
+import numpy as np
+
+from meshvis.errors import OutputError
+from meshvis.soup import Soup
+
+
+def one_line(text: object, limit: int = 200) -> str:
+    """The first line of ``str(text)``, shortened to ``limit`` characters."""
+    lines = [s.strip() for s in str(text).splitlines() if s.strip()]
+    first = lines[0] if lines else ""
+    return first if len(first) <= limit else first[: limit - 3] + "..."
+
+
+def describe_exception(exc: BaseException) -> str:
+    """A short one-line description of an exception raised by a parser."""
+    text = one_line(exc)
+    name = type(exc).__name__
+    if not text:
+        return name
+    if isinstance(exc, (KeyError, IndexError, struct.error)):
+        return f"{name}: {text}"
+    return text
+
+
+@contextlib.contextmanager
+def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-8") -> Iterator[IO]:
+    """Open ``path`` for writing so that it is replaced only when writing succeeds.
+
+    The data goes to a temporary file in the same folder; on leaving the ``with`` block
+    normally it is flushed, synced to disk and renamed over ``path`` (``os.replace``, atomic
+    on POSIX).  On any exception the temporary file is removed and an existing ``path`` is
+    left untouched.  The new file gets the permissions of the file it replaces, or the
+    usual ones for a new file (0666 less the umask).
+
+    Parameters
+    ----------
+    path : str or path-like
+    mode : ``"w"`` (text) or ``"wb"`` (binary)
+    encoding : text encoding for ``"w"``
+
+    Raises
+    ------
+    OutputError
+        The folder does not exist or is not writable, or ``path`` is a folder.
+    """
+    if mode not in ("w", "wb"):
+        raise ValueError("mode must be 'w' or 'wb'")
+    path = os.fspath(path)
+    folder = os.path.dirname(os.path.abspath(path))
+    if os.path.isdir(path):
+        raise OutputError("output path is a folder", path)
+    if not os.path.isdir(folder):
+        raise OutputError("output folder does not exist", path)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
+    except PermissionError:
+        raise OutputError("output folder is not writable", path) from None
+    except OSError as exc:
+        raise OutputError(f"cannot write: {one_line(exc.strerror or exc)}", path) from None
+    try:
+        with os.fdopen(fd, mode, **({"encoding": encoding, "newline": "\n"} if mode == "w" else {})) as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+        try:
+            perm = stat.S_IMODE(os.stat(path).st_mode)
+        except OSError:
+            umask = os.umask(0)
+            os.umask(umask)
+            perm = 0o666 & ~umask
+        os.chmod(tmp, perm)
+        os.replace(tmp, path)
+    except BaseException as exc:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+        if isinstance(exc, OSError) and not isinstance(exc, OutputError):
+            raise OutputError(f"cannot write: {one_line(exc.strerror or exc)}", path) from None
+        raise
+
+
+def weld_corners(soup: Soup, use_uv: bool = True, use_colors: bool = True) -> tuple[np.ndarray, np.ndarray]:
+    """Share one output vertex between corners with the same vertex, UV and colour.
+
+    Parameters
+    ----------
+    soup : Soup
+    use_uv, use_colors : bool
+        Whether UVs / colours (when the soup has them) take part in the key.
+
+    Returns
+    -------
+    corner_vertex : (k,) int64
+        For each output vertex, the flat corner index (into ``faces.ravel()``) it is
+        taken from: gather positions, UVs and colours with it.
+    faces : (m, 3) int64
+        Faces indexing the output vertices.
+
+    Notes
+    -----
+    The key of a corner is built in steps, each a ``np.unique`` on one int64 array: the
+    vertex index, then combined with the id of its UV pair, then with the id of its
+    packed RGBA colour.  Output vertices are sorted by key, so the result is
+    deterministic.
+    """
+    flat = soup.faces.reshape(-1)
+    key = flat.astype(np.int64)
+    if use_uv and soup.uv is not None:
+        uv = soup.uv.reshape(-1, 2)
+        # a complex number holds the UV pair exactly and sorts fast in one dimension
+        _, uv_id = np.unique(uv[:, 0] + 1j * uv[:, 1], return_inverse=True)
+        _, key = np.unique(key * (int(uv_id.max()) + 1) + uv_id.reshape(-1), return_inverse=True)
+    if use_colors and soup.colors is not None:
+        packed = np.ascontiguousarray(soup.colors.reshape(-1, 4)).view(np.uint32).reshape(-1)
+        _, col_id = np.unique(packed, return_inverse=True)
+        key = key.reshape(-1) * (int(col_id.max()) + 1) + col_id.reshape(-1)
+    _, first, inverse = np.unique(key.reshape(-1), return_index=True, return_inverse=True)
+    return first.astype(np.int64), inverse.reshape(-1, 3).astype(np.int64)
+
+
+def unique_names(names: list[str], fallback: str) -> list[str]:
+    """Make names non-empty and unique (``name``, ``name.1``, ...), keeping order."""
+    out: list[str] = []
+    seen: set[str] = set()
+    for i, n in enumerate(names):
+        base = " ".join(str(n or "").split()) or f"{fallback}{i}"
+        cand, k = base, 1
+        while cand in seen:
+            cand = f"{base}.{k}"
+            k += 1
+        seen.add(cand)
+        out.append(cand)
+    return out
+
+
+def check_output(path: str, inputs: list[str], force: bool) -> None:
+    """Refuse an output path that is an input, a folder, in a missing or unwritable folder,
+    or that exists while ``force`` is False (raises :class:`OutputError`)."""
+    for inp in inputs:
+        if os.path.exists(path) and os.path.exists(inp) and os.path.samefile(path, inp):
+            raise OutputError("output path is the input file; choose another path", path)
+        if os.path.abspath(path) == os.path.abspath(inp):
+            raise OutputError("output path is the input file; choose another path", path)
+    if os.path.isdir(path):
+        raise OutputError("output path is a folder", path)
+    if os.path.exists(path) and not force:
+        raise OutputError("exists; use --force to overwrite", path)
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise OutputError("output folder does not exist", folder)
+    if not os.access(folder, os.W_OK):
+        raise OutputError("output folder is not writable", folder)
+
+
+def ensure_folder(out_dir: str) -> None:
+    """Create the output folder if needed and check that files can be created in it.
+
+    Raises
+    ------
+    OutputError
+        The path is a file, cannot be created, or is not writable.
+    """
+    if os.path.exists(out_dir) and not os.path.isdir(out_dir):
+        raise OutputError("the output folder is a file", out_dir)
+    try:
+        os.makedirs(out_dir, exist_ok=True)
+    except OSError as exc:
+        raise OutputError(f"cannot create the output folder: {one_line(exc.strerror or exc)}", out_dir) from None
+    try:  # os.access is not enough: root passes it, read-only mounts fail only on write
+        fd, probe = tempfile.mkstemp(prefix=".meshvis-probe-", dir=out_dir)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise OutputError(f"output folder is not writable ({one_line(exc.strerror or exc)})", out_dir) from None
+
+
+def fmt_floats(values: np.ndarray) -> list[str]:
+    """Shortest text that reads back to the same float64, per value."""
+    return list(map(repr, np.asarray(values, np.float64).ravel().tolist()))

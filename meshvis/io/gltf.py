@@ -1,0 +1,346 @@
+"""glTF 2.0 / GLB reader (flattened scene, instancing applied) and writer.
+
+Reading: trimesh decodes the primitives (accessors, sparse data, Draco, textures); the
+scene tree is walked here from the file's own JSON, in file order, so that every *node
+instance* becomes one part named after the node (or after its mesh when the node has no
+name), all primitives of the node's mesh belong to that part, and material ids are the
+file's material indices.  A mirroring node transform turns the faces back
+(:meth:`Soup.transformed`).
+
+Writing: one node per part (or per group), one primitive per run of faces with the same
+material (so face order is kept when each part is contiguous), positions as
+float32 relative to the node's translation (the centre of its bounding box, kept in
+float64 in the JSON, which limits the precision lost to float32), UVs, RGBA vertex
+colours and PBR materials with their base colour texture embedded.
+"""
+from __future__ import annotations
+
+import base64
+import json
+import struct
+
+import numpy as np
+
+from meshvis.errors import ModelError, ModelFormatError
+from meshvis.io._common import atomic_write, unique_names, weld_corners
+from meshvis.io.mtl import describe_pbr
+from meshvis.io.scene import mesh_soup, soup_from_scene
+from meshvis.soup import Material, Soup
+
+_GLB_MAGIC = b"glTF"
+_JSON_CHUNK = 0x4E4F534A
+_BIN_CHUNK = 0x004E4942
+
+
+# ---------------------------------------------------------------------------- reading
+def _read_json(path: str, label: str) -> dict:
+    """The glTF JSON document of a .gltf or .glb file."""
+    with open(path, "rb") as fh:
+        data = fh.read()
+    if data[:4] == _GLB_MAGIC:
+        if len(data) < 20:
+            raise ModelFormatError("GLB file is truncated (no JSON chunk)", label)
+        _, _, total = struct.unpack_from("<III", data, 0)
+        if total > len(data):
+            raise ModelFormatError(f"GLB file is truncated: {total} bytes announced, {len(data)} found", label)
+        length, kind = struct.unpack_from("<II", data, 12)
+        if kind != _JSON_CHUNK or 20 + length > len(data):
+            raise ModelFormatError("GLB file has no valid JSON chunk", label)
+        raw = data[20: 20 + length]
+    elif path.lower().endswith(".glb"):
+        raise ModelFormatError("not a GLB file (it does not start with 'glTF')", label)
+    else:
+        raw = data
+    try:
+        doc = json.loads(raw.decode("utf-8"))
+    except (UnicodeDecodeError, ValueError) as exc:
+        raise ModelFormatError(f"glTF JSON does not parse: {str(exc).splitlines()[0]}", label) from None
+    if not isinstance(doc, dict) or "asset" not in doc:
+        raise ModelFormatError("not a glTF document (no 'asset')", label)
+    return doc
+
+
+def _local_matrix(node: dict) -> np.ndarray:
+    """4x4 transform of a glTF node: ``matrix``, or T * R * S."""
+    if "matrix" in node:
+        return np.array(node["matrix"], np.float64).reshape(4, 4).T
+    m = np.eye(4)
+    if "scale" in node:
+        m = np.diag(np.append(np.asarray(node["scale"], np.float64), 1.0)) @ m
+    if "rotation" in node:
+        x, y, z, w = np.asarray(node["rotation"], np.float64)
+        r = np.array([
+            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+        ])
+        rot = np.eye(4)
+        rot[:3, :3] = r
+        m = rot @ m
+    if "translation" in node:
+        t = np.eye(4)
+        t[:3, 3] = node["translation"]
+        m = t @ m
+    return m
+
+
+def _instances(doc: dict) -> list[tuple[int, np.ndarray]]:
+    """(node index, world matrix) of every node with a mesh, depth first in file order."""
+    nodes = doc.get("nodes", [])
+    if "scenes" in doc and doc["scenes"]:
+        scene = doc["scenes"][doc.get("scene", 0) if 0 <= doc.get("scene", 0) < len(doc["scenes"]) else 0]
+        roots = list(scene.get("nodes", []))
+    else:
+        children = {c for n in nodes for c in n.get("children", [])}
+        roots = [i for i in range(len(nodes)) if i not in children]
+    out = []
+    stack = [(r, np.eye(4), ()) for r in reversed(roots)]
+    while stack:
+        i, parent, path = stack.pop()
+        if not (0 <= i < len(nodes)) or i in path:
+            continue  # bad index or a cycle
+        node = nodes[i]
+        world = parent @ _local_matrix(node)
+        if "mesh" in node:
+            out.append((i, world))
+        for c in reversed(node.get("children", [])):
+            stack.append((c, world, path + (i,)))
+    return out
+
+
+def read_gltf(path: str, label: str | None = None) -> Soup:
+    """Read a .glb / .gltf file into a flattened soup (see the module docstring)."""
+    import trimesh
+
+
+    label = label or path
+    doc = _read_json(path, label)
+    with open(path, "rb") as fh:
+        ftype = "glb" if fh.read(4) == _GLB_MAGIC else "gltf"
+    scene = trimesh.load(path, file_type=ftype, force="scene", process=False, maintain_order=True)
+    meshes = doc.get("meshes", [])
+    geoms = list(scene.geometry.values())
+    prim_counts = [len(m.get("primitives", [])) for m in meshes]
+    if sum(prim_counts) != len(geoms):
+        # trimesh skipped or split something: fall back to its own scene graph
+        return soup_from_scene(scene, path=label)
+    first = np.concatenate([[0], np.cumsum(prim_counts)]).astype(int)
+    json_mats = doc.get("materials", [])
+
+    materials: list[Material] = [
+        Material(str(m.get("name") or f"material{i}"), None) for i, m in enumerate(json_mats)
+    ]
+    # a material that meshvis only wrote so that UVs survive stands for "no material"
+    placeholder = {i for i, m in enumerate(json_mats)
+                   if isinstance(m.get("extras"), dict) and m["extras"].get("meshvis_placeholder")}
+    pieces: list[Soup] = []
+    piece_part: list[int] = []
+    names: list[str] = []
+    nodes = doc.get("nodes", [])
+    for node_index, world in _instances(doc):
+        node = nodes[node_index]
+        mi = node["mesh"]
+        if not (0 <= mi < len(meshes)):
+            raise ModelFormatError(f"node {node_index} refers to mesh {mi}, which does not exist", label)
+        name = node.get("name") or meshes[mi].get("name") or f"node{node_index}"
+        added = False
+        for k, prim in enumerate(meshes[mi].get("primitives", [])):
+            geom = geoms[first[mi] + k]
+            if not hasattr(geom, "faces") or len(geom.faces) == 0:
+                continue  # points or lines
+            mat_index = int(prim.get("material", -1))
+            if mat_index in placeholder:
+                mat_index = -1
+            if 0 <= mat_index < len(materials) and materials[mat_index].source is None:
+                materials[mat_index].source = getattr(getattr(geom, "visual", None), "material", None)
+            piece = mesh_soup(geom, name, mat_index if 0 <= mat_index < len(materials) else -1)
+            if not np.allclose(world, np.eye(4)):
+                piece = piece.transformed(world)
+            pieces.append(piece)
+            piece_part.append(len(names))
+            added = True
+        if added:
+            names.append(name)
+    if not pieces:
+        raise ModelError("the model has no faces", label)
+    soup = Soup.concatenate(pieces)
+    soup.part_id = np.repeat(np.array(piece_part, np.int64), [p.n_faces for p in pieces])
+    soup.part_names = unique_names(names, "node")
+    if placeholder:  # drop the placeholders and renumber the others
+        keep = [i for i in range(len(materials)) if i not in placeholder]
+        new_id = np.full(len(materials), -1, np.int64)
+        new_id[keep] = np.arange(len(keep))
+        soup.material_id = np.where(soup.material_id >= 0, new_id[np.maximum(soup.material_id, 0)], -1)
+        materials = [materials[i] for i in keep]
+    soup.materials = materials
+    soup.path = label
+    return soup
+
+
+# ---------------------------------------------------------------------------- writing
+class _Buffer:
+    """Binary buffer with 4-byte aligned views."""
+
+    def __init__(self) -> None:
+        self.chunks: list[bytes] = []
+        self.size = 0
+        self.views: list[dict] = []
+        self.accessors: list[dict] = []
+
+    def view(self, data: bytes, target: int | None = None) -> int:
+        pad = (-self.size) % 4
+        if pad:
+            self.chunks.append(b"\x00" * pad)
+            self.size += pad
+        v = {"buffer": 0, "byteOffset": self.size, "byteLength": len(data)}
+        if target is not None:
+            v["target"] = target
+        self.chunks.append(data)
+        self.size += len(data)
+        self.views.append(v)
+        return len(self.views) - 1
+
+    def accessor(self, array: np.ndarray, kind: str, component: int, target: int | None,
+                 normalized: bool = False, with_bounds: bool = False) -> int:
+        view = self.view(np.ascontiguousarray(array).tobytes(), target)
+        acc = {"bufferView": view, "componentType": component, "count": int(len(array)), "type": kind}
+        if normalized:
+            acc["normalized"] = True
+        if with_bounds:
+            a = np.asarray(array).reshape(len(array), -1)
+            acc["min"] = a.min(axis=0).tolist()
+            acc["max"] = a.max(axis=0).tolist()
+        self.accessors.append(acc)
+        return len(self.accessors) - 1
+
+    def data(self) -> bytes:
+        blob = b"".join(self.chunks)
+        return blob + b"\x00" * ((-len(blob)) % 4)
+
+
+def write_gltf(soup: Soup, path: str, groups=None, group_names=None, face_values=None, *, binary: bool = True) -> None:
+    """Write ``soup`` as GLB (``binary=True``) or as one self-contained .gltf (see the module docstring)."""
+
+    buf = _Buffer()
+    if groups is not None:
+        node_of_face = groups
+        node_names = list(group_names or [])
+    else:
+        node_of_face = soup.part_id
+        node_names = list(soup.part_names)
+    node_names = unique_names(node_names + [f"node{i}" for i in range(len(node_names), int(node_of_face.max()) + 1)],
+                              "node")
+
+    mat_names = unique_names([m.name for m in soup.materials], "material")
+    gl_materials, images, textures = [], [], []
+    image_cache: dict[bytes, int] = {}
+    for mat, name in zip(soup.materials, mat_names):
+        desc = describe_pbr(mat, name)
+        pbr = {"baseColorFactor": [float(x) for x in desc.base_color]}
+        pbr["metallicFactor"] = float(desc.metallic) if desc.metallic is not None else 0.0
+        pbr["roughnessFactor"] = float(desc.roughness) if desc.roughness is not None else 1.0
+        if desc.image is not None:
+            if desc.image not in image_cache:
+                view = buf.view(desc.image)
+                images.append({"bufferView": view, "mimeType": desc.mime or "image/png"})
+                textures.append({"source": len(images) - 1, "sampler": 0})
+                image_cache[desc.image] = len(textures) - 1
+            pbr["baseColorTexture"] = {"index": image_cache[desc.image]}
+        entry = {"name": name, "pbrMetallicRoughness": pbr}
+        if desc.double_sided:
+            entry["doubleSided"] = True
+        if desc.alpha_mode in ("MASK", "BLEND"):
+            entry["alphaMode"] = desc.alpha_mode
+        gl_materials.append(entry)
+
+    # UVs are only read back with a material: faces without one get a marked placeholder
+    placeholder = -1
+    if soup.uv is not None and (soup.material_id < 0).any():
+        placeholder = len(gl_materials)
+        gl_materials.append({"name": "meshvis_none", "extras": {"meshvis_placeholder": True},
+                             "pbrMetallicRoughness": {"metallicFactor": 0.0}})
+
+    _, first = np.unique(node_of_face, return_index=True)
+    node_order = node_of_face[np.sort(first)]
+    nodes, meshes = [], []
+    for g in node_order.tolist():
+        sel = np.flatnonzero(node_of_face == g)
+        part = soup.subset(sel)
+        lo, hi = part.bounds
+        centre = (lo + hi) / 2.0
+        primitives = []
+        # one primitive per run of faces with the same material: face order is kept
+        mids = part.material_id
+        change = np.ones(len(mids), bool)
+        change[1:] = mids[1:] != mids[:-1]
+        run_start = np.flatnonzero(change)
+        for a, b in zip(run_start.tolist(), np.append(run_start[1:], len(mids)).tolist()):
+            mt = int(mids[a])
+            piece = part.subset(np.arange(a, b))
+            corner_src, faces = weld_corners(piece)
+            pos = (piece.vertices[piece.faces.reshape(-1)[corner_src]] - centre).astype(np.float32)
+            attrs = {"POSITION": buf.accessor(pos, "VEC3", 5126, 34962, with_bounds=True)}
+            if piece.uv is not None:
+                uv = piece.uv.reshape(-1, 2)[corner_src].astype(np.float32)
+                uv[:, 1] = 1.0 - uv[:, 1]  # glTF's v axis points down
+                attrs["TEXCOORD_0"] = buf.accessor(uv, "VEC2", 5126, 34962)
+            if piece.colors is not None:
+                col = piece.colors.reshape(-1, 4)[corner_src]
+                attrs["COLOR_0"] = buf.accessor(col, "VEC4", 5121, 34962, normalized=True)
+            prim = {"attributes": attrs,
+                    "indices": buf.accessor(faces.astype(np.uint32).reshape(-1), "SCALAR", 5125, 34963),
+                    "mode": 4}
+            if mt >= 0:
+                prim["material"] = mt
+            elif placeholder >= 0:
+                prim["material"] = placeholder
+            primitives.append(prim)
+        meshes.append({"name": node_names[g], "primitives": primitives})
+        nodes.append({"name": node_names[g], "mesh": len(meshes) - 1,
+                      "translation": [float(c) for c in centre]})
+
+    doc: dict = {
+        "asset": {"version": "2.0", "generator": "meshvis"},
+        "scene": 0,
+        "scenes": [{"nodes": list(range(len(nodes)))}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "accessors": buf.accessors,
+        "bufferViews": buf.views,
+    }
+    if gl_materials:
+        doc["materials"] = gl_materials
+    if textures:
+        doc["textures"] = textures
+        doc["images"] = images
+        doc["samplers"] = [{}]
+    blob = buf.data()
+    if binary:
+        doc["buffers"] = [{"byteLength": len(blob)}]
+        js = json.dumps(doc, separators=(",", ":")).encode("utf-8")
+        js += b" " * ((-len(js)) % 4)
+        total = 12 + 8 + len(js) + 8 + len(blob)
+        with atomic_write(path, "wb") as fh:
+            fh.write(struct.pack("<4sII", _GLB_MAGIC, 2, total))
+            fh.write(struct.pack("<II", len(js), _JSON_CHUNK))
+            fh.write(js)
+            fh.write(struct.pack("<II", len(blob), _BIN_CHUNK))
+            fh.write(blob)
+    else:
+        uri = "data:application/octet-stream;base64," + base64.b64encode(blob).decode("ascii")
+        doc["buffers"] = [{"byteLength": len(blob), "uri": uri}]
+        with atomic_write(path, "w") as fh:
+            json.dump(doc, fh, separators=(",", ":"))
+
+
+def _write_glb(soup, path, groups, group_names, face_values):
+    write_gltf(soup, path, groups, group_names, binary=True)
+
+
+def _write_gltf_json(soup, path, groups, group_names, face_values):
+    write_gltf(soup, path, groups, group_names, binary=False)
+
+
+#: format name -> reader / writer, collected by :mod:`meshvis.io.reading` and :mod:`meshvis.io.writing`
+READERS = {"glb": read_gltf, "gltf": read_gltf}
+WRITERS = {"glb": _write_glb, "gltf": _write_gltf_json}

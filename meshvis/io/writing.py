@@ -1,0 +1,102 @@
+"""Writing models: :func:`save` checks the output path and the per-face arrays, then hands
+the soup to the format's writer.
+
+Each format module declares what it writes in a ``WRITERS`` mapping (format name ->
+``writer(soup, path, groups, group_names, face_values)``); this module collects them.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import replace
+from typing import Mapping
+
+import numpy as np
+
+from meshvis.errors import OutputError, ParameterError
+from meshvis.io import gltf, obj, off, ply, stl
+from meshvis.io.convert import as_soup
+from meshvis.soup import Material, Soup
+
+#: file extension -> format name, for writing
+WRITE_FORMATS = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".off": "off", ".glb": "glb", ".gltf": "gltf"}
+
+#: format name -> writer, collected from the format modules
+WRITERS = {**obj.WRITERS, **ply.WRITERS, **stl.WRITERS, **off.WRITERS, **gltf.WRITERS}
+
+
+def save(
+    soup: Soup,
+    path: str | os.PathLike,
+    *,
+    face_groups: np.ndarray | None = None,
+    group_names: list[str] | None = None,
+    face_values: Mapping[str, np.ndarray] | None = None,
+) -> None:
+    """Write a soup to an OBJ, PLY, STL, OFF, GLB or glTF file, atomically.
+
+    Parameters
+    ----------
+    soup : Soup (or anything :func:`meshvis.soup.as_soup` accepts)
+    path : str or path-like
+        The extension picks the format.
+    face_groups : (m,) int, optional
+        A group number per face (e.g. a layer); written as OBJ ``g`` groups inside the
+        parts, as one glTF node per group, and as a ``group`` face property in PLY.
+    group_names : list of str, optional
+        Name of each group number; default ``group<k>``.
+    face_values : dict name -> (m,) array, optional
+        Per-face numbers written as PLY face properties (ignored by the other formats).
+
+    What each format keeps
+    ----------------------
+    * OBJ: parts (``o``), groups (``g``), materials (an MTL file next to the OBJ, textures
+      copied next to it), UVs, vertex colours (RGB).
+    * PLY (binary): vertex colours (RGBA), UVs (welded per vertex), part / material /
+      group ids as face properties with their names in header comments, ``face_values``.
+    * GLB / glTF: one node per part (or per group), one primitive per run of faces with
+      the same material (face order is kept when each part's faces are contiguous), UVs,
+      vertex colours, materials with their base colour texture; float32 positions
+      relative to each node's centre.
+    * STL (binary, float32): geometry only.  OFF: geometry and vertex colours.
+
+    Raises
+    ------
+    OutputError
+        Unknown extension, missing or unwritable folder.
+    ParameterError
+        ``face_groups`` / ``face_values`` of the wrong length.
+    """
+    path = os.fspath(path)
+    soup = as_soup(soup)
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in WRITE_FORMATS:
+        known = ", ".join(sorted(WRITE_FORMATS))
+        raise OutputError(f"cannot write '{ext or '(no extension)'}' files; known: {known}", path)
+    folder = os.path.dirname(os.path.abspath(path))
+    if not os.path.isdir(folder):
+        raise OutputError("output folder does not exist", path)
+    if not os.access(folder, os.W_OK):
+        raise OutputError("output folder is not writable", path)
+    m = soup.n_faces
+    groups = None
+    if face_groups is not None:
+        groups = np.asarray(face_groups).astype(np.int64, copy=False).reshape(-1)
+        if len(groups) != m:
+            raise ParameterError(f"face_groups has {len(groups)} entries for {m} faces")
+        if m and groups.min() < 0:
+            raise ParameterError("face_groups must be non-negative")
+        n_groups = int(groups.max()) + 1 if m else 0
+        names = list(group_names) if group_names is not None else []
+        names += [f"group{k}" for k in range(len(names), n_groups)]
+        group_names = [str(n) for n in names]
+    values = {}
+    for key, val in (face_values or {}).items():
+        val = np.asarray(val)
+        if val.shape[:1] != (m,) or val.ndim != 1:
+            raise ParameterError(f"face_values[{key!r}] must have one value per face ({m})")
+        values[str(key)] = val
+    n_mat = int(soup.material_id.max()) + 1 if m else 0
+    if n_mat > len(soup.materials):  # ids without a Material: give them one so writers can name them
+        extra = [Material(f"material{i}") for i in range(len(soup.materials), n_mat)]
+        soup = replace(soup, materials=list(soup.materials) + extra)
+    WRITERS[WRITE_FORMATS[ext]](soup, path, groups, group_names, values)

@@ -1,0 +1,199 @@
+"""A pinhole (or orthographic) camera: primary rays and projection of points to pixels.
+
+Pixel convention: x grows to the right, y grows downwards, pixel (0, 0) is the top-left
+pixel and its centre is at (0.5, 0.5).  The vertical field of view ``fov`` is in degrees.
+"""
+from __future__ import annotations
+
+import os
+from dataclasses import asdict, dataclass, field
+from typing import Any
+
+import numpy as np
+
+from meshvis.errors import ParameterError
+
+#: unit vectors of the axis names accepted as "up"
+AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, float, float]:
+    """The up vector for an axis name, or for ``"auto"``: +y when every file is glTF/GLB
+    (the format fixes y up), +z otherwise (the CAD and scanning convention)."""
+    if name != "auto":
+        return AXES[name]
+    gltf = bool(paths) and all(os.path.splitext(str(p))[1].lower() in (".gltf", ".glb") for p in paths)
+    return AXES["y"] if gltf else AXES["z"]
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v)
+    if n == 0:
+        raise ParameterError("camera vectors must not be zero")
+    return v / n
+
+
+@dataclass
+class Camera:
+    """A camera looking from ``position`` at ``target``.
+
+    Parameters
+    ----------
+    position, target : (3,) float
+    up : (3,) float, approximate up direction (default +y, as in glTF and most OBJ files)
+    fov : float, vertical field of view in degrees (perspective)
+    orthographic : bool
+    ortho_height : float, height of the view in model units (orthographic)
+
+    Examples
+    --------
+    >>> cam = Camera((0, -5, 0), (0, 0, 0))
+    >>> o, d = cam.rays(4, 4)
+    >>> o.shape, d.shape
+    ((16, 3), (16, 3))
+    """
+
+    position: Any
+    target: Any
+    up: Any = field(default=(0.0, 1.0, 0.0))
+    fov: float = 35.0
+    orthographic: bool = False
+    ortho_height: float | None = None
+
+    def __post_init__(self) -> None:
+        self.position = np.asarray(self.position, np.float64).reshape(3)
+        self.target = np.asarray(self.target, np.float64).reshape(3)
+        self.up = np.asarray(self.up, np.float64).reshape(3)
+        if not (np.isfinite(self.position).all() and np.isfinite(self.target).all()):
+            raise ParameterError("camera position and target must be finite")
+        if not 0 < self.fov < 180:
+            raise ParameterError(f"field of view must be in (0, 180) degrees, got {self.fov}")
+
+    # ------------------------------------------------------------------ frame
+    def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """Unit vectors (right, true up, forward)."""
+        forward = _unit(self.target - self.position)
+        up = self.up
+        if abs(np.dot(_unit(up), forward)) > 0.999:  # looking along up: pick another up
+            up = np.array([0.0, 1.0, 0.0]) if abs(forward[1]) < 0.9 else np.array([1.0, 0.0, 0.0])
+        right = _unit(np.cross(forward, up))
+        true_up = np.cross(right, forward)
+        return right, true_up, forward
+
+    def _half_height(self) -> float:
+        if self.orthographic:
+            h = self.ortho_height or np.linalg.norm(self.target - self.position)
+            return 0.5 * float(h)
+        return float(np.tan(np.radians(self.fov) / 2))
+
+    # ------------------------------------------------------------------ rays and projection
+    def rays(self, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """Primary rays through every pixel centre, row-major from the top-left pixel.
+
+        Returns
+        -------
+        origins, directions : (height*width, 3) float64 (directions are unit vectors)
+        """
+        row, col = np.divmod(np.arange(width * height), width)
+        return self.pixel_rays(col, row, width, height)
+
+    def pixel_rays(self, col: np.ndarray, row: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """Primary rays through the centres of the given pixels of a ``width`` x ``height`` image.
+
+        Returns
+        -------
+        origins, directions : (n, 3) float64 (directions are unit vectors)
+        """
+        right, up, forward = self.basis()
+        hh = self._half_height()
+        hw = hh * width / height
+        gx = ((np.asarray(col) + 0.5) / width * 2 - 1) * hw
+        gy = (1 - (np.asarray(row) + 0.5) / height * 2) * hh
+        if self.orthographic:
+            origins = self.position + gx[:, None] * right + gy[:, None] * up
+            directions = np.broadcast_to(forward, origins.shape).copy()
+        else:
+            directions = forward + gx[:, None] * right + gy[:, None] * up
+            directions /= np.linalg.norm(directions, axis=1, keepdims=True)
+            origins = np.broadcast_to(self.position, directions.shape).copy()
+        return origins, directions
+
+    def project(self, points: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+        """Pixel coordinates (x right, y down) and depth along the view axis of 3D points."""
+        right, up, forward = self.basis()
+        rel = np.asarray(points, np.float64).reshape(-1, 3) - self.position
+        x, y, z = rel @ right, rel @ up, rel @ forward
+        hh = self._half_height()
+        hw = hh * width / height
+        if self.orthographic:
+            u, v = x / hw, y / hh
+        else:
+            with np.errstate(divide="ignore", invalid="ignore"):
+                u, v = x / (z * hw), y / (z * hh)
+        px = (u + 1) / 2 * width
+        py = (1 - v) / 2 * height
+        return np.stack([px, py], axis=1), z
+
+    # ------------------------------------------------------------------ construction
+    @classmethod
+    def fit(
+        cls,
+        model: Any,
+        azimuth: float = 30.0,
+        elevation: float = 20.0,
+        distance: float | None = None,
+        fov: float = 35.0,
+        orthographic: bool = False,
+        margin: float = 1.0,
+        up: Any = (0.0, 1.0, 0.0),
+    ) -> "Camera":
+        """A camera framing the model's bounding sphere.
+
+        ``azimuth`` turns around the up axis, ``elevation`` lifts the camera above the
+        horizon; both in degrees.  ``distance`` defaults to the distance
+        at which the bounding sphere (times ``margin``) fills the view.
+        """
+        bounds = _bounds_of(model)
+        center = bounds.mean(axis=0)
+        radius = 0.5 * float(np.linalg.norm(bounds[1] - bounds[0])) or 1.0
+        up = _unit(np.asarray(up, np.float64))
+        # a horizontal frame orthogonal to up; azimuth 0 views the model's "front": from +z
+        # for y-up models (glTF, most OBJ), from -y for z-up models (CAD, STL)
+        ref = np.array([0.0, 0.0, 1.0]) if abs(up[2]) < 0.9 else np.array([0.0, -1.0, 0.0])
+        e1 = _unit(ref - np.dot(ref, up) * up)
+        e2 = np.cross(up, e1)
+        az, el = np.radians(azimuth), np.radians(elevation)
+        view = np.cos(el) * (np.cos(az) * e1 + np.sin(az) * e2) + np.sin(el) * up  # from target to camera
+        if distance is None:
+            distance = margin * radius / np.sin(np.radians(fov) / 2)
+        position = center + view * distance
+        return cls(position, center, up, fov, orthographic, 2 * margin * radius if orthographic else None)
+
+    @classmethod
+    def orbit(cls, model: Any, n_frames: int, elevation: float = 20.0, start: float = 30.0, **kw: Any) -> list["Camera"]:
+        """``n_frames`` cameras turning once around the model."""
+        return [cls.fit(model, azimuth=start + 360.0 * k / n_frames, elevation=elevation, **kw) for k in range(n_frames)]
+
+    def to_json(self) -> dict:
+        d = asdict(self)
+        for k in ("position", "target", "up"):
+            d[k] = [float(x) for x in getattr(self, k)]
+        return d
+
+    @classmethod
+    def from_json(cls, d: dict) -> "Camera":
+        known = {"position", "target", "up", "fov", "orthographic", "ortho_height"}
+        unknown = set(d) - known
+        if unknown:
+            raise ParameterError(f"unknown camera keys: {', '.join(sorted(unknown))}")
+        return cls(**d)
+
+
+def _bounds_of(model: Any) -> np.ndarray:
+    if hasattr(model, "bounds") and not callable(model.bounds):
+        b = np.asarray(model.bounds, np.float64)
+        if b.shape == (2, 3):
+            return b
+    from meshvis.io import as_soup
+
+    return as_soup(model).bounds

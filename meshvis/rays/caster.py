@@ -1,0 +1,235 @@
+"""The ray-visibility backend: the only module that talks to Embree (through ``embreex``).
+
+Embree works in float32.  To keep float32 round-off independent of where the model sits
+and how big it is, the scene is built on a *normalised* copy of the model: centred on its
+bounding-box centre and scaled to unit bounding-box diagonal.  Callers pass and receive
+input coordinates (float64); the mapping happens here.
+
+Origins that lie on a surface must be pushed off it (Embree's ray always starts at t = 0,
+so an origin exactly on its own triangle hits it about half of the time).  The push is
+``offset`` (default 1e-5) times the diagonal, i.e. far above float32 resolution of the
+normalised copy (about 6e-8) and far below any feature users care about.
+
+Threads or processes?  ``embreex`` releases the GIL while it traces, so two threads
+trace a large batch 1.5–1.8 times as fast as one on a 2-core machine (docs/performance.md);
+processes would have to rebuild the scene and copy the rays and results, and measure
+slower.  ``meshvis bench rays`` measures all three side by side.
+"""
+from __future__ import annotations
+
+import os
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from meshvis.io import as_soup
+
+#: default push of an origin off its surface, as a fraction of the bounding-box diagonal
+DEFAULT_OFFSET = 1e-5
+#: rays per chunk handed to one thread; large enough to amortise the call overhead
+CHUNK = 1 << 17
+
+
+def default_threads() -> int:
+    """Threads used for large batches: the ``MESHVIS_THREADS`` variable or the core count."""
+    env = os.environ.get("MESHVIS_THREADS")
+    if env:
+        return max(1, int(env))
+    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
+
+
+@dataclass
+class Hits:
+    """First hits of a batch of rays, in input coordinates.
+
+    Attributes
+    ----------
+    face : (n,) int64, index of the face hit, -1 for a miss
+    distance : (n,) float64, distance along the (unit) direction, ``inf`` for a miss
+    side : (n,) int8, 0 when the ray hit the front (counter-clockwise) side, 1 the back, -1 miss
+    bary : (n, 2) float32, barycentric coordinates (u, v) of the hit on its face: the point
+        is ``(1-u-v) a + u b + v c`` for the face's corners (a, b, c)
+    """
+
+    face: np.ndarray
+    distance: np.ndarray
+    side: np.ndarray
+    bary: np.ndarray | None = None
+
+    @property
+    def hit(self) -> np.ndarray:
+        return self.face >= 0
+
+    def points(self, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
+        """Hit points (NaN rows for misses)."""
+        d = directions / np.linalg.norm(directions, axis=1, keepdims=True)
+        return origins + d * self.distance[:, None]
+
+
+class RayCaster:
+    """Batched ray queries against one model, built once and reused by every stage.
+
+    Parameters
+    ----------
+    model : Soup, trimesh.Trimesh or (vertices, faces)
+        The geometry.  Degenerate faces are kept (Embree skips them).
+    offset : float
+        Push of surface origins off their surface, relative to the bounding-box diagonal.
+    threads : int, optional
+        Threads for large batches (default: :func:`default_threads`).
+
+    Examples
+    --------
+    >>> import numpy as np, trimesh
+    >>> rc = RayCaster(trimesh.creation.box())
+    >>> h = rc.intersect(np.array([[0., 0, 5]]), np.array([[0., 0, -1]]))
+    >>> int(h.side[0]), float(h.distance[0])
+    (0, 4.5)
+    """
+
+    def __init__(self, model: Any, *, offset: float = DEFAULT_OFFSET, threads: int | None = None):
+        import embreex.mesh_construction as mc
+        import embreex.rtcore_scene as rs
+
+        soup = as_soup(model)
+        self.soup = soup
+        self.offset = float(offset)
+        self.threads = default_threads() if threads is None else max(1, int(threads))
+        lo, hi = soup.bounds
+        self.center = 0.5 * (lo + hi)
+        diag = soup.diagonal
+        # a model that is a single point (all faces degenerate) still gets a usable scale
+        self.scale = 1.0 / diag if diag > 0 else 1.0
+        self.diagonal = diag if diag > 0 else 1.0
+        self.normals = soup.normals
+        self.part_id = soup.part_id
+        v32 = ((soup.vertices - self.center) * self.scale).astype(np.float32)
+        # Vertices unused by faces may be far away or non-finite: clamp them harmlessly.
+        v32[~np.isfinite(v32).all(axis=1)] = 0
+        self._scene = rs.EmbreeScene()
+        self._mesh = mc.TriangleMesh(self._scene, v32, soup.faces.astype(np.int32))
+
+    # ------------------------------------------------------------------ coordinates
+    def to_unit(self, points: np.ndarray) -> np.ndarray:
+        """Input coordinates -> normalised float32 coordinates of the Embree scene."""
+        return ((np.asarray(points, np.float64) - self.center) * self.scale).astype(np.float32)
+
+    @staticmethod
+    def _unit_dirs(directions: np.ndarray) -> np.ndarray:
+        d = np.asarray(directions, np.float64)
+        return d / np.sqrt(np.einsum("ij,ij->i", d, d))[:, None]
+
+    # ------------------------------------------------------------------ raw calls
+    def _run(self, o32: np.ndarray, d32: np.ndarray, query: str, dists: np.ndarray | None = None) -> Any:
+        """One Embree query over a batch, split over threads when it is large."""
+        n = len(o32)
+        if n == 0:
+            if query == "INTERSECT":
+                return {"primID": np.zeros(0, np.int32), "tfar": np.zeros(0, np.float32), "Ng": np.zeros((0, 3), np.float32),
+                        "u": np.zeros(0, np.float32), "v": np.zeros(0, np.float32)}
+            return np.zeros(0, np.int32)
+
+        def call(sl: slice) -> Any:
+            kw = {} if dists is None else {"dists": np.ascontiguousarray(dists[sl])}
+            if query == "INTERSECT":
+                return self._scene.run(np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), output=1, **kw)
+            return self._scene.run(np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), query=query, **kw)
+
+        if self.threads == 1 or n < 2 * CHUNK:
+            return call(slice(0, n))
+        k = max(self.threads, -(-n // (4 * CHUNK)) * self.threads)
+        bounds = np.linspace(0, n, k + 1).astype(int)
+        slices = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
+        with ThreadPoolExecutor(self.threads) as pool:
+            parts = list(pool.map(call, slices))
+        if query == "INTERSECT":
+            return {
+                "primID": np.concatenate([p["primID"] for p in parts]),
+                "tfar": np.concatenate([p["tfar"] for p in parts]),
+                "Ng": np.concatenate([p["Ng"] for p in parts]),
+                "u": np.concatenate([p["u"] for p in parts]),
+                "v": np.concatenate([p["v"] for p in parts]),
+            }
+        return np.concatenate(parts)
+
+    # ------------------------------------------------------------------ public queries
+    def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: np.ndarray | float | None = None,
+                  *, exact_distance: bool = False) -> Hits:
+        """First hit of every ray ``origins + t * directions``, ``0 <= t <= max_distance``.
+
+        Parameters
+        ----------
+        origins, directions : (n, 3) float arrays in input coordinates (directions need not be unit)
+        max_distance : optional float or (n,) array, in input units
+        exact_distance : recompute each distance in float64 on the hit triangle's plane
+            (otherwise it carries float32 round-off, about 1e-7 of the diagonal)
+
+        Returns
+        -------
+        Hits
+            ``side`` is 0 where ``dot(direction, normal) < 0`` (the ray met the front).
+        """
+        origins = np.asarray(origins, np.float64).reshape(-1, 3)
+        d = self._unit_dirs(np.asarray(directions).reshape(-1, 3))
+        dists = None
+        if max_distance is not None:
+            dists = np.broadcast_to(np.asarray(max_distance, np.float64) * self.scale, (len(origins),)).astype(np.float32)
+        r = self._run(self.to_unit(origins), d.astype(np.float32), "INTERSECT", dists)
+        face = r["primID"].astype(np.int64)
+        hit = face >= 0
+        distance = np.full(len(face), np.inf)
+        distance[hit] = r["tfar"][hit].astype(np.float64) / self.scale
+        # side from Embree's geometric normal, which points like ours (counter-clockwise)
+        dots = np.einsum("ij,ij->i", d, r["Ng"])
+        side = np.where(hit, dots >= 0, -1).astype(np.int8)
+        if exact_distance and hit.any():
+            # Refine in float64 on the hit triangle's plane (not for grazing hits).
+            idx = np.flatnonzero(hit)
+            n_hit = self.normals[face[idx]]
+            cosine = np.einsum("ij,ij->i", d[idx], n_hit)
+            v0 = self.soup.vertices[self.soup.faces[face[idx], 0]]
+            steep = np.abs(cosine) > 1e-3
+            t_plane = np.einsum("ij,ij->i", n_hit[steep], v0[steep] - origins[idx[steep]]) / cosine[steep]
+            distance[idx[steep]] = np.maximum(t_plane, 0.0)
+        return Hits(face, distance, side, np.stack([r["u"], r["v"]], axis=1))
+
+    def occluded(self, origins: np.ndarray, targets: np.ndarray) -> np.ndarray:
+        """True where the open segment ``origins -> targets`` meets geometry.
+
+        Both ends are excluded by ``offset`` × diagonal, so a target lying on a surface does
+        not occlude itself; push origins off their own surface first (:meth:`push_off`).
+        """
+        origins = np.asarray(origins, np.float64).reshape(-1, 3)
+        targets = np.asarray(targets, np.float64).reshape(-1, 3)
+        seg = targets - origins
+        length = np.linalg.norm(seg, axis=1)
+        ok = length > 0
+        d = np.zeros_like(seg)
+        d[ok] = seg[ok] / length[ok, None]
+        d[~ok] = (0.0, 0.0, 1.0)
+        dist = np.maximum(length * self.scale - self.offset, 0.0).astype(np.float32)
+        r = self._run(self.to_unit(origins), d.astype(np.float32), "OCCLUDED", dist)
+        return (r != -1) & ok
+
+    def push_off(self, points: np.ndarray, face: np.ndarray, side: np.ndarray) -> np.ndarray:
+        """Move points lying on ``face`` off its surface, towards ``side`` (0 front, 1 back)."""
+        sign = np.where(np.asarray(side) == 0, 1.0, -1.0)
+        return points + self.normals[face] * (sign * self.offset * self.diagonal)[:, None]
+
+    def intersect_from_surface(self, points: np.ndarray, face: np.ndarray, side: np.ndarray, directions: np.ndarray) -> Hits:
+        """Like :meth:`intersect` for rays that start on ``face`` and leave it on ``side``."""
+        return self.intersect(self.push_off(points, face, side), directions)
+
+    def part_of(self, face: np.ndarray) -> np.ndarray:
+        """Part id of each face index (-1 for misses)."""
+        face = np.asarray(face)
+        out = np.full(face.shape, -1, np.int64)
+        hit = face >= 0
+        out[hit] = self.part_id[face[hit]]
+        return out
+
+    def __repr__(self) -> str:
+        return f"<RayCaster {self.soup.n_faces} faces, {self.threads} threads>"
+

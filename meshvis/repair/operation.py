@@ -1,0 +1,128 @@
+"""One repair operation on one loaded model, with its outputs: the unit of work shared by
+the single-file commands and ``meshvis batch``.
+
+Options are a plain mapping (an ``argparse.Namespace`` works too) whose keys and
+defaults are :func:`default_options`; the command line takes its defaults from here, so a
+batch file is processed exactly as the single-file command would process it.
+"""
+from __future__ import annotations
+
+from typing import Any, Callable, Mapping
+
+import numpy as np
+
+from meshvis.errors import ParameterError
+
+#: operations that classify a model and write a result
+OPERATIONS = ("classify", "orient", "remove-interior", "layers")
+
+#: options of the classification, shared by every operation
+CLASSIFY_DEFAULTS: dict[str, Any] = {
+    "seed": 0, "rays_per_node": 32, "samples_per_face": 4, "no_filter": False, "no_progressive": False,
+    "solver": "pymaxflow", "inside_point": [], "outside_point": [], "inside_box": [], "outside_box": [],
+}
+#: options of each operation on top of the classification
+OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
+    "classify": {},
+    "orient": {"front": "ccw", "two_sided": "keep", "semantics": "layer", "conflicts": "majority"},
+    "remove-interior": {},
+    "layers": {"max_layers": None},
+}
+#: where results go (None: not written)
+OUTPUT_KEYS = ("output", "report", "preview", "removed", "graphml")
+
+
+def default_options(op: str) -> dict[str, Any]:
+    """Every option of ``op`` with its default value."""
+    if op not in OPERATIONS:
+        raise ParameterError(f"unknown operation {op!r}; choose one of {', '.join(OPERATIONS)}")
+    return {**CLASSIFY_DEFAULTS, **OPERATION_DEFAULTS[op]}
+
+
+def _options(options: Mapping[str, Any] | Any) -> dict[str, Any]:
+    return dict(options) if isinstance(options, Mapping) else dict(vars(options))
+
+
+def classify_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
+    """Keyword arguments of :func:`meshvis.classify` from operation options."""
+    from meshvis.graphcut.hints import Hints
+
+    o = {**CLASSIFY_DEFAULTS, **_options(options)}
+    hints = None
+    if o["inside_point"] or o["outside_point"] or o["inside_box"] or o["outside_box"]:
+        hints = Hints(inside_points=np.array(o["inside_point"], np.float64).reshape(-1, 3),
+                      outside_points=np.array(o["outside_point"], np.float64).reshape(-1, 3),
+                      inside_boxes=np.array(o["inside_box"], np.float64).reshape(-1, 2, 3),
+                      outside_boxes=np.array(o["outside_box"], np.float64).reshape(-1, 2, 3))
+    return dict(rays_per_node=int(o["rays_per_node"]), seed=int(o["seed"]),
+                samples_per_face=int(o["samples_per_face"]), use_filter=not o["no_filter"],
+                progressive=not o["no_progressive"], solver=o["solver"], hints=hints)
+
+
+def run_operation(op: str, soup, options: Mapping[str, Any] | Any, progress: Callable | None = None,
+                  say: Callable[[str], None] | None = None) -> dict:
+    """Classify ``soup``, apply ``op``, write the outputs named in ``options``, return the report.
+
+    Parameters
+    ----------
+    op : one of :data:`OPERATIONS`
+    soup : a loaded :class:`~meshvis.soup.Soup`
+    options : operation options (see :func:`default_options`) plus the output paths
+        ``output``, ``preview``, ``removed``, ``graphml`` (the report is the caller's)
+    progress : ``progress(stage, fraction)`` callback of :func:`meshvis.classify`
+    say : where to print one-line summaries (default: nowhere)
+
+    Returns
+    -------
+    dict, the JSON report (per-face arrays, counts, stages, rays, nodes, edges, timings, seed)
+    """
+    from meshvis.graphcut.classify import classify
+    from meshvis.io import atomic_write, save
+    from meshvis.repair.layers import layers
+    from meshvis.repair.orient import orient
+    from meshvis.repair.remove import remove_interior
+    from meshvis.rays.render import render, render_layers, save_png
+
+    o = {**default_options(op), **{k: None for k in OUTPUT_KEYS}, **_options(options)}
+    tell = say or (lambda text: None)
+    c = classify(soup, progress=progress, **classify_kwargs(o))
+    tell(c.summary())
+    if op == "classify":
+        report = c.report()
+        if o["graphml"]:
+            import networkx as nx
+
+            with atomic_write(o["graphml"], "wb") as fh:
+                nx.write_graphml(c.graph.to_networkx({"area": c.nodes.area}), fh)
+        if o["preview"]:
+            save_png(render(soup, color_by="side").image, o["preview"])
+    elif op == "orient":
+        r = orient(soup, classification=c, front=o["front"], two_sided=o["two_sided"],
+                   semantics=o["semantics"], conflicts=o["conflicts"])
+        save(r.soup, o["output"])
+        report = r.report()
+        tell(f"flipped {report['flipped']} of {report['input_faces']} faces; "
+             f"{report['status_counts']}; wrote {o['output']} ({r.soup.n_faces} faces)")
+        if o["preview"]:
+            save_png(render(r.soup, color_by="side").image, o["preview"])
+    elif op == "remove-interior":
+        r = remove_interior(soup, classification=c)
+        save(r.kept, o["output"])
+        if o["removed"]:
+            save(r.removed, o["removed"])
+        report = r.report()
+        tell(f"kept {report['kept_faces']}, removed {report['removed_faces']} of {report['input_faces']} faces; "
+             f"wrote {o['output']}" + (f" and {o['removed']}" if o["removed"] else ""))
+        if o["preview"]:
+            save_png(render(r.kept, color_by="side").image, o["preview"])
+    else:  # layers
+        r = layers(soup, classification=c, max_layers=o["max_layers"])
+        names = [f"layer{k}" for k in range(1, int(r.layer.max()) + 1)]
+        save(soup, o["output"], face_groups=r.layer - 1, group_names=names, face_values={"layer": r.layer})
+        report = r.report()
+        tell(f"{r.n_layers} layers, faces per layer {report['faces_per_layer']}; wrote {o['output']}")
+        if o["preview"]:
+            save_png(render_layers(soup, r.layer), o["preview"])
+    report["operation"] = op
+    report["seed"] = o["seed"]
+    return report

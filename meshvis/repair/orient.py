@@ -1,0 +1,287 @@
+"""Normal orientation (appendix H §5, "Normal Orientation").
+
+Every face whose sides got exactly one outside label (or whose sample points agree) is
+turned so that its front faces the outside.  The other cases are decided by options:
+
+* two-sided faces (both sides outside: sheets, leaves): ``keep`` as they are (default),
+  ``duplicate`` (emit both orientations) or ``strongest`` (the side with the larger
+  escaping ray share, i.e. outside weight per area, Eq. 7, wins);
+* hidden faces (both sides inside): oriented by the layer they belong to — layer
+  semantics (DESIGN.md §4): each shell faces outward with respect to its layer; with
+  ``semantics="cavity"``, shells of even layers face inward instead (a solid with voids).
+  A shell faces outward as a whole: a hidden face takes the orientation voted by area
+  over the connected, orientable patch of faces (joined by manifold edges) it belongs to,
+  where every face that is one-sided (at layer 1 or at its own layer) votes.  This
+  settles faces whose own evidence is ambiguous: contact faces between touching solids,
+  and parts of one solid inside another that are two-sided once the outer layer is
+  peeled.  A face whose patch has no vote keeps its own layer side;
+* flagged faces whose sample points disagree: by area ``majority`` (default) or
+  ``duplicate``.
+"""
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Any
+
+import numpy as np
+
+from meshvis.graphcut.classify import Classification, classify
+from meshvis.errors import ParameterError
+from meshvis.repair.layers import LayerResult, layers
+from meshvis.soup import Soup
+
+# status codes per input face
+ONE_SIDED, TWO_SIDED, HIDDEN, CONFLICT, DEGENERATE = 0, 1, 2, 3, 4
+STATUS_NAMES = ("one-sided", "two-sided", "hidden", "conflict", "degenerate")
+
+
+@dataclass
+class OrientResult:
+    """Result of :func:`orient`.
+
+    Attributes
+    ----------
+    soup : the oriented output soup (input faces, some flipped, plus any duplicates)
+    source : (k,) int64, input face of every output face
+    flipped : (m,) bool, input faces written turned over
+    duplicated : (m,) bool, input faces written in both orientations
+    status : (m,) int8, one of ``STATUS_NAMES`` per input face
+    parity_faces : int, hidden faces whose side came from ray parity (:func:`parity_side`)
+    """
+
+    soup: Soup
+    source: np.ndarray
+    flipped: np.ndarray
+    duplicated: np.ndarray
+    status: np.ndarray
+    classification: Classification
+    layers: LayerResult | None
+    parity_faces: int = 0
+
+    def report(self, per_face: bool = True) -> dict:
+        counts = np.bincount(self.status, minlength=len(STATUS_NAMES))
+        d = {
+            "input_faces": int(len(self.status)),
+            "output_faces": int(self.soup.n_faces),
+            "flipped": int(self.flipped.sum()),
+            "duplicated": int(self.duplicated.sum()),
+            "status_counts": {n: int(c) for n, c in zip(STATUS_NAMES, counts)},
+            "classification": self.classification.report(per_face=False),
+        }
+        if self.layers is not None:
+            d["layers"] = self.layers.report(per_face=False)
+        else:
+            d["layers"] = "skipped: no hidden faces"
+        d["parity_faces"] = self.parity_faces if self.parity_faces else "skipped: every hidden face had a vote"
+        if per_face:
+            d["per_face"] = {"flipped": self.flipped, "duplicated": self.duplicated, "status": self.status,
+                             "outside_front": self.classification.outside[:, 0],
+                             "outside_back": self.classification.outside[:, 1]}
+        return d
+
+
+def _check(name: str, value: str, allowed: tuple[str, ...]) -> None:
+    if value not in allowed:
+        raise ParameterError(f"{name} must be one of {', '.join(allowed)}; got {value!r}")
+
+
+def strongest_side(c: Classification) -> np.ndarray:
+    """(m,) side (0/1) with the larger escaping share ``w_o / A`` (Eq. 7), per face."""
+    w = c.graph.weights.w_out / np.maximum(c.nodes.area, 1e-300)
+    return (c.face_labels_from(w)[:, 1] > c.face_labels_from(w)[:, 0]).astype(np.int8)
+
+
+def surface_vote(c: Classification, outer: np.ndarray, decided: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Side that should face front for every face, voted over its orientable surface patch.
+
+    Faces joined by manifold edges (after welding; flagged faces included) form patches
+    whose sides split into two consistent sets (the orientation double cover of
+    :func:`meshvis.graphcut.clusters.cluster_sides`).  Each decided face votes with its area for the
+    set its outer side belongs to.
+
+    Returns
+    -------
+    side : (m,) int8, the side of each face in the winning set (0 where there is no vote)
+    decisive : (m,) bool, the face's patch has votes and they are not tied
+    """
+    from meshvis.geometry.adjacency import edges
+    from meshvis.graphcut.clusters import cluster_sides
+
+    patches = cluster_sides(edges(c.pre.faces_welded), ~c.degenerate)
+    node = patches.side_node
+    votes = np.zeros(patches.n_nodes)
+    d = np.flatnonzero(decided & (node[:, 0] >= 0))
+    np.add.at(votes, node[d, outer[d]], c.soup.areas[d])
+    ok = node[:, 0] >= 0
+    side = np.zeros(len(outer), np.int8)
+    decisive = np.zeros(len(outer), bool)
+    v0, v1 = votes[node[ok, 0]], votes[node[ok, 1]]
+    side[ok] = (v1 > v0).astype(np.int8)
+    decisive[ok] = v0 != v1
+    return side, decisive
+
+
+def parity_side(c: Classification, faces: np.ndarray, seed: int = 0, rays: int = 9,
+                max_crossings: int = 64) -> np.ndarray:
+    """Outer side of ``faces`` by ray parity against their own body.
+
+    From each face's centroid, ``rays`` cosine-distributed rays leave its front side, and
+    every crossing of a face of the same body (the face's component over all welded edges,
+    non-manifold ones included) is counted, coincident copies once each: an even count
+    means the front looks out of the body (Jordan's parity rule).  The majority over the
+    rays decides (ties: front).  Meant for the few hidden faces that visibility leaves
+    open: two-sided at their layer, on a patch that no one-sided face votes for (a sliver
+    cut off by non-manifold edges where solids touch).
+
+    Parameters
+    ----------
+    c : Classification of the model
+    faces : (k,) int, faces to decide
+    seed : seed of the ray directions; rays : rays per face
+    max_crossings : crossings followed per ray at most
+
+    Returns
+    -------
+    (k,) int8, 0 when the front should face out, 1 when the back should
+    """
+    from meshvis.geometry.adjacency import components, duplicate_faces, edges, face_adjacency
+    from meshvis.rays.samples import cosine_hemisphere
+
+    faces = np.asarray(faces, np.int64)
+    if len(faces) == 0:
+        return np.zeros(0, np.int8)
+    soup, caster = c.soup, c.caster
+    body = components(soup.n_faces, face_adjacency(edges(c.pre.faces_welded), manifold_only=False))[1]
+    # Embree reports one of several coincident copies, and the next step jumps past them
+    # all: a hit counts as many crossings as its copy group has faces of the ray's body
+    group = duplicate_faces(c.pre.faces_welded).astype(np.int64)
+    nb = np.int64(body.max() + 1)
+    keys, per_key = np.unique(group * nb + body, return_counts=True)
+
+    def own_copies(face: np.ndarray, of_body: np.ndarray) -> np.ndarray:
+        k = group[face] * nb + of_body
+        i = np.minimum(np.searchsorted(keys, k), len(keys) - 1)
+        return np.where(keys[i] == k, per_key[i], 0)
+
+    f = np.repeat(faces, rays)
+    d = cosine_hemisphere(soup.normals[f], np.random.default_rng(seed))
+    o = caster.push_off(soup.triangles[f].mean(axis=1), f, np.zeros(len(f), np.int8))
+    step = caster.offset * caster.diagonal
+    odd = np.zeros(len(f), bool)
+    live = np.arange(len(f))
+    for _ in range(max_crossings):  # one pass per crossing depth, all rays together
+        h = caster.intersect(o[live], d[live])
+        hit = h.hit
+        crossed = np.where(hit, own_copies(np.where(hit, h.face, 0), body[f[live]]), 0)
+        odd[live] ^= crossed % 2 == 1
+        o[live[hit]] = h.points(o[live], d[live])[hit] + d[live[hit]] * step
+        live = live[hit]
+        if len(live) == 0:
+            break
+    return (odd.reshape(-1, rays).sum(axis=1) * 2 > rays).astype(np.int8)
+
+
+def orient(
+    model: Any,
+    *,
+    front: str = "ccw",
+    two_sided: str = "keep",
+    semantics: str = "layer",
+    conflicts: str = "majority",
+    classification: Classification | None = None,
+    **classify_kw: Any,
+) -> OrientResult:
+    """Turn every face so that its front side faces the outside.
+
+    Parameters
+    ----------
+    model : anything :func:`meshvis.classify` accepts
+    front : "ccw" (counter-clockwise front, the usual convention) or "cw"
+    two_sided : "keep", "duplicate" or "strongest" (see module docstring)
+    semantics : "layer" (default) or "cavity" for hidden shells
+    conflicts : "majority" or "duplicate" for flagged faces whose sample points disagree
+    classification : reuse an existing classification of the same model
+    **classify_kw : passed to :func:`meshvis.classify`
+
+    Returns
+    -------
+    OrientResult
+
+    Examples
+    --------
+    >>> import trimesh, numpy as np
+    >>> m = trimesh.creation.icosphere(2); f = m.faces.copy(); f[::3] = f[::3, ::-1]
+    >>> r = orient((m.vertices, f), seed=0)
+    >>> int(r.flipped.sum()) == len(f[::3])
+    True
+    """
+    _check("front", front, ("ccw", "cw"))
+    _check("two_sided", two_sided, ("keep", "duplicate", "strongest"))
+    _check("semantics", semantics, ("layer", "cavity"))
+    _check("conflicts", conflicts, ("majority", "duplicate"))
+    c = classification or classify(model, **classify_kw)
+    soup = c.soup
+    m = soup.n_faces
+    o = c.outside
+    out0, out1 = o[:, 0] > 0, o[:, 1] > 0
+    full0, full1 = o[:, 0] >= 1, o[:, 1] >= 1
+    agree = (np.isin(o[:, 0], (0.0, 1.0))) & (np.isin(o[:, 1], (0.0, 1.0)))
+
+    status = np.full(m, ONE_SIDED, np.int8)
+    status[agree & full0 & full1] = TWO_SIDED
+    status[~out0 & ~out1] = HIDDEN
+    status[~agree & (out0 | out1)] = CONFLICT
+    status[c.degenerate] = DEGENERATE
+
+    outer = np.zeros(m, np.int8)  # side that should become the front
+    outer[(status == ONE_SIDED) & full1] = 1
+    conflict = status == CONFLICT
+    outer[conflict] = (o[conflict, 1] > o[conflict, 0]).astype(np.int8)
+    if two_sided == "strongest":
+        ts = status == TWO_SIDED
+        outer[ts] = strongest_side(c)[ts]
+
+    lay = None
+    n_parity = 0
+    hidden = status == HIDDEN
+    if hidden.any():
+        lay = layers(soup, classification=c)
+        side = lay.outer_side[hidden]
+        side = np.where(side == 2, -1, side)
+        own = side >= 0  # one-sided at its own layer
+        outer[hidden] = np.maximum(side, 0)
+        decided = status == ONE_SIDED
+        decided[np.flatnonzero(hidden)[own]] = True
+        vote, decisive = surface_vote(c, outer, decided)
+        # a shell faces outward as a whole: where the face's patch has a clear vote it wins
+        # over the face's own side (contact faces between touching solids see both ways)
+        side = np.where(decisive[hidden], vote[hidden], np.maximum(side, 0))
+        outer[hidden] = side
+        # faces two-sided at their layer on a patch without a vote (a sliver of surface cut
+        # off by non-manifold edges where solids touch): ray parity against their own body
+        open_ = np.zeros(m, bool)
+        open_[np.flatnonzero(hidden)[~own]] = True
+        open_ &= ~decisive
+        n_parity = int(open_.sum())
+        if n_parity:
+            outer[open_] = parity_side(c, np.flatnonzero(open_), seed=int(c.params.get("seed", 0)))
+        if semantics == "cavity":
+            even = hidden & (lay.layer % 2 == 0)
+            outer[even] = 1 - outer[even]
+
+    flip = outer == 1
+    if front == "cw":
+        flip = ~flip
+    dup = np.zeros(m, bool)
+    if two_sided == "duplicate":
+        dup |= status == TWO_SIDED
+    if conflicts == "duplicate":
+        dup |= conflict
+    keep_as_is = (status == TWO_SIDED) & (two_sided == "keep") | (status == DEGENERATE)
+    flip[keep_as_is] = False  # kept two-sided and degenerate faces are written untouched
+
+    extra = np.flatnonzero(dup)
+    source = np.concatenate([np.arange(m), extra])
+    out_flip = np.concatenate([flip, ~flip[extra]])
+    out = soup.subset(source).flipped(out_flip)
+    return OrientResult(out, source, flip, dup, status, c, lay, n_parity)
