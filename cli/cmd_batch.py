@@ -5,6 +5,7 @@ done), 1 when at least one file failed (error, time limit, crashed worker), 2 fo
 error (bad option, input not found, output folder not writable, no Dask scheduler),
 130 when interrupted (Ctrl-C).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -44,26 +45,48 @@ def _algorithm_dests() -> list[str]:
 
 
 def add_parser(sub) -> None:
-    from .cmd_repair import algorithm_options
     from meshvis.batch.runner import OPERATIONS
 
+    from .cmd_repair import algorithm_options
+
     p = sub.add_parser(
-        "batch", help="run orient / remove-interior / layers over many files (local processes or Dask)",
+        "batch",
+        help="run orient / remove-interior / layers over many files (local processes or Dask)",
         description="Run one repair operation over files, folders (recursive) and glob patterns.",
-        epilog=EPILOG, formatter_class=argparse.RawDescriptionHelpFormatter,
+        epilog=EPILOG,
+        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
-    p.add_argument("inputs", nargs="+", metavar="INPUT",
-                   help="model file, folder (searched recursively) or quoted glob pattern ('**' spans folders)")
+    p.add_argument(
+        "inputs",
+        nargs="+",
+        metavar="INPUT",
+        help="model file, folder (searched recursively) or quoted glob pattern ('**' spans folders)",
+    )
     p.add_argument("--op", required=True, choices=OPERATIONS, help="operation to run on every file")
     p.add_argument("--out", required=True, metavar="DIR", help="output folder (created if missing)")
-    p.add_argument("--jobs", "-j", type=positive_int, metavar="N",
-                   help="worker processes on this machine (default: one per core)")
-    p.add_argument("--resume", action="store_true",
-                   help="skip files whose output and 'ok' report from an earlier run exist")
-    p.add_argument("--time-limit", type=_positive_float, metavar="SECONDS",
-                   help="stop a file after this many seconds and report it as 'timeout'")
-    p.add_argument("--dask-scheduler", metavar="ADDRESS",
-                   help="run the files on this Dask scheduler (e.g. tcp://10.0.0.5:8786) instead of locally")
+    p.add_argument(
+        "--jobs",
+        "-j",
+        type=positive_int,
+        metavar="N",
+        help="worker processes on this machine (default: one per core)",
+    )
+    p.add_argument(
+        "--resume",
+        action="store_true",
+        help="skip files whose output and 'ok' report from an earlier run exist",
+    )
+    p.add_argument(
+        "--time-limit",
+        type=_positive_float,
+        metavar="SECONDS",
+        help="stop a file after this many seconds and report it as 'timeout'",
+    )
+    p.add_argument(
+        "--dask-scheduler",
+        metavar="ADDRESS",
+        help="run the files on this Dask scheduler (e.g. tcp://10.0.0.5:8786) instead of locally",
+    )
     algorithm_options(p)
     p.add_argument("--quiet", "-q", action="store_true", help="print nothing but errors")
     p.set_defaults(func=run)
@@ -82,8 +105,14 @@ class _Display:
             from rich.console import Console
             from rich.progress import BarColumn, MofNCompleteColumn, Progress, TextColumn, TimeElapsedColumn
 
-            self.bar = Progress(TextColumn("{task.description}"), BarColumn(), MofNCompleteColumn(),
-                                TimeElapsedColumn(), console=Console(stderr=True), transient=True)
+            self.bar = Progress(
+                TextColumn("{task.description}"),
+                BarColumn(),
+                MofNCompleteColumn(),
+                TimeElapsedColumn(),
+                console=Console(stderr=True),
+                transient=True,
+            )
             self.task_id = self.bar.add_task("starting", total=len(tasks))
 
     def __enter__(self):
@@ -121,7 +150,9 @@ class _Display:
 def _status_line(row: dict) -> str:
     faces = ""
     if row.get("faces_in") is not None:
-        faces = f"  {row['faces_in']} -> {row['faces_out'] if row.get('faces_out') is not None else '?'} faces"
+        faces = (
+            f"  {row['faces_in']} -> {row['faces_out'] if row.get('faces_out') is not None else '?'} faces"
+        )
     secs = f"  {row['seconds']:.1f} s" if row.get("seconds") is not None else ""
     text = f"{row['status']:<8} {row['input']}{faces}{secs}"
     if row.get("error"):
@@ -136,29 +167,39 @@ def _summary_table(result, out_dir: str, limit: int = 60):
     shown = rows if len(rows) <= limit else [r for r in rows if r["status"] not in ("ok", "skipped")]
     # paths relative to the folder all inputs share keep the table narrow
     base = os.path.commonpath([os.path.dirname(os.path.abspath(r["input"])) for r in rows]) if rows else "."
-    table = Table(title=f"meshvis batch: {len(rows)} files from {base}, {result.seconds:.1f} s",
-                  title_justify="left")
-    for col, just in (("file", "left"), ("status", "left"), ("faces in", "right"), ("faces out", "right"),
-                      ("rays", "right"), ("seconds", "right")):
+    table = Table(
+        title=f"meshvis batch: {len(rows)} files from {base}, {result.seconds:.1f} s", title_justify="left"
+    )
+    for col, just in (
+        ("file", "left"),
+        ("status", "left"),
+        ("faces in", "right"),
+        ("faces out", "right"),
+        ("rays", "right"),
+        ("seconds", "right"),
+    ):
         table.add_column(col, justify=just, overflow="fold", no_wrap=col != "file")
     for r in shown:
         table.add_row(
-            os.path.relpath(os.path.abspath(r["input"]), base), r["status"],
+            os.path.relpath(os.path.abspath(r["input"]), base),
+            r["status"],
             "" if r.get("faces_in") is None else f"{r['faces_in']:,}",
             "" if r.get("faces_out") is None else f"{r['faces_out']:,}",
             "" if r.get("rays") is None else f"{r['rays']:,}",
             "" if r.get("seconds") is None else f"{r['seconds']:.2f}",
         )
     counts = ", ".join(f"{n} {s}" for s, n in sorted(result.counts.items()))
-    caption = counts + ("" if shown is rows else f" (only failures listed; all files in {out_dir}/summary.csv)")
+    caption = counts + (
+        "" if shown is rows else f" (only failures listed; all files in {out_dir}/summary.csv)"
+    )
     table.caption, table.caption_justify = caption, "left"
     return table
 
 
 def run(args: argparse.Namespace) -> int:
     from meshvis.batch.runner import default_jobs, plan, run_batch, write_summary
-    from meshvis.io import ensure_folder
     from meshvis.errors import ParameterError
+    from meshvis.io import ensure_folder
 
     if args.dask_scheduler and args.jobs:
         raise ParameterError("--jobs sets local worker processes; with --dask-scheduler the cluster decides")
@@ -167,11 +208,25 @@ def run(args: argparse.Namespace) -> int:
     ensure_folder(args.out)
     jobs = None if args.dask_scheduler else (args.jobs or default_jobs(len(tasks)))
     with _Display(tasks, args.quiet) as display:
-        result = run_batch(tasks, jobs=jobs, time_limit=args.time_limit, scheduler=args.dask_scheduler,
-                           resume=args.resume, on_start=display.start, on_done=display.finish)
-    meta = {"operation": args.op, "options": options, "inputs": list(args.inputs), "out": args.out,
-            "jobs": jobs, "dask_scheduler": args.dask_scheduler,
-            "time_limit": args.time_limit, "resume": args.resume}
+        result = run_batch(
+            tasks,
+            jobs=jobs,
+            time_limit=args.time_limit,
+            scheduler=args.dask_scheduler,
+            resume=args.resume,
+            on_start=display.start,
+            on_done=display.finish,
+        )
+    meta = {
+        "operation": args.op,
+        "options": options,
+        "inputs": list(args.inputs),
+        "out": args.out,
+        "jobs": jobs,
+        "dask_scheduler": args.dask_scheduler,
+        "time_limit": args.time_limit,
+        "resume": args.resume,
+    }
     csv_path, json_path = write_summary(result, args.out, meta)
     if not args.quiet:
         from rich.console import Console

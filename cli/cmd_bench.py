@@ -1,4 +1,5 @@
 """``meshvis bench rays|classify|accuracy|stability|compare|labeling|labeling-sweep``: reproducible measurements."""
+
 from __future__ import annotations
 
 import argparse

@@ -1,11 +1,13 @@
 """``meshvis demo``: orient, remove-interior and layers on a bundled model, with previews."""
+
 from __future__ import annotations
 
 import argparse
 import os
 
-from .common import say
 from meshvis.errors import OutputError
+
+from .common import say
 
 
 def add_parser(sub) -> None:

@@ -1,4 +1,5 @@
 """``meshvis info MODEL [--json]``: what is wrong with a model (counts and timings)."""
+
 from __future__ import annotations
 
 import argparse
@@ -15,10 +16,17 @@ def add_parser(sub) -> None:
     )
     p.add_argument("model", help="input model")
     p.add_argument("--json", action="store_true", help="print the numbers as JSON")
-    p.add_argument("--eps", type=float, default=1e-6,
-                   help="distance tolerance of the intersection tests, fraction of the diagonal (default 1e-6)")
-    p.add_argument("--no-intersections", action="store_true",
-                   help="skip the intersection / coplanarity tests (the slowest stage)")
+    p.add_argument(
+        "--eps",
+        type=float,
+        default=1e-6,
+        help="distance tolerance of the intersection tests, fraction of the diagonal (default 1e-6)",
+    )
+    p.add_argument(
+        "--no-intersections",
+        action="store_true",
+        help="skip the intersection / coplanarity tests (the slowest stage)",
+    )
     p.set_defaults(func=run)
 
 

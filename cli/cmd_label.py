@@ -1,4 +1,5 @@
 """``meshvis label MODEL... -o OUT.svg``: external labels for the visible parts of a model."""
+
 from __future__ import annotations
 
 import argparse
@@ -21,40 +22,77 @@ def add_parser(sub) -> None:
         "input files are combined; a single-part file is named after its file.",
     )
     p.add_argument("inputs", nargs="+", metavar="MODEL", help="model file(s); parts become labels")
-    p.add_argument("-o", "--output", required=True,
-                   help="SVG, PNG or GIF to write (with several frames: NAME_000.svg ... or one GIF)")
-    p.add_argument("--layout", choices=tuple(LAYOUTS), default="left-right", help="label layout (default left-right)")
+    p.add_argument(
+        "-o",
+        "--output",
+        required=True,
+        help="SVG, PNG or GIF to write (with several frames: NAME_000.svg ... or one GIF)",
+    )
+    p.add_argument(
+        "--layout", choices=tuple(LAYOUTS), default="left-right", help="label layout (default left-right)"
+    )
     p.add_argument("--area", choices=SHAPES, default="hull", help="internal area shape (default hull)")
     p.add_argument("--margin", type=float, help="internal area margin in pixels (default 2%% of the image)")
-    p.add_argument("--method", choices=("fuzzy", "two-step"), default="fuzzy",
-                   help="fuzzy-greedy layout (default) or the classic two-step baseline")
+    p.add_argument(
+        "--method",
+        choices=("fuzzy", "two-step"),
+        default="fuzzy",
+        help="fuzzy-greedy layout (default) or the classic two-step baseline",
+    )
     p.add_argument("--json", metavar="FILE", help="also write labels, metrics and timings as JSON")
     p.add_argument("--png", metavar="FILE", help="also write a PNG of the (first) frame")
-    p.add_argument("--texts", metavar="FILE", help="JSON object or 2-column CSV mapping part names to label texts")
-    p.add_argument("--size", type=positive_int, nargs=2, default=(512, 512), metavar=("W", "H"),
-                   help="image size in pixels (default 512 512)")
+    p.add_argument(
+        "--texts", metavar="FILE", help="JSON object or 2-column CSV mapping part names to label texts"
+    )
+    p.add_argument(
+        "--size",
+        type=positive_int,
+        nargs=2,
+        default=(512, 512),
+        metavar=("W", "H"),
+        help="image size in pixels (default 512 512)",
+    )
     cam = p.add_argument_group("camera")
     src = cam.add_mutually_exclusive_group()
     src.add_argument("--orbit", type=positive_int, metavar="N", help="N frames turning once around the model")
-    src.add_argument("--camera-path", metavar="FILE", help="JSON list of cameras (position, target, up, fov, ...)")
+    src.add_argument(
+        "--camera-path", metavar="FILE", help="JSON list of cameras (position, target, up, fov, ...)"
+    )
     src.add_argument("--camera", metavar="FILE", help="JSON of one camera")
     cam.add_argument("--azimuth", type=float, default=30.0, help="degrees around the up axis (default 30)")
     cam.add_argument("--elevation", type=float, default=20.0, help="degrees above the horizon (default 20)")
     cam.add_argument("--distance", type=float, help="camera distance (default: fit the model)")
     cam.add_argument("--fov", type=float, default=35.0, help="vertical field of view in degrees (default 35)")
     cam.add_argument("--orthographic", action="store_true", help="orthographic projection")
-    cam.add_argument("--up", choices=UP_AXES, default="auto",
-                     help="the model's up axis (default auto: y for glTF/GLB, z otherwise)")
-    cam.add_argument("--fit-margin", type=float, default=1.6,
-                     help="room around the model when fitting the camera (default 1.6)")
+    cam.add_argument(
+        "--up",
+        choices=UP_AXES,
+        default="auto",
+        help="the model's up axis (default auto: y for glTF/GLB, z otherwise)",
+    )
+    cam.add_argument(
+        "--fit-margin",
+        type=float,
+        default=1.6,
+        help="room around the model when fitting the camera (default 1.6)",
+    )
     opt = p.add_argument_group("optimisation (appendix I)")
-    opt.add_argument("--d-a", type=float, default=0.05, help="anchor distance threshold, fraction of d_S (default 0.05)")
-    opt.add_argument("--d-e", type=float, help="endpoint distance threshold, fraction of d_S (default: box size)")
-    opt.add_argument("--weights", metavar="W2,W3,W4,W5,W6,W7",
-                     help="weights of f2..f7 (default 0.2,1,1,1,0.7,0.7)")
+    opt.add_argument(
+        "--d-a", type=float, default=0.05, help="anchor distance threshold, fraction of d_S (default 0.05)"
+    )
+    opt.add_argument(
+        "--d-e", type=float, help="endpoint distance threshold, fraction of d_S (default: box size)"
+    )
+    opt.add_argument(
+        "--weights", metavar="W2,W3,W4,W5,W6,W7", help="weights of f2..f7 (default 0.2,1,1,1,0.7,0.7)"
+    )
     opt.add_argument("--no-coherence", action="store_true", help="lay frames out independently (no f6, f7)")
-    opt.add_argument("--font-size", type=positive_int, help="label font size in pixels (default: from the image size)")
-    opt.add_argument("--min-pixels", type=positive_int, default=1, help="parts with fewer visible pixels are not labelled")
+    opt.add_argument(
+        "--font-size", type=positive_int, help="label font size in pixels (default: from the image size)"
+    )
+    opt.add_argument(
+        "--min-pixels", type=positive_int, default=1, help="parts with fewer visible pixels are not labelled"
+    )
     p.add_argument("--show-area", action="store_true", help="draw the internal area's boundary")
     p.add_argument("--duration", type=positive_int, default=120, help="GIF frame time in ms (default 120)")
     p.add_argument("--force", action="store_true", help="overwrite existing outputs")
@@ -69,8 +107,8 @@ def _up(args: argparse.Namespace) -> tuple[float, float, float]:
 
 
 def _weights(text: str | None):
-    from meshvis.labeling.membership import Weights
     from meshvis.errors import ParameterError
+    from meshvis.labeling.membership import Weights
 
     if not text:
         return Weights()
@@ -93,12 +131,12 @@ def _frame_paths(output: str, n: int) -> list[str]:
 def run(args: argparse.Namespace) -> int:
     import json
 
+    from meshvis.errors import OutputError, ParameterError
     from meshvis.labeling import frames as fr
     from meshvis.labeling import output as out
     from meshvis.labeling.inputs import load_models, read_texts
     from meshvis.labeling.metrics import sequence_metrics
     from meshvis.rays.camera import Camera
-    from meshvis.errors import OutputError, ParameterError
 
     ext = os.path.splitext(args.output)[1].lower()
     if ext not in (".svg", ".png", ".gif"):
@@ -106,8 +144,17 @@ def run(args: argparse.Namespace) -> int:
     soup = load_models(args.inputs if len(args.inputs) > 1 else args.inputs[0])
     up = _up(args)
     if args.orbit:
-        cameras = fr.orbit(soup, args.orbit, elevation=args.elevation, start=args.azimuth, fov=args.fov,
-                           orthographic=args.orthographic, up=up, fit_margin=args.fit_margin, distance=args.distance)
+        cameras = fr.orbit(
+            soup,
+            args.orbit,
+            elevation=args.elevation,
+            start=args.azimuth,
+            fov=args.fov,
+            orthographic=args.orthographic,
+            up=up,
+            fit_margin=args.fit_margin,
+            distance=args.distance,
+        )
     elif args.camera_path:
         cameras = fr.read_camera_path(args.camera_path)
     elif args.camera:
@@ -117,15 +164,35 @@ def run(args: argparse.Namespace) -> int:
         except (OSError, ValueError, TypeError) as exc:
             raise ParameterError(f"{args.camera}: cannot read the camera: {exc}") from None
     else:
-        cameras = [Camera.fit(soup, azimuth=args.azimuth, elevation=args.elevation, distance=args.distance,
-                              fov=args.fov, orthographic=args.orthographic, margin=args.fit_margin, up=up)]
+        cameras = [
+            Camera.fit(
+                soup,
+                azimuth=args.azimuth,
+                elevation=args.elevation,
+                distance=args.distance,
+                fov=args.fov,
+                orthographic=args.orthographic,
+                margin=args.fit_margin,
+                up=up,
+            )
+        ]
     paths = _frame_paths(args.output, len(cameras))
     for path in paths + [p for p in (args.json, args.png) if p]:
         check_output(path, args.inputs, args.force)
     texts = read_texts(args.texts) if args.texts else None
-    options = dict(layout=args.layout, area=args.area, margin=args.margin, method=args.method,
-                   size=tuple(args.size), texts=texts, weights=_weights(args.weights), d_a=args.d_a, d_e=args.d_e,
-                   font_size=args.font_size, min_pixels=args.min_pixels)
+    options = dict(
+        layout=args.layout,
+        area=args.area,
+        margin=args.margin,
+        method=args.method,
+        size=tuple(args.size),
+        texts=texts,
+        weights=_weights(args.weights),
+        d_a=args.d_a,
+        d_e=args.d_e,
+        font_size=args.font_size,
+        min_pixels=args.min_pixels,
+    )
     results = fr.layout_frames(soup, cameras, coherence=not args.no_coherence, **options)
     if ext == ".gif":
         out.write_gif(results, args.output, duration_ms=args.duration)
@@ -141,15 +208,21 @@ def run(args: argparse.Namespace) -> int:
     first = results[0]
     m = first.metrics
     say(args, f"wrote {', '.join(paths if len(paths) <= 3 else paths[:2] + ['...', paths[-1]])}")
-    say(args, f"{len(first.labels)} labels ({args.layout}, {args.method}); "
-              f"overlaps {m['overlaps']}, crossings {m['crossings']}, label over model {m['label_over_model']} px; "
-              f"layout {first.timings['layout_ms']:.1f} ms")
+    say(
+        args,
+        f"{len(first.labels)} labels ({args.layout}, {args.method}); "
+        f"overlaps {m['overlaps']}, crossings {m['crossings']}, label over model {m['label_over_model']} px; "
+        f"layout {first.timings['layout_ms']:.1f} ms",
+    )
     if first.invisible:
         say(args, f"not visible, not labelled: {', '.join(n for _, n in first.invisible)}")
     if first.unplaced:
         say(args, f"no room found for: {', '.join(n for _, n in first.unplaced)}")
     if len(results) > 1:
         s = sequence_metrics(results)
-        say(args, f"{len(results)} frames; mean label motion {s['label_motion_mean']:.1f} px, "
-                  f"side flips {s['side_flips']}, order swaps {s['order_swaps']}")
+        say(
+            args,
+            f"{len(results)} frames; mean label motion {s['label_motion_mean']:.1f} px, "
+            f"side flips {s['side_flips']}, order swaps {s['order_swaps']}",
+        )
     return 0

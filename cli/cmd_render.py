@@ -1,4 +1,5 @@
 """``meshvis render MODEL -o PICTURE.png``: a shaded preview through the ray backend."""
+
 from __future__ import annotations
 
 import argparse
@@ -10,12 +11,20 @@ def add_parser(sub) -> None:
     p = sub.add_parser("render", help="render a shaded preview image (front sides blue, back sides orange)")
     p.add_argument("input", help="input model")
     p.add_argument("-o", "--output", required=True, help="PNG file to write")
-    p.add_argument("--color-by", choices=("side", "part", "layer", "none"), default="side",
-                   help="side: front blue / back orange (default); part; layer (runs the layer peeling)")
+    p.add_argument(
+        "--color-by",
+        choices=("side", "part", "layer", "none"),
+        default="side",
+        help="side: front blue / back orange (default); part; layer (runs the layer peeling)",
+    )
     p.add_argument("--azimuth", type=float, default=30.0, help="degrees around the up axis (default 30)")
     p.add_argument("--elevation", type=float, default=20.0, help="degrees above the horizon (default 20)")
-    p.add_argument("--up", choices=("auto", "x", "y", "z"), default="auto",
-                   help="the model's up axis (default auto: y for glTF/GLB, z otherwise)")
+    p.add_argument(
+        "--up",
+        choices=("auto", "x", "y", "z"),
+        default="auto",
+        help="the model's up axis (default auto: y for glTF/GLB, z otherwise)",
+    )
     p.add_argument("--size", type=positive_int, nargs=2, default=(512, 512), metavar=("W", "H"))
     p.add_argument("--seed", type=int, default=0, help="seed of the layer peeling (--color-by layer)")
     p.add_argument("--force", action="store_true", help="overwrite an existing output")
@@ -24,8 +33,8 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from meshvis.rays.camera import Camera, up_axis
     from meshvis.io import load
+    from meshvis.rays.camera import Camera, up_axis
     from meshvis.rays.render import render, save_png
 
     check_output(args.output, [args.input], args.force)
@@ -36,7 +45,9 @@ def run(args: argparse.Namespace) -> int:
         from meshvis.repair.layers import layers
 
         values = layers(soup, seed=args.seed).layer
-    camera = Camera.fit(soup, azimuth=args.azimuth, elevation=args.elevation, up=up_axis(args.up, [args.input]))
+    camera = Camera.fit(
+        soup, azimuth=args.azimuth, elevation=args.elevation, up=up_axis(args.up, [args.input])
+    )
     r = render(soup, camera, size=tuple(args.size), color_by=color_by, face_values=values)
     save_png(r.image, args.output)
     say(args, f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {int((r.face >= 0).sum())} model pixels)")

@@ -1,14 +1,15 @@
 """``meshvis classify | orient | remove-interior | layers``: the graph-cut commands."""
+
 from __future__ import annotations
 
 import argparse
 import os
 import time
 
-
-from .common import check_output, point, positive_int, say, write_json
 from meshvis.errors import ParameterError
 from meshvis.repair.operation import CLASSIFY_DEFAULTS, OPERATION_DEFAULTS
+
+from .common import check_output, point, positive_int, say, write_json
 
 
 def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
@@ -18,14 +19,38 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     p.add_argument("--report", metavar="REPORT.json", help="write a JSON report with per-face results")
     p.add_argument("--preview", metavar="PICTURE.png", help="write a ray-cast preview image")
     algorithm_options(p)
-    p.add_argument("--inside-point", type=point, action="append", default=[], metavar="X,Y,Z",
-                   help="a point known to be inside (repeatable)")
-    p.add_argument("--outside-point", type=point, action="append", default=[], metavar="X,Y,Z",
-                   help="a point known to be outside (repeatable)")
-    p.add_argument("--inside-box", type=box, action="append", default=[], metavar="X0,Y0,Z0,X1,Y1,Z1",
-                   help="an axis-aligned box known to be inside (repeatable)")
-    p.add_argument("--outside-box", type=box, action="append", default=[], metavar="X0,Y0,Z0,X1,Y1,Z1",
-                   help="an axis-aligned box known to be outside (repeatable)")
+    p.add_argument(
+        "--inside-point",
+        type=point,
+        action="append",
+        default=[],
+        metavar="X,Y,Z",
+        help="a point known to be inside (repeatable)",
+    )
+    p.add_argument(
+        "--outside-point",
+        type=point,
+        action="append",
+        default=[],
+        metavar="X,Y,Z",
+        help="a point known to be outside (repeatable)",
+    )
+    p.add_argument(
+        "--inside-box",
+        type=box,
+        action="append",
+        default=[],
+        metavar="X0,Y0,Z0,X1,Y1,Z1",
+        help="an axis-aligned box known to be inside (repeatable)",
+    )
+    p.add_argument(
+        "--outside-box",
+        type=box,
+        action="append",
+        default=[],
+        metavar="X0,Y0,Z0,X1,Y1,Z1",
+        help="an axis-aligned box known to be outside (repeatable)",
+    )
     p.add_argument("--force", action="store_true", help="overwrite existing outputs")
     p.add_argument("--quiet", "-q", action="store_true", help="print nothing but errors")
 
@@ -45,10 +70,18 @@ def algorithm_options(p: argparse.ArgumentParser) -> None:
     """Add the graph-cut options that apply to any model (shared with ``meshvis batch``)."""
     d = CLASSIFY_DEFAULTS
     p.add_argument("--seed", type=int, default=d["seed"], help=f"random seed (default {d['seed']})")
-    p.add_argument("--rays-per-node", type=positive_int, default=d["rays_per_node"],
-                   help=f"ray budget per node (default {d['rays_per_node']})")
-    p.add_argument("--samples-per-face", type=positive_int, default=d["samples_per_face"],
-                   help="sample points per intersecting/coplanar face (default 4)")
+    p.add_argument(
+        "--rays-per-node",
+        type=positive_int,
+        default=d["rays_per_node"],
+        help=f"ray budget per node (default {d['rays_per_node']})",
+    )
+    p.add_argument(
+        "--samples-per-face",
+        type=positive_int,
+        default=d["samples_per_face"],
+        help="sample points per intersecting/coplanar face (default 4)",
+    )
     p.add_argument("--no-filter", action="store_true", help="switch off the cosine filter (Eq. 8-9)")
     p.add_argument("--no-progressive", action="store_true", help="cast the whole ray budget in one round")
     p.add_argument("--solver", choices=("pymaxflow", "scipy"), default=d["solver"])
@@ -64,12 +97,24 @@ def add_parser(sub) -> None:
     _common(p)
     od = OPERATION_DEFAULTS["orient"]
     p.add_argument("--front", choices=("ccw", "cw"), default=od["front"], help="winding of the front side")
-    p.add_argument("--two-sided", choices=("keep", "duplicate", "strongest"), default=od["two_sided"],
-                   help="what to do with faces whose both sides are outside (default keep)")
-    p.add_argument("--semantics", choices=("layer", "cavity"), default=od["semantics"],
-                   help="hidden shells face outward per layer (default) or inward as cavities")
-    p.add_argument("--conflicts", choices=("majority", "duplicate"), default=od["conflicts"],
-                   help="intersected faces whose samples disagree: area majority or both orientations")
+    p.add_argument(
+        "--two-sided",
+        choices=("keep", "duplicate", "strongest"),
+        default=od["two_sided"],
+        help="what to do with faces whose both sides are outside (default keep)",
+    )
+    p.add_argument(
+        "--semantics",
+        choices=("layer", "cavity"),
+        default=od["semantics"],
+        help="hidden shells face outward per layer (default) or inward as cavities",
+    )
+    p.add_argument(
+        "--conflicts",
+        choices=("majority", "duplicate"),
+        default=od["conflicts"],
+        help="intersected faces whose samples disagree: area majority or both orientations",
+    )
     p.set_defaults(func=run, op="orient")
 
     p = sub.add_parser("remove-interior", help="remove the faces that cannot be seen from outside")
@@ -85,10 +130,20 @@ def add_parser(sub) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from meshvis.io import load
+
     from .progress import stage_progress
 
-    outputs = [x for x in (getattr(args, "output", None), args.report, args.preview,
-                           getattr(args, "removed", None), getattr(args, "graphml", None)) if x]
+    outputs = [
+        x
+        for x in (
+            getattr(args, "output", None),
+            args.report,
+            args.preview,
+            getattr(args, "removed", None),
+            getattr(args, "graphml", None),
+        )
+        if x
+    ]
     if len(set(map(os.path.abspath, outputs))) != len(outputs):
         raise ParameterError("two outputs share one path")
     for path in outputs:

@@ -1,4 +1,5 @@
 """Argument helpers shared by the subcommands."""
+
 from __future__ import annotations
 
 import argparse

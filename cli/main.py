@@ -5,6 +5,7 @@ Each subcommand lives in its own module of this package with two functions:
 print one line and exit with status 2, as do refused file operations (``OSError``: disk
 full, I/O error); warnings print as one line; Ctrl-C exits with 130.
 """
+
 from __future__ import annotations
 
 import argparse

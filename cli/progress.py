@@ -1,4 +1,5 @@
 """A progress display on stderr for long work (rich), silent with --quiet or when not a terminal."""
+
 from __future__ import annotations
 
 import contextlib
@@ -13,8 +14,13 @@ def stage_progress(args):
         return
     from rich.progress import BarColumn, Progress, TextColumn, TimeElapsedColumn
 
-    with Progress(TextColumn("{task.description:<12}"), BarColumn(), TimeElapsedColumn(),
-                  transient=True, console=__import__("rich.console").console.Console(stderr=True)) as bar:
+    with Progress(
+        TextColumn("{task.description:<12}"),
+        BarColumn(),
+        TimeElapsedColumn(),
+        transient=True,
+        console=__import__("rich.console").console.Console(stderr=True),
+    ) as bar:
         task = bar.add_task("start", total=1.0)
 
         def update(stage: str, fraction: float) -> None:

@@ -10,6 +10,7 @@ coherence, and the measures and baselines to judge the result.
 >>> result = meshvis.labeling.layout("model.glb", layout="left-right")      # doctest: +SKIP
 >>> meshvis.labeling.write(result, "labels.svg")                             # doctest: +SKIP
 """
+
 from __future__ import annotations
 
 from .baselines import adjust_text, two_step
@@ -24,8 +25,30 @@ from .pipeline import METHODS, fit_camera, layout, solve
 from .result import Label, LayoutResult
 
 __all__ = [
-    "LAYOUTS", "SHAPES", "METHODS", "Weights", "Label", "LayoutResult", "IdBuffer",
-    "layout", "solve", "fit_camera", "id_buffer", "layout_frames", "orbit", "read_camera_path",
-    "two_step", "adjust_text", "frame_metrics", "motion_metrics", "sequence_metrics", "is_clean",
-    "write", "write_svg", "write_png", "write_gif", "write_json", "to_svg",
+    "LAYOUTS",
+    "SHAPES",
+    "METHODS",
+    "Weights",
+    "Label",
+    "LayoutResult",
+    "IdBuffer",
+    "layout",
+    "solve",
+    "fit_camera",
+    "id_buffer",
+    "layout_frames",
+    "orbit",
+    "read_camera_path",
+    "two_step",
+    "adjust_text",
+    "frame_metrics",
+    "motion_metrics",
+    "sequence_metrics",
+    "is_clean",
+    "write",
+    "write_svg",
+    "write_png",
+    "write_gif",
+    "write_json",
+    "to_svg",
 ]

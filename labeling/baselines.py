@@ -11,10 +11,12 @@
   count (no time limit, so the result is reproducible).  Leaders are straight segments
   from the anchor to the nearest point of the text box.
 """
+
 from __future__ import annotations
 
 import time
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 
@@ -38,7 +40,9 @@ def _model_obstacles(ids: np.ndarray, cell: int) -> np.ndarray:
     pad[:h, :w] = ids >= 0
     occ = pad.reshape(hb, cell, wb, cell).any(axis=(1, 3))
     r, c = np.nonzero(occ)
-    return np.column_stack([c * cell, r * cell, np.minimum((c + 1) * cell, w), np.minimum((r + 1) * cell, h)]).astype(float)
+    return np.column_stack(
+        [c * cell, r * cell, np.minimum((c + 1) * cell, w), np.minimum((r + 1) * cell, h)]
+    ).astype(float)
 
 
 def _nearest_on_box(p: np.ndarray, box: np.ndarray) -> np.ndarray:
@@ -79,8 +83,17 @@ def adjust_text(reference: LayoutResult, *, iterations: int = 300, obstacle_cell
     prop = FontProperties(fname=font_file(), size=reference.font_size * 72.0 / dpi)
     labs = reference.labels
     texts = [
-        ax.text(lab.anchor[0], lab.anchor[1], lab.text, fontproperties=prop, ha="center", va="center",
-                bbox=dict(boxstyle=f"square,pad={style.pad_y / reference.font_size:.3f}", fc="white", ec="0.4", lw=0.6))
+        ax.text(
+            lab.anchor[0],
+            lab.anchor[1],
+            lab.text,
+            fontproperties=prop,
+            ha="center",
+            va="center",
+            bbox=dict(
+                boxstyle=f"square,pad={style.pad_y / reference.font_size:.3f}", fc="white", ec="0.4", lw=0.6
+            ),
+        )
         for lab in labs
     ]
     obstacles = _model_obstacles(reference.ids, obstacle_cell)
@@ -89,8 +102,16 @@ def adjust_text(reference: LayoutResult, *, iterations: int = 300, obstacle_cell
     anchors = np.array([lab.anchor for lab in labs]).reshape(-1, 2)
     if labs:
         adjustText.adjust_text(
-            texts, x=anchors[:, 0], y=anchors[:, 1], objects=objects, ax=ax, iter_lim=int(iterations),
-            time_lim=None, ensure_inside_axes=True, expand_axes=False, prevent_crossings=True,
+            texts,
+            x=anchors[:, 0],
+            y=anchors[:, 1],
+            objects=objects,
+            ax=ax,
+            iter_lim=int(iterations),
+            time_lim=None,
+            ensure_inside_axes=True,
+            expand_axes=False,
+            prevent_crossings=True,
         )
     fig.canvas.draw()  # places the text boxes at the adjusted positions
     renderer = fig.canvas.get_renderer()
@@ -99,14 +120,38 @@ def adjust_text(reference: LayoutResult, *, iterations: int = 300, obstacle_cell
         bb = txt.get_bbox_patch().get_window_extent(renderer)
         box = np.array([bb.x0, h - bb.y1, bb.x1, h - bb.y0])
         end = _nearest_on_box(lab.anchor, box)
-        out.append(Label(
-            part=lab.part, name=lab.name, text=lab.text, anchor=lab.anchor.copy(), anchor_3d=lab.anchor_3d.copy(),
-            endpoint=end, leader=np.array([lab.anchor, end]), box=box, side="free", rank=lab.rank,
-        ))
+        out.append(
+            Label(
+                part=lab.part,
+                name=lab.name,
+                text=lab.text,
+                anchor=lab.anchor.copy(),
+                anchor_3d=lab.anchor_3d.copy(),
+                endpoint=end,
+                leader=np.array([lab.anchor, end]),
+                box=box,
+                side="free",
+                rank=lab.rank,
+            )
+        )
     elapsed = time.perf_counter() - t0
-    res = LayoutResult(out, reference.invisible, reference.unplaced, reference.skipped, reference.image,
-                       reference.ids, reference.camera, reference.layout, "adjusttext", reference.area_polygon,
-                       reference.font_size, reference.box_height, reference.sphere_diameter,
-                       {"iterations": int(iterations), "obstacle_cell": int(obstacle_cell)}, {}, {"boxes": elapsed})
+    res = LayoutResult(
+        out,
+        reference.invisible,
+        reference.unplaced,
+        reference.skipped,
+        reference.image,
+        reference.ids,
+        reference.camera,
+        reference.layout,
+        "adjusttext",
+        reference.area_polygon,
+        reference.font_size,
+        reference.box_height,
+        reference.sphere_diameter,
+        {"iterations": int(iterations), "obstacle_cell": int(obstacle_cell)},
+        {},
+        {"boxes": elapsed},
+    )
     res.metrics = frame_metrics(res)
     return res

@@ -18,13 +18,15 @@ Three parts, all measured in one process on the same ID buffers:
 
 ``meshvis bench labeling`` calls :func:`main`; Python code calls :func:`run`.
 """
+
 from __future__ import annotations
 
 import argparse
 import os
 import statistics
 import time
-from typing import Any, Callable, Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -34,15 +36,26 @@ from .baselines import adjust_text
 from .boxes import Spacing
 from .candidates import LAYOUTS
 from .frames import layout_frames, orbit
+from .geometry2d import polyline_length
 from .idbuffer import id_buffer
 from .inputs import label_texts, load_models
-from .geometry2d import polyline_length
 from .metrics import is_clean, sequence_metrics
 from .pipeline import LAYOUT_STAGES, fit_camera, solve
 
 #: metrics shown in the tables
-QUALITY = ("labels", "overlaps", "crossings", "leaders_through_labels", "label_over_model", "invalid_anchors",
-           "salience_mean", "leader_mean_norm", "leader_max_norm", "shifted_labels", "labelling_rate")
+QUALITY = (
+    "labels",
+    "overlaps",
+    "crossings",
+    "leaders_through_labels",
+    "label_over_model",
+    "invalid_anchors",
+    "salience_mean",
+    "leader_mean_norm",
+    "leader_max_norm",
+    "shifted_labels",
+    "labelling_rate",
+)
 
 
 def default_model() -> tuple[Any, str]:
@@ -128,10 +141,21 @@ def run(
     caster = RayCaster(soup)
     setup_s = time.perf_counter() - t0
     cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up)
-    out: dict[str, Any] = {"model": name, "d_e": d_e, "rotate": spacing.rotate, "parts": soup.n_parts,
-                           "faces": soup.n_faces, "size": int(size),
-                           "repeat": int(repeat), "setup_s": setup_s, "layouts": {}, "sizes": {}, "orbit": {},
-                           "views": {}, "view_elevations": [float(e) for e in view_elevations]}
+    out: dict[str, Any] = {
+        "model": name,
+        "d_e": d_e,
+        "rotate": spacing.rotate,
+        "parts": soup.n_parts,
+        "faces": soup.n_faces,
+        "size": int(size),
+        "repeat": int(repeat),
+        "setup_s": setup_s,
+        "layouts": {},
+        "sizes": {},
+        "orbit": {},
+        "views": {},
+        "view_elevations": [float(e) for e in view_elevations],
+    }
 
     def idbuf_at(n: int):
         t = time.perf_counter()
@@ -144,20 +168,30 @@ def run(
     for layout in layouts:
         entry: dict[str, Any] = {}
         for method in ("fuzzy", "two-step"):
-            solve(ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing)  # warm-up (fonts, caches)
-            runs = [solve(ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing)
-                    for _ in range(max(1, repeat))]
-            entry[method] = {"timings": _median_timings([r.timings for r in runs]), "metrics": _pick(runs[-1].metrics)}
+            solve(
+                ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing
+            )  # warm-up (fonts, caches)
+            runs = [
+                solve(ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing)
+                for _ in range(max(1, repeat))
+            ]
+            entry[method] = {
+                "timings": _median_timings([r.timings for r in runs]),
+                "metrics": _pick(runs[-1].metrics),
+            }
             ref = runs[-1]
             if method == "two-step" and adjusttext:
                 at = adjust_text(ref, iterations=adjusttext_iterations)
-                entry["adjusttext"] = {"timings": {"boxes": at.timings["boxes"],
-                                                   "layout_ms": 1000.0 * at.timings["boxes"]},
-                                       "metrics": _pick(at.metrics)}
+                entry["adjusttext"] = {
+                    "timings": {"boxes": at.timings["boxes"], "layout_ms": 1000.0 * at.timings["boxes"]},
+                    "metrics": _pick(at.metrics),
+                }
         out["layouts"][layout] = entry
         f = entry["fuzzy"]
-        say(f"{layout:11s} fuzzy {f['timings']['layout_ms']:6.1f} ms, leader {f['metrics']['leader_mean_norm']:.3f}, "
-            f"salience {f['metrics']['salience_mean']:.3f}")
+        say(
+            f"{layout:11s} fuzzy {f['timings']['layout_ms']:6.1f} ms, leader {f['metrics']['leader_mean_norm']:.3f}, "
+            f"salience {f['metrics']['salience_mean']:.3f}"
+        )
     # quality and time against the image size
     ref_anchor: dict[str, dict[int, np.ndarray]] = {}
     ref_ds: dict[str, float] = {}
@@ -167,8 +201,10 @@ def run(
         rec: dict[str, Any] = {"idbuffer_s": idn}
         for method in ("fuzzy", "two-step"):
             solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing)
-            runs = [solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing)
-                    for _ in range(max(1, repeat))]
+            runs = [
+                solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing)
+                for _ in range(max(1, repeat))
+            ]
             r = runs[-1]
             lay_ms = float(statistics.median(x.timings["layout_ms"] for x in runs))
             scale = 1.0 / n  # anchors in fractions of the image, comparable across sizes
@@ -178,46 +214,85 @@ def run(
                 ref_ds[method] = r.sphere_diameter * scale
             ref = ref_anchor[method]
             common = sorted(set(anchors) & set(ref))
-            err = float(np.mean([np.linalg.norm(anchors[p] - ref[p]) for p in common]) / ref_ds[method]) if common else 0.0
-            rec[method] = {"layout_ms": lay_ms, "total_s": idn + lay_ms / 1000.0, "error": err,
-                           "metrics": _pick(r.metrics)}
+            err = (
+                float(np.mean([np.linalg.norm(anchors[p] - ref[p]) for p in common]) / ref_ds[method])
+                if common
+                else 0.0
+            )
+            rec[method] = {
+                "layout_ms": lay_ms,
+                "total_s": idn + lay_ms / 1000.0,
+                "error": err,
+                "metrics": _pick(r.metrics),
+            }
         per_size[int(n)] = rec
-        say(f"size {n:5d}: id buffer {idn * 1000:7.1f} ms, fuzzy layout {rec['fuzzy']['layout_ms']:6.1f} ms, "
-            f"error {rec['fuzzy']['error']:.4f}")
+        say(
+            f"size {n:5d}: id buffer {idn * 1000:7.1f} ms, fuzzy layout {rec['fuzzy']['layout_ms']:6.1f} ms, "
+            f"error {rec['fuzzy']['error']:.4f}"
+        )
     out["sizes"] = {k: per_size[k] for k in sorted(per_size)}
     out["size_layout"] = size_layout
     if orbit_frames and orbit_frames > 1:
         cams = orbit(soup, orbit_frames, elevation=elevation, start=azimuth, up=up)
-        variants = {"fuzzy": dict(method="fuzzy"), "fuzzy-no-coherence": dict(method="fuzzy", coherence=False),
-                    "two-step": dict(method="two-step", coherence=False)}
+        variants = {
+            "fuzzy": dict(method="fuzzy"),
+            "fuzzy-no-coherence": dict(method="fuzzy", coherence=False),
+            "two-step": dict(method="two-step", coherence=False),
+        }
         for key, kw in variants.items():
-            res = layout_frames(soup, cams, caster=caster, layout=orbit_layout, size=(size, size), d_e=d_e,
-                                spacing=spacing, **kw)
+            res = layout_frames(
+                soup,
+                cams,
+                caster=caster,
+                layout=orbit_layout,
+                size=(size, size),
+                d_e=d_e,
+                spacing=spacing,
+                **kw,
+            )
             seq = sequence_metrics(res)
-            seq["clean_frames"] = int(sum(r.metrics["overlaps"] == 0 and r.metrics["crossings"] == 0
-                                          and r.metrics["label_over_model"] == 0 for r in res))
+            seq["clean_frames"] = int(
+                sum(
+                    r.metrics["overlaps"] == 0
+                    and r.metrics["crossings"] == 0
+                    and r.metrics["label_over_model"] == 0
+                    for r in res
+                )
+            )
             seq["layout_ms_mean"] = float(np.mean([r.timings["layout_ms"] for r in res[1:]] or [0.0]))
             seq["leader_mean_norm"] = float(np.mean([r.metrics["leader_mean_norm"] for r in res]))
             seq["salience_mean"] = float(np.mean([r.metrics["salience_mean"] for r in res]))
             out["orbit"][key] = seq
-            say(f"orbit {key:18s} label motion {seq['label_motion_mean']:.2f} px/frame, anchor motion "
-                f"{seq['anchor_motion_mean']:.2f}, flips {seq['side_flips']}, swaps {seq['order_swaps']}")
+            say(
+                f"orbit {key:18s} label motion {seq['label_motion_mean']:.2f} px/frame, anchor motion "
+                f"{seq['anchor_motion_mean']:.2f}, flips {seq['side_flips']}, swaps {seq['order_swaps']}"
+            )
         out["orbit_layout"] = orbit_layout
         out["orbit_frames"] = int(orbit_frames)
     if views:
-        cams = [fit_camera(soup, azimuth=az, elevation=el, up=up)
-                for el in view_elevations for az in np.arange(views) * 360.0 / views]
+        cams = [
+            fit_camera(soup, azimuth=az, elevation=el, up=up)
+            for el in view_elevations
+            for az in np.arange(views) * 360.0 / views
+        ]
         bufs = [id_buffer(soup, c, (size, size), caster=caster) for c in cams]
         for layout in layouts:
             out["views"][layout] = compare_views(bufs, texts, layout, d_e, spacing)
             v = out["views"][layout]
-            say(f"views {layout:11s} leader fuzzy {v['fuzzy']['leader_mean']:.3f} two-step "
-                f"{v['two-step']['leader_mean']:.3f}, fuzzy shorter in {v['fuzzy_shorter']} of {v['views']}")
+            say(
+                f"views {layout:11s} leader fuzzy {v['fuzzy']['leader_mean']:.3f} two-step "
+                f"{v['two-step']['leader_mean']:.3f}, fuzzy shorter in {v['fuzzy_shorter']} of {v['views']}"
+            )
     return out
 
 
-def compare_views(buffers: Sequence[Any], texts: Sequence[str], layout: str, d_e: float | None = None,
-                  spacing: Spacing | None = None) -> dict[str, Any]:
+def compare_views(
+    buffers: Sequence[Any],
+    texts: Sequence[str],
+    layout: str,
+    d_e: float | None = None,
+    spacing: Spacing | None = None,
+) -> dict[str, Any]:
     """Quality of the fuzzy and the two-step method over many views of one model.
 
     Returns, per method: ``labels`` and ``unplaced`` (summed), ``clean`` (views with no
@@ -244,103 +319,158 @@ def compare_views(buffers: Sequence[Any], texts: Sequence[str], layout: str, d_e
             inside[m] += sum(polyline_length(lab.leader[:2]) for lab in mine) / r.sphere_diameter
     out: dict[str, Any] = {"views": len(buffers), "common_leader": common, "common_first_segment": inside}
     for m, rs in per.items():
-        out[m] = {"labels": int(sum(r.metrics["labels"] for r in rs)),
-                  "unplaced": int(sum(len(r.unplaced) for r in rs)),
-                  "clean": int(sum(is_clean(r.metrics) for r in rs)),
-                  "leader_mean": float(np.mean([r.metrics["leader_mean_norm"] for r in rs])),
-                  "salience_mean": float(np.mean([r.metrics["salience_mean"] for r in rs])),
-                  "box_ms": float(np.median([1000.0 * r.timings["boxes"] for r in rs])),
-                  "layout_ms": float(np.median([r.timings["layout_ms"] for r in rs])),
-                  "layout_ms_max": float(max(r.timings["layout_ms"] for r in rs)),
-                  "labels_max": int(max(r.metrics["labels"] for r in rs))}
-    out["fuzzy_shorter"] = int(sum(a.metrics["leader_mean_norm"] < b.metrics["leader_mean_norm"]
-                                   for a, b in zip(per["fuzzy"], per["two-step"])))
+        out[m] = {
+            "labels": int(sum(r.metrics["labels"] for r in rs)),
+            "unplaced": int(sum(len(r.unplaced) for r in rs)),
+            "clean": int(sum(is_clean(r.metrics) for r in rs)),
+            "leader_mean": float(np.mean([r.metrics["leader_mean_norm"] for r in rs])),
+            "salience_mean": float(np.mean([r.metrics["salience_mean"] for r in rs])),
+            "box_ms": float(np.median([1000.0 * r.timings["boxes"] for r in rs])),
+            "layout_ms": float(np.median([r.timings["layout_ms"] for r in rs])),
+            "layout_ms_max": float(max(r.timings["layout_ms"] for r in rs)),
+            "labels_max": int(max(r.metrics["labels"] for r in rs)),
+        }
+    out["fuzzy_shorter"] = int(
+        sum(
+            a.metrics["leader_mean_norm"] < b.metrics["leader_mean_norm"]
+            for a, b in zip(per["fuzzy"], per["two-step"])
+        )
+    )
     return out
 
 
 def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' common name
     """Plain-text tables of a :func:`run` result."""
-    lines = [f"labeling benchmark: {result['model']} ({result['parts']} parts, {result['visible_parts']} visible), "
-             f"{result['size']} x {result['size']}, median of {result['repeat']} runs, d_e "
-             f"{'paper default' if result.get('d_e') is None else result['d_e']}, rotate {result.get('rotate')} px",
-             f"ray caster build {result['setup_s'] * 1000:.1f} ms, ID buffer {result['idbuffer_s'] * 1000:.1f} ms", ""]
+    lines = [
+        f"labeling benchmark: {result['model']} ({result['parts']} parts, {result['visible_parts']} visible), "
+        f"{result['size']} x {result['size']}, median of {result['repeat']} runs, d_e "
+        f"{'paper default' if result.get('d_e') is None else result['d_e']}, rotate {result.get('rotate')} px",
+        f"ray caster build {result['setup_s'] * 1000:.1f} ms, ID buffer {result['idbuffer_s'] * 1000:.1f} ms",
+        "",
+    ]
     stages = [s for s in LAYOUT_STAGES]
     head = f"{'layout':11s} {'method':10s} " + " ".join(f"{s[:6]:>6s}" for s in stages) + f" {'layout':>7s}"
     lines += ["per-stage time per frame (ms)", head]
     for layout, entry in result["layouts"].items():
         for method in ("fuzzy", "two-step"):
             t = entry[method]["timings"]
-            lines.append(f"{layout:11s} {method:10s} " + " ".join(f"{1000 * t.get(s, 0.0):6.1f}" for s in stages)
-                         + f" {t['layout_ms']:7.1f}")
+            lines.append(
+                f"{layout:11s} {method:10s} "
+                + " ".join(f"{1000 * t.get(s, 0.0):6.1f}" for s in stages)
+                + f" {t['layout_ms']:7.1f}"
+            )
         if "adjusttext" in entry:
-            lines.append(f"{layout:11s} {'adjusttext':10s} " + " ".join(f"{'':6s}" for _ in stages)
-                         + f" {entry['adjusttext']['timings']['layout_ms']:7.1f}")
-    lines += ["", "quality", f"{'layout':11s} {'method':10s} {'labels':>6s} {'overlap':>7s} {'cross':>5s} "
-              f"{'thru':>4s} {'over_px':>7s} {'bad_a':>5s} {'salience':>8s} {'leader':>7s} {'max':>6s} {'shifted':>7s}"]
+            lines.append(
+                f"{layout:11s} {'adjusttext':10s} "
+                + " ".join(f"{'':6s}" for _ in stages)
+                + f" {entry['adjusttext']['timings']['layout_ms']:7.1f}"
+            )
+    lines += [
+        "",
+        "quality",
+        f"{'layout':11s} {'method':10s} {'labels':>6s} {'overlap':>7s} {'cross':>5s} "
+        f"{'thru':>4s} {'over_px':>7s} {'bad_a':>5s} {'salience':>8s} {'leader':>7s} {'max':>6s} {'shifted':>7s}",
+    ]
     for layout, entry in result["layouts"].items():
         for method in ("fuzzy", "two-step", "adjusttext"):
             if method not in entry:
                 continue
             m = entry[method]["metrics"]
-            lines.append(f"{layout:11s} {method:10s} {m['labels']:6d} {m['overlaps']:7d} {m['crossings']:5d} "
-                         f"{m['leaders_through_labels']:4d} {m['label_over_model']:7d} {m['invalid_anchors']:5d} "
-                         f"{m['salience_mean']:8.3f} {m['leader_mean_norm']:7.3f} {m['leader_max_norm']:6.3f} "
-                         f"{m.get('shifted_labels', 0):7d}")
+            lines.append(
+                f"{layout:11s} {method:10s} {m['labels']:6d} {m['overlaps']:7d} {m['crossings']:5d} "
+                f"{m['leaders_through_labels']:4d} {m['label_over_model']:7d} {m['invalid_anchors']:5d} "
+                f"{m['salience_mean']:8.3f} {m['leader_mean_norm']:7.3f} {m['leader_max_norm']:6.3f} "
+                f"{m.get('shifted_labels', 0):7d}"
+            )
     if result.get("sizes"):
-        lines += ["", f"quality against image size ({result['size_layout']}); error = mean anchor distance to the "
-                  f"same method's anchors at the largest size / d_S",
-                  f"{'size':>5s} {'id_ms':>7s} {'fz_ms':>7s} {'fz_err':>7s} {'fz_leader':>9s} {'fz_sal':>6s} "
-                  f"{'2s_ms':>7s} {'2s_err':>7s} {'2s_leader':>9s} {'2s_sal':>6s}"]
+        lines += [
+            "",
+            f"quality against image size ({result['size_layout']}); error = mean anchor distance to the "
+            f"same method's anchors at the largest size / d_S",
+            f"{'size':>5s} {'id_ms':>7s} {'fz_ms':>7s} {'fz_err':>7s} {'fz_leader':>9s} {'fz_sal':>6s} "
+            f"{'2s_ms':>7s} {'2s_err':>7s} {'2s_leader':>9s} {'2s_sal':>6s}",
+        ]
         for n, rec in result["sizes"].items():
             f, t = rec["fuzzy"], rec["two-step"]
-            lines.append(f"{int(n):5d} {rec['idbuffer_s'] * 1000:7.1f} {f['layout_ms']:7.1f} {f['error']:7.4f} "
-                         f"{f['metrics']['leader_mean_norm']:9.3f} {f['metrics']['salience_mean']:6.3f} "
-                         f"{t['layout_ms']:7.1f} {t['error']:7.4f} {t['metrics']['leader_mean_norm']:9.3f} "
-                         f"{t['metrics']['salience_mean']:6.3f}")
+            lines.append(
+                f"{int(n):5d} {rec['idbuffer_s'] * 1000:7.1f} {f['layout_ms']:7.1f} {f['error']:7.4f} "
+                f"{f['metrics']['leader_mean_norm']:9.3f} {f['metrics']['salience_mean']:6.3f} "
+                f"{t['layout_ms']:7.1f} {t['error']:7.4f} {t['metrics']['leader_mean_norm']:9.3f} "
+                f"{t['metrics']['salience_mean']:6.3f}"
+            )
     if result.get("orbit"):
-        lines += ["", f"orbit of {result['orbit_frames']} frames ({result['orbit_layout']}), motion per frame (px)",
-                  f"{'variant':20s} {'label':>6s} {'anchor':>6s} {'flips':>5s} {'swaps':>5s} {'clean':>5s} "
-                  f"{'leader':>6s} {'salience':>8s} {'ms':>6s}"]
+        lines += [
+            "",
+            f"orbit of {result['orbit_frames']} frames ({result['orbit_layout']}), motion per frame (px)",
+            f"{'variant':20s} {'label':>6s} {'anchor':>6s} {'flips':>5s} {'swaps':>5s} {'clean':>5s} "
+            f"{'leader':>6s} {'salience':>8s} {'ms':>6s}",
+        ]
         for key, s in result["orbit"].items():
-            lines.append(f"{key:20s} {s['label_motion_mean']:6.2f} {s['anchor_motion_mean']:6.2f} {s['side_flips']:5d} "
-                         f"{s['order_swaps']:5d} {s['clean_frames']:5d} {s['leader_mean_norm']:6.3f} "
-                         f"{s['salience_mean']:8.3f} {s['layout_ms_mean']:6.1f}")
+            lines.append(
+                f"{key:20s} {s['label_motion_mean']:6.2f} {s['anchor_motion_mean']:6.2f} {s['side_flips']:5d} "
+                f"{s['order_swaps']:5d} {s['clean_frames']:5d} {s['leader_mean_norm']:6.3f} "
+                f"{s['salience_mean']:8.3f} {s['layout_ms_mean']:6.1f}"
+            )
     if result.get("views"):
         n = next(iter(result["views"].values()))["views"]
-        lines += ["", f"{n} views (azimuths evenly spaced, elevations {result.get('view_elevations')}), "
-                  "per layout; leader = mean over the views of the mean leader / d_S; common = summed over "
-                  "the labels both methods place; box = median box-stage ms; fz_ms, fz_max = median and "
-                  "slowest layout ms of the fuzzy method; most = most labels in one view",
-                  f"{'layout':11s} {'fz_labels':>9s} {'2s_labels':>9s} {'fz_clean':>8s} {'2s_clean':>8s} "
-                  f"{'fz_leader':>9s} {'2s_leader':>9s} {'shorter':>7s} {'fz_common':>9s} {'2s_common':>9s} "
-                  f"{'fz_sal':>6s} {'fz_box':>6s} {'2s_box':>6s} {'fz_ms':>6s} {'fz_max':>6s} {'most':>4s}"]
+        lines += [
+            "",
+            f"{n} views (azimuths evenly spaced, elevations {result.get('view_elevations')}), "
+            "per layout; leader = mean over the views of the mean leader / d_S; common = summed over "
+            "the labels both methods place; box = median box-stage ms; fz_ms, fz_max = median and "
+            "slowest layout ms of the fuzzy method; most = most labels in one view",
+            f"{'layout':11s} {'fz_labels':>9s} {'2s_labels':>9s} {'fz_clean':>8s} {'2s_clean':>8s} "
+            f"{'fz_leader':>9s} {'2s_leader':>9s} {'shorter':>7s} {'fz_common':>9s} {'2s_common':>9s} "
+            f"{'fz_sal':>6s} {'fz_box':>6s} {'2s_box':>6s} {'fz_ms':>6s} {'fz_max':>6s} {'most':>4s}",
+        ]
         for layout, v in result["views"].items():
             f, t = v["fuzzy"], v["two-step"]
-            lines.append(f"{layout:11s} {f['labels']:9d} {t['labels']:9d} {f['clean']:8d} {t['clean']:8d} "
-                         f"{f['leader_mean']:9.3f} {t['leader_mean']:9.3f} {v['fuzzy_shorter']:7d} "
-                         f"{v['common_leader']['fuzzy']:9.2f} {v['common_leader']['two-step']:9.2f} "
-                         f"{f['salience_mean']:6.3f} {f['box_ms']:6.1f} {t['box_ms']:6.1f} "
-                         f"{f['layout_ms']:6.1f} {f['layout_ms_max']:6.1f} {f['labels_max']:4d}")
+            lines.append(
+                f"{layout:11s} {f['labels']:9d} {t['labels']:9d} {f['clean']:8d} {t['clean']:8d} "
+                f"{f['leader_mean']:9.3f} {t['leader_mean']:9.3f} {v['fuzzy_shorter']:7d} "
+                f"{v['common_leader']['fuzzy']:9.2f} {v['common_leader']['two-step']:9.2f} "
+                f"{f['salience_mean']:6.3f} {f['box_ms']:6.1f} {t['box_ms']:6.1f} "
+                f"{f['layout_ms']:6.1f} {f['layout_ms_max']:6.1f} {f['labels_max']:4d}"
+            )
     return "\n".join(lines)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``meshvis bench labeling``."""
     parser.add_argument("model", nargs="*", help="model file(s) (default: models/assembly.obj)")
-    parser.add_argument("--size", type=int, default=512, help="image size of the layout comparison (default 512)")
-    parser.add_argument("--sizes", type=int, nargs="+", default=[256, 384, 512, 768, 1024],
-                        help="image sizes of the quality-against-size curve")
+    parser.add_argument(
+        "--size", type=int, default=512, help="image size of the layout comparison (default 512)"
+    )
+    parser.add_argument(
+        "--sizes",
+        type=int,
+        nargs="+",
+        default=[256, 384, 512, 768, 1024],
+        help="image sizes of the quality-against-size curve",
+    )
     parser.add_argument("--layouts", nargs="+", choices=tuple(LAYOUTS), default=list(LAYOUTS))
     parser.add_argument("--orbit", type=int, default=12, help="frames of the orbit (0: skip)")
-    parser.add_argument("--views", type=int, default=12,
-                        help="azimuths of the many-views comparison, at elevations 20 and 45 (0: skip; default 12)")
+    parser.add_argument(
+        "--views",
+        type=int,
+        default=12,
+        help="azimuths of the many-views comparison, at elevations 20 and 45 (0: skip; default 12)",
+    )
     parser.add_argument("--repeat", type=int, default=5, help="runs per timing, median reported (default 5)")
     parser.add_argument("--no-adjusttext", action="store_true", help="skip the (slow) adjustText baseline")
     parser.add_argument("--up", choices=("x", "y", "z"), default="z", help="the model's up axis (default z)")
-    parser.add_argument("--d-e", type=float, default=None,
-                        help="d_e of the fuzzy method, fraction of d_S (default: the paper's, from the box size)")
-    parser.add_argument("--rotate", type=float, default=None,
-                        help="largest endpoint move of a rotated leader, pixels (silhouette layout; 0: none)")
+    parser.add_argument(
+        "--d-e",
+        type=float,
+        default=None,
+        help="d_e of the fuzzy method, fraction of d_S (default: the paper's, from the box size)",
+    )
+    parser.add_argument(
+        "--rotate",
+        type=float,
+        default=None,
+        help="largest endpoint move of a rotated leader, pixels (silhouette layout; 0: none)",
+    )
     parser.add_argument("--json", metavar="FILE", help="also write the numbers as JSON")
 
 
@@ -351,10 +481,20 @@ def main(args: argparse.Namespace) -> int:
     model = None
     if args.model:
         model = args.model if len(args.model) > 1 else args.model[0]
-    result = run(model, size=args.size, layouts=args.layouts, sizes=args.sizes, orbit_frames=args.orbit,
-                 repeat=args.repeat, adjusttext=not args.no_adjusttext, up=AXES[args.up], views=args.views,
-                 d_e=args.d_e, rotate=args.rotate,
-                 progress=lambda s: print(s, flush=True))
+    result = run(
+        model,
+        size=args.size,
+        layouts=args.layouts,
+        sizes=args.sizes,
+        orbit_frames=args.orbit,
+        repeat=args.repeat,
+        adjusttext=not args.no_adjusttext,
+        up=AXES[args.up],
+        views=args.views,
+        d_e=args.d_e,
+        rotate=args.rotate,
+        progress=lambda s: print(s, flush=True),
+    )
     return report(result, format(result), args.json)
 
 

@@ -33,6 +33,7 @@ A last pass checks every pair of labels and re-places a label of any conflicting
 valid place is left out and reported.  Everything is deterministic: sorts are stable
 with the label index as the last key, and candidate ties go to the lowest index.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -192,7 +193,7 @@ def coherent_order(desired: np.ndarray, previous: np.ndarray, pitch: float) -> n
         changed = False
         for i in range(len(order) - 1):
             a, b = order[i], order[i + 1]
-            if (abs(desired[b] - desired[a]) < pitch and previous[a] > previous[b]):  # NaN compares False
+            if abs(desired[b] - desired[a]) < pitch and previous[a] > previous[b]:  # NaN compares False
                 order[i], order[i + 1] = b, a
                 changed = True
     return np.asarray(order, np.int64)
@@ -202,11 +203,25 @@ def coherent_order(desired: np.ndarray, previous: np.ndarray, pitch: float) -> n
 class _Context:
     """Everything the placement of one frame shares."""
 
-    def __init__(self, anchors, endpoints, sides, widths, height, area, image_size, spacing, rank, previous=None,
-                 directions=None):
+    def __init__(
+        self,
+        anchors,
+        endpoints,
+        sides,
+        widths,
+        height,
+        area,
+        image_size,
+        spacing,
+        rank,
+        previous=None,
+        directions=None,
+    ):
         self.anchors = np.asarray(anchors, np.float64).reshape(-1, 2)
         # per label: its box centre along each side in the previous frame (NaN: elsewhere)
-        self.previous = np.full((len(self.anchors), 4), np.nan) if previous is None else np.asarray(previous, np.float64)
+        self.previous = (
+            np.full((len(self.anchors), 4), np.nan) if previous is None else np.asarray(previous, np.float64)
+        )
         self.endpoints = np.array(endpoints, np.float64).reshape(-1, 2)  # a copy: parting moves them
         self.sides = np.array(sides, np.int64)  # a copy: a label may change side
         # the layout's principal directions (a label may move to another one of them)
@@ -219,10 +234,14 @@ class _Context:
         self.rank = np.asarray(rank, np.int64)
         self.placed: list[Placement | None] = [None] * len(self.anchors)
         x0, y0, x1, y1 = area.bbox
-        self.col_x = {WEST: float(np.nanmin(area.left)) - spacing.clearance,
-                      EAST: float(np.nanmax(area.right)) + spacing.clearance}
-        self.row_y = {NORTH: float(np.nanmin(area.top)) - spacing.clearance,
-                      SOUTH: float(np.nanmax(area.bottom)) + spacing.clearance}
+        self.col_x = {
+            WEST: float(np.nanmin(area.left)) - spacing.clearance,
+            EAST: float(np.nanmax(area.right)) + spacing.clearance,
+        }
+        self.row_y = {
+            NORTH: float(np.nanmin(area.top)) - spacing.clearance,
+            SOUTH: float(np.nanmax(area.bottom)) + spacing.clearance,
+        }
         self.center = area.centroid
         self.stats = BoxStats()
         self._boundary = None
@@ -397,7 +416,9 @@ def _place_row(ctx: _Context, idx: np.ndarray, side: int) -> None:
             edges.append(box[2] if sign > 0 else box[0])
             shift = abs(port_x[j] - ctx.endpoints[k, 0])
             ctx.stats.shifted += int(shift > 0.5)
-            ctx.placed[k] = Placement(ctx.row_leader(k, side, float(port_x[j]), r), box, side, r, float(shift))
+            ctx.placed[k] = Placement(
+                ctx.row_leader(k, side, float(port_x[j]), r), box, side, r, float(shift)
+            )
 
 
 def _ring_order(ctx: _Context, idx: np.ndarray) -> np.ndarray:
@@ -482,8 +503,11 @@ def _run_order(ctx: _Context, ring: np.ndarray) -> list[int]:
     bx = np.concatenate([c - half, c + half], axis=1)
     rays = np.stack([e, e + ctx.ray_length * nrm], axis=1)
     a, b = np.arange(n - 1), np.arange(1, n)
-    clash = (boxes_overlap(bx[a], bx[b], ctx.sp.gap).diagonal()
-             | segment_hits_box(rays[b], bx[a]).diagonal() | segment_hits_box(rays[a], bx[b]).diagonal())
+    clash = (
+        boxes_overlap(bx[a], bx[b], ctx.sp.gap).diagonal()
+        | segment_hits_box(rays[b], bx[a]).diagonal()
+        | segment_hits_box(rays[a], bx[b]).diagonal()
+    )
     order: list[int] = []
     for run in np.split(np.asarray(ring), np.flatnonzero(~clash) + 1):
         lo, hi = 0, len(run) - 1
@@ -497,7 +521,7 @@ def _place_in_order(ctx: _Context, order: list[int]) -> list[int]:
     """Search a place for each silhouette label in ``order``; the labels left out."""
     unplaced = []
     for n, k in enumerate(order):
-        ctx.future = tuple(order[n + 1:])
+        ctx.future = tuple(order[n + 1 :])
         if not _search(ctx, k):
             unplaced.append(k)
     ctx.future = ()
@@ -572,8 +596,10 @@ def _placed_arrays(ctx: _Context, exclude: int) -> tuple[np.ndarray, np.ndarray]
             continue
         boxes.append(p.box)
         segs.append(p.segments)
-    out = (np.array(boxes, np.float64).reshape(-1, 4),
-           np.concatenate(segs).reshape(-1, 2, 2) if segs else np.zeros((0, 2, 2)))
+    out = (
+        np.array(boxes, np.float64).reshape(-1, 4),
+        np.concatenate(segs).reshape(-1, 2, 2) if segs else np.zeros((0, 2, 2)),
+    )
     ctx._cache = (key, out)
     return out
 
@@ -599,7 +625,9 @@ def _radial_tiers(ctx: _Context, reach: float) -> int:
     return int(min(96, max(2, reach // (0.5 * ctx.height + ctx.sp.gap) + 1)))
 
 
-def _candidates(ctx: _Context, k: int, reach: float) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _candidates(
+    ctx: _Context, k: int, reach: float
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Candidate (boxes, leaders, costs, tiers, shifts) of a column or row label within ``reach`` pixels."""
     side = int(ctx.sides[k])
     a = ctx.anchors[k]
@@ -622,11 +650,14 @@ def _candidates(ctx: _Context, k: int, reach: float) -> tuple[np.ndarray, np.nda
         boxes = ctx.row_box(k, side, X, T)
         y = ctx.row_y[side]
         tip = boxes[:, 3] if side == NORTH else boxes[:, 1]
-        leaders = np.stack([
-            np.broadcast_to(a, (len(X), 2)),
-            np.column_stack([X, np.full(len(X), y)]),
-            np.column_stack([X, np.where(T > 0, tip, y)]),
-        ], axis=1)
+        leaders = np.stack(
+            [
+                np.broadcast_to(a, (len(X), 2)),
+                np.column_stack([X, np.full(len(X), y)]),
+                np.column_stack([X, np.where(T > 0, tip, y)]),
+            ],
+            axis=1,
+        )
         shifts = np.abs(X - ctx.endpoints[k, 0])
         tiers = T
         cost = shifts + T * (h + ctx.sp.gap) * 2.0
@@ -636,8 +667,9 @@ def _candidates(ctx: _Context, k: int, reach: float) -> tuple[np.ndarray, np.nda
     return boxes, leaders, cost, tiers, shifts
 
 
-def _radial_candidates(ctx: _Context, k: int, reach: float, moves: tuple[float, float] | None = None,
-                       below: float = np.inf) -> tuple[np.ndarray, ...]:
+def _radial_candidates(
+    ctx: _Context, k: int, reach: float, moves: tuple[float, float] | None = None, below: float = np.inf
+) -> tuple[np.ndarray, ...]:
     """Candidates of a silhouette-layout label: boxes pushed out along the ray of an endpoint.
 
     Every endpoint E (the label's own; with ``moves`` = (step, most) also points every
@@ -674,8 +706,11 @@ def _radial_candidates(ctx: _Context, k: int, reach: float, moves: tuple[float, 
     along = _facing(N[:, None, :], off[None])  # (E, A)
     moved = np.hypot(*(E - ctx.endpoints[k]).T)
     longer = np.hypot(*(E - a).T) - np.hypot(*(ctx.endpoints[k] - a))
-    cost = (t * tier_step)[None, :, None] + ((moved > 0) * (h + longer))[:, None, None] \
+    cost = (
+        (t * tier_step)[None, :, None]
+        + ((moved > 0) * (h + longer))[:, None, None]
         + ((1.0 - along) * h + 1e6 * (along <= 0.05))[:, None, :]
+    )
     ie, it, ia = np.nonzero(cost < below)
     port = E + (ctx.sp.clearance + t[:, None, None] * tier_step) * N  # (T, E, 2)
     c = port[it, ie] + off[ia]
@@ -770,7 +805,9 @@ def _boxes_free(ctx: _Context, boxes: np.ndarray, pboxes: np.ndarray, psegs: np.
     return ok
 
 
-def _leaders_free(leaders: np.ndarray, pboxes: np.ndarray, psegs: np.ndarray, paths: np.ndarray | None) -> np.ndarray:
+def _leaders_free(
+    leaders: np.ndarray, pboxes: np.ndarray, psegs: np.ndarray, paths: np.ndarray | None
+) -> np.ndarray:
     """Which polylines (L, P, 2) cross no placed box, no placed leader and none of ``paths``."""
     L, P = leaders.shape[:2]
     segs = np.stack([leaders[:, :-1], leaders[:, 1:]], axis=2).reshape(-1, 2, 2)
@@ -783,8 +820,9 @@ def _leaders_free(leaders: np.ndarray, pboxes: np.ndarray, psegs: np.ndarray, pa
     return ~bad.reshape(L, P - 1).any(axis=1)
 
 
-def _cheapest(ctx: _Context, k: int, cands: tuple, rays: np.ndarray,
-              paths: np.ndarray | None) -> tuple[int | None, int | None]:
+def _cheapest(
+    ctx: _Context, k: int, cands: tuple, rays: np.ndarray, paths: np.ndarray | None
+) -> tuple[int | None, int | None]:
     """Cheapest valid radial candidate that blocks no future ray, and the cheapest valid one.
 
     ``cands`` = (boxes, leaders, lid, cost, ...) of :func:`_radial_candidates`, where the
@@ -928,8 +966,19 @@ def place_boxes(
     """
     n = len(anchors)
     rank = np.arange(n) if rank is None else np.asarray(rank)
-    ctx = _Context(anchors, endpoints, sides, widths, height, area, image_size, spacing or Spacing(), rank, previous,
-                   directions)
+    ctx = _Context(
+        anchors,
+        endpoints,
+        sides,
+        widths,
+        height,
+        area,
+        image_size,
+        spacing or Spacing(),
+        rank,
+        previous,
+        directions,
+    )
     for side in (WEST, EAST):
         _place_column(ctx, np.flatnonzero(ctx.sides == side), side)
     for side in (NORTH, SOUTH):

@@ -22,6 +22,7 @@ layout uses the exact Euclidean distance transform of ``A_I``
 ``A_I`` gives the direction, and the endpoint is put on the boundary half a pixel before it.
 This replaces the GPU jump flooding of the paper (§6.2) by exact CPU transforms.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -105,7 +106,9 @@ def _edt_in_box(mask: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndar
     return dist, (R, C)
 
 
-def _radial(mask: np.ndarray, X: np.ndarray, Y: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+def _radial(
+    mask: np.ndarray, X: np.ndarray, Y: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Nearest-boundary candidates: (length, ex, ey, key) on the grid of ``mask``.
 
     ``X``, ``Y``: image coordinates of the pixel centres of ``mask``; ``key`` = flat index

@@ -6,14 +6,16 @@ model is loaded and its ray caster built once for the whole path.  Every frame a
 first gets ``metrics["motion"]`` (:func:`meshvis.labeling.metrics.motion_metrics`) against its
 predecessor.
 """
+
 from __future__ import annotations
 
 import json
 import os
-from typing import Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
-from meshvis.rays.camera import Camera
 from meshvis.errors import ParameterError
+from meshvis.rays.camera import Camera
 from meshvis.rays.caster import RayCaster
 
 from .inputs import load_models
@@ -21,15 +23,33 @@ from .metrics import motion_metrics
 from .result import LayoutResult
 
 
-def orbit(model: Any, n_frames: int, *, elevation: float = 20.0, start: float = 30.0, fov: float = 35.0,
-          orthographic: bool = False, up: Sequence[float] = (0.0, 0.0, 1.0), fit_margin: float = 1.6,
-          distance: float | None = None) -> list[Camera]:
+def orbit(
+    model: Any,
+    n_frames: int,
+    *,
+    elevation: float = 20.0,
+    start: float = 30.0,
+    fov: float = 35.0,
+    orthographic: bool = False,
+    up: Sequence[float] = (0.0, 0.0, 1.0),
+    fit_margin: float = 1.6,
+    distance: float | None = None,
+) -> list[Camera]:
     """``n_frames`` cameras turning once around the model, framed for labels (see ``fit_margin``)."""
     if int(n_frames) < 1:
         raise ParameterError(f"an orbit needs at least 1 frame, got {n_frames}")
     soup = load_models(model)
-    return Camera.orbit(soup, int(n_frames), elevation=elevation, start=start, fov=fov,
-                        orthographic=orthographic, margin=fit_margin, up=up, distance=distance)
+    return Camera.orbit(
+        soup,
+        int(n_frames),
+        elevation=elevation,
+        start=start,
+        fov=fov,
+        orthographic=orthographic,
+        margin=fit_margin,
+        up=up,
+        distance=distance,
+    )
 
 
 def read_camera_path(path: str | os.PathLike) -> list[Camera]:

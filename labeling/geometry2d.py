@@ -4,6 +4,7 @@ Used both to place label boxes and to measure layouts, so that the placement and
 metrics agree on what "overlap" and "crossing" mean.  Boxes are ``(x0, y0, x1, y1)`` with
 ``x0 <= x1``, ``y0 <= y1``; segments are ``(2, 2)`` arrays ``[[x0, y0], [x1, y1]]``.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -67,8 +68,10 @@ def segments_intersect(a: np.ndarray, b: np.ndarray) -> np.ndarray:
         return out
     ba, bb = _seg_bbox(a), _seg_bbox(b)
     near = (
-        (ba[:, None, 0] <= bb[None, :, 2]) & (bb[None, :, 0] <= ba[:, None, 2])
-        & (ba[:, None, 1] <= bb[None, :, 3]) & (bb[None, :, 1] <= ba[:, None, 3])
+        (ba[:, None, 0] <= bb[None, :, 2])
+        & (bb[None, :, 0] <= ba[:, None, 2])
+        & (ba[:, None, 1] <= bb[None, :, 3])
+        & (bb[None, :, 1] <= ba[:, None, 3])
     )
     i, j = np.nonzero(near)
     if len(i) == 0:
@@ -103,8 +106,10 @@ def segment_hits_box(seg: np.ndarray, boxes: np.ndarray, shrink: float = 0.0) ->
     hi_all = boxes[:, 2:] - shrink
     sb = _seg_bbox(seg)
     near = (
-        (sb[:, None, 0] < hi_all[None, :, 0]) & (lo_all[None, :, 0] < sb[:, None, 2])
-        & (sb[:, None, 1] < hi_all[None, :, 1]) & (lo_all[None, :, 1] < sb[:, None, 3])
+        (sb[:, None, 0] < hi_all[None, :, 0])
+        & (lo_all[None, :, 0] < sb[:, None, 2])
+        & (sb[:, None, 1] < hi_all[None, :, 1])
+        & (lo_all[None, :, 1] < sb[:, None, 3])
     )
     i, j = np.nonzero(near)
     if len(i) == 0:

@@ -24,6 +24,7 @@ pixel order (row-major).  When every candidate of the chosen area has ``F = 0`` 
 endpoints coincide with placed ones), the candidate with the best remaining criteria
 (``F`` with ``f5`` floored at 1e-6) is taken.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -55,7 +56,10 @@ class _Buckets:
         j1 = min(int(np.floor((py + d) / self.cell)) - self.y0, self.ny - 1)
         if i0 > i1 or j0 > j1:
             return np.zeros(0, np.int64)
-        pieces = [self.order[self.start[j * self.nx + i0]: self.start[j * self.nx + i1 + 1]] for j in range(j0, j1 + 1)]
+        pieces = [
+            self.order[self.start[j * self.nx + i0] : self.start[j * self.nx + i1 + 1]]
+            for j in range(j0, j1 + 1)
+        ]
         return np.concatenate(pieces) if pieces else np.zeros(0, np.int64)
 
 
@@ -125,7 +129,7 @@ def greedy_layout(
     abk = _Buckets(ax, ay, d_a) if d_a > 0 and len(area) else None
     order, picks, feas, prio = [], [], [], []
     while alive.any():
-        f5w = f5 ** w5 if w5 != 1 else f5
+        f5w = f5**w5 if w5 != 1 else f5
         P = count - S @ f5w
         i = int(np.argmax(np.where(alive, P, -np.inf)))
         lo, hi = start[i], start[i + 1]
@@ -151,7 +155,7 @@ def greedy_layout(
             changed = new < f4[near]
             near, new = near[changed], new[changed]
             if len(near):
-                new_w = new ** w4 if w4 != 1 else new
+                new_w = new**w4 if w4 != 1 else new
                 delta = static[near] * (new_w - f4w[near])
                 S += np.bincount(cell[near], weights=delta, minlength=n_areas * n_e).reshape(n_areas, n_e)
                 f4[near] = new

@@ -6,13 +6,15 @@ on).  The part id of the first hit is the pixel's object id; the visible area ``
 part *i* is its pixel count.  Parts with no pixel (or fewer than ``min_pixels``) are
 invisible: they are reported and not labelled.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
+
 import numpy as np
 
-from meshvis.rays.camera import Camera
 from meshvis.errors import ParameterError
+from meshvis.rays.camera import Camera
 from meshvis.rays.caster import RayCaster
 from meshvis.soup import Soup
 
@@ -74,7 +76,9 @@ class IdBuffer:
         return out
 
 
-def pixel_rays(camera: Camera, col: np.ndarray, row: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+def pixel_rays(
+    camera: Camera, col: np.ndarray, row: np.ndarray, width: int, height: int
+) -> tuple[np.ndarray, np.ndarray]:
     """The primary rays of a few pixels (one per anchor): :meth:`Camera.pixel_rays`."""
     return camera.pixel_rays(col, row, width, height)
 
@@ -140,4 +144,3 @@ def id_buffer(
         sphere_center=center,
         sphere_diameter=max(diameter, 1.0),
     )
-

@@ -9,16 +9,17 @@ Label texts default to the part names and can be overridden by a JSON object
 (``{"part name": "label text"}``) or a two-column CSV file (``part name,label text``); an
 empty text means "do not label this part".  Keys may also be part indices.
 """
+
 from __future__ import annotations
 
 import csv
 import json
 import os
-from typing import Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 from meshvis.errors import ModelError, ParameterError
-from meshvis.io import unique_names
-from meshvis.io import as_soup
+from meshvis.io import as_soup, unique_names
 from meshvis.soup import Soup
 
 
@@ -41,7 +42,9 @@ def load_models(model: Any) -> Soup:
     """
     if isinstance(model, (str, os.PathLike, Soup)) or not isinstance(model, (list, tuple)):
         items = [model]
-    elif len(model) == 2 and not isinstance(model[0], (str, os.PathLike, Soup)) and hasattr(model[0], "shape"):
+    elif (
+        len(model) == 2 and not isinstance(model[0], (str, os.PathLike, Soup)) and hasattr(model[0], "shape")
+    ):
         items = [model]  # a (vertices, faces) pair
     else:
         items = list(model)

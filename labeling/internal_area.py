@@ -15,6 +15,7 @@ side so that it is never clipped by the image border (the distance transforms th
 true boundary).  Coordinates are pixel coordinates of the *image*: x right, y down, pixel
 (r, c) covering ``[c, c+1) x [r, r+1)`` with its centre at ``(c + 0.5, r + 0.5)``.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -21,6 +21,7 @@ Weights default to the paper's values (§7.3): ``w2 = 0.2, w3 = 1, w4 = w5 = 1,
 w6 = w7 = 0.7``.  ``d_a``, ``d_e`` and ``d_S`` are in pixels here; the public API takes
 ``d_a`` and ``d_e`` as fractions of ``d_S`` like the paper (§7.2).
 """
+
 from __future__ import annotations
 
 from dataclasses import asdict, dataclass

@@ -25,9 +25,11 @@ Between frames (:func:`motion_metrics`): ``anchor_motion_mean``/``_max``,
 ``label_motion_mean``/``_max`` (box centres), their ``_norm`` versions, ``side_flips``
 and ``order_swaps`` (pairs of labels on the same side whose order along it reversed).
 """
+
 from __future__ import annotations
 
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 
 import numpy as np
 from scipy import ndimage
@@ -127,7 +129,9 @@ def frame_metrics(result: LayoutResult, dist_sil: np.ndarray | None = None) -> d
     shifts = np.array([lab.shift for lab in labs])
     out["shifted_labels"] = int((shifts > 0.5).sum())
     out["shift_mean"] = float(shifts.mean()) if n else 0.0
-    out["outside_image"] = int(((boxes[:, 0] < 0) | (boxes[:, 1] < 0) | (boxes[:, 2] > w) | (boxes[:, 3] > h)).sum())
+    out["outside_image"] = int(
+        ((boxes[:, 0] < 0) | (boxes[:, 1] < 0) | (boxes[:, 2] > w) | (boxes[:, 3] > h)).sum()
+    )
     return out
 
 
@@ -153,7 +157,12 @@ def motion_metrics(prev: LayoutResult, cur: LayoutResult) -> dict[str, Any]:
         out["side_flips"] = out["order_swaps"] = 0
         return out
     am = np.array([np.linalg.norm(b[p].anchor - a[p].anchor) for p in common])
-    lm = np.array([np.linalg.norm((b[p].box[:2] + b[p].box[2:]) / 2 - (a[p].box[:2] + a[p].box[2:]) / 2) for p in common])
+    lm = np.array(
+        [
+            np.linalg.norm((b[p].box[:2] + b[p].box[2:]) / 2 - (a[p].box[:2] + a[p].box[2:]) / 2)
+            for p in common
+        ]
+    )
     out["anchor_motion_mean"], out["anchor_motion_max"] = float(am.mean()), float(am.max())
     out["label_motion_mean"], out["label_motion_max"] = float(lm.mean()), float(lm.max())
     for k in ("anchor_motion_mean", "anchor_motion_max", "label_motion_mean", "label_motion_max"):

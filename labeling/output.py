@@ -9,12 +9,14 @@
 * **GIF**: the PNG frames of a sequence on a common canvas.
 * **JSON**: :meth:`LayoutResult.to_json` per frame (labels, metrics, timings).
 """
+
 from __future__ import annotations
 
 import base64
 import io
 import os
-from typing import Any, Sequence
+from collections.abc import Sequence
+from typing import Any
 from xml.sax.saxutils import escape, quoteattr
 
 import numpy as np
@@ -67,7 +69,7 @@ def to_svg(result: LayoutResult, *, show_area: bool = False, canvas: Sequence[fl
         '<?xml version="1.0" encoding="UTF-8"?>',
         f'<svg xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" '
         f'width="{x1 - x0:g}" height="{y1 - y0:g}" viewBox="{x0:g} {y0:g} {x1 - x0:g} {y1 - y0:g}">',
-        f'<title>{escape(result.layout)} labels ({escape(result.method)})</title>',
+        f"<title>{escape(result.layout)} labels ({escape(result.method)})</title>",
         f'<rect x="{x0:g}" y="{y0:g}" width="{x1 - x0:g}" height="{y1 - y0:g}" fill="#ffffff"/>',
         f'<image x="0" y="0" width="{w}" height="{h}" preserveAspectRatio="none" href="{uri}" xlink:href="{uri}"/>',
     ]
@@ -99,8 +101,13 @@ def to_svg(result: LayoutResult, *, show_area: bool = False, canvas: Sequence[fl
     return "\n".join(out) + "\n"
 
 
-def to_image(result: LayoutResult, *, canvas: Sequence[float] | None = None, supersample: int = 2,
-             show_area: bool = False):
+def to_image(
+    result: LayoutResult,
+    *,
+    canvas: Sequence[float] | None = None,
+    supersample: int = 2,
+    show_area: bool = False,
+):
     """Rasterise a labelled view to a ``PIL.Image`` (RGB) of the canvas size."""
     from PIL import Image, ImageDraw
 
@@ -109,7 +116,9 @@ def to_image(result: LayoutResult, *, canvas: Sequence[float] | None = None, sup
     W, H = int(round(x1 - x0)), int(round(y1 - y0))
     img = Image.new("RGB", (W * s, H * s), (255, 255, 255))
     w, h = result.size
-    base = Image.fromarray(np.asarray(result.image, np.uint8)).resize((w * s, h * s), Image.Resampling.NEAREST)
+    base = Image.fromarray(np.asarray(result.image, np.uint8)).resize(
+        (w * s, h * s), Image.Resampling.NEAREST
+    )
     img.paste(base, (int(round(-x0)) * s, int(round(-y0)) * s))
     draw = ImageDraw.Draw(img)
 
@@ -171,8 +180,16 @@ def write_gif(results: Sequence[LayoutResult], path: str, *, duration_ms: int = 
     canvas = union_canvas(results)
     frames = [to_image(r, canvas=canvas).convert("P", palette=1, colors=255) for r in results]
     with _atomic(_check_path(path), "wb") as fh:
-        frames[0].save(fh, format="GIF", save_all=True, append_images=frames[1:], duration=int(duration_ms),
-                       loop=int(loop), optimize=False, disposal=1)
+        frames[0].save(
+            fh,
+            format="GIF",
+            save_all=True,
+            append_images=frames[1:],
+            duration=int(duration_ms),
+            loop=int(loop),
+            optimize=False,
+            disposal=1,
+        )
 
 
 def write_json(data: Any, path: str) -> None:

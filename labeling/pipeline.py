@@ -15,15 +15,17 @@ Stages and their timing keys:
 ``layout_ms`` in the timings is everything after the ID buffer up to and including the
 boxes: the number the paper reports per frame.
 """
+
 from __future__ import annotations
 
 import time
-from typing import Any, Mapping, Sequence
+from collections.abc import Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
-from meshvis.rays.camera import Camera
 from meshvis.errors import ParameterError
+from meshvis.rays.camera import Camera
 from meshvis.rays.caster import RayCaster
 from meshvis.soup import Soup
 
@@ -44,19 +46,36 @@ METHODS = ("fuzzy", "two-step")
 LAYOUT_STAGES = ("area", "candidates", "salience", "memberships", "greedy", "boxes")
 
 
-def fit_camera(soup: Soup, *, azimuth: float = 30.0, elevation: float = 20.0, distance: float | None = None,
-               fov: float = 35.0, orthographic: bool = False, up: Sequence[float] = (0.0, 0.0, 1.0),
-               margin: float = 1.6) -> Camera:
+def fit_camera(
+    soup: Soup,
+    *,
+    azimuth: float = 30.0,
+    elevation: float = 20.0,
+    distance: float | None = None,
+    fov: float = 35.0,
+    orthographic: bool = False,
+    up: Sequence[float] = (0.0, 0.0, 1.0),
+    margin: float = 1.6,
+) -> Camera:
     """The default labeling camera: like :meth:`Camera.fit` but with room around the model.
 
     ``margin`` 1.6 leaves about a fifth of the image on each side for the labels.
     """
-    return Camera.fit(soup, azimuth=azimuth, elevation=elevation, distance=distance, fov=fov,
-                      orthographic=orthographic, margin=margin, up=up)
+    return Camera.fit(
+        soup,
+        azimuth=azimuth,
+        elevation=elevation,
+        distance=distance,
+        fov=fov,
+        orthographic=orthographic,
+        margin=margin,
+        up=up,
+    )
 
 
-def _fit_font(n_labels: int, layout: str, height: int, font_size: int, min_size: int = 6,
-              gap: float = 3.0) -> TextStyle:
+def _fit_font(
+    n_labels: int, layout: str, height: int, font_size: int, min_size: int = 6, gap: float = 3.0
+) -> TextStyle:
     """Shrink the font until the boxes of a west/east column fit the image height."""
     style = TextStyle(font_size)
     if not is_horizontal(layout) or n_labels == 0:
@@ -67,7 +86,9 @@ def _fit_font(n_labels: int, layout: str, height: int, font_size: int, min_size:
     return style
 
 
-def _previous_frame(previous: LayoutResult, slot: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _previous_frame(
+    previous: LayoutResult, slot: np.ndarray, n: int
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """The previous frame's anchor (n, 2), endpoint (n, 2) and box centre along each of the
     west, east, north and south sides (n, 4; y for west/east, x for north/south) of every
     label of this frame; NaN where the label was absent or on another side."""
@@ -156,9 +177,24 @@ def solve(
     labelled = np.array([p for p in visible if texts[p]], np.int64)
     if len(labelled) == 0 or not idbuf.model_mask.any():
         ia = internal_area(idbuf.model_mask, area, margin) if idbuf.model_mask.any() else None
-        return LayoutResult([], invisible, [], skipped, idbuf.image, idbuf.ids, idbuf.camera, layout, method,
-                            ia.polygon if ia is not None else np.zeros((0, 2)), font_size or default_font_size(h),
-                            0.0, d_s, {}, frame_metrics_empty(), timings)
+        return LayoutResult(
+            [],
+            invisible,
+            [],
+            skipped,
+            idbuf.image,
+            idbuf.ids,
+            idbuf.camera,
+            layout,
+            method,
+            ia.polygon if ia is not None else np.zeros((0, 2)),
+            font_size or default_font_size(h),
+            0.0,
+            d_s,
+            {},
+            frame_metrics_empty(),
+            timings,
+        )
     ia = internal_area(idbuf.model_mask, area, margin)
     t = tick("area", t)
     cand = leader_candidates(ia, layout)
@@ -193,14 +229,17 @@ def solve(
     da_px = d_a * d_s
 
     if method == "fuzzy":
-        static = weighted(f2_length(length, cand.d_max), weights.w2) * weighted(f3_salience(sal, cand.d_max), weights.w3)
+        static = weighted(f2_length(length, cand.d_max), weights.w2) * weighted(
+            f3_salience(sal, cand.d_max), weights.w3
+        )
         if previous is not None:
             prev_a, prev_e, _ = _previous_frame(previous, slot, len(labelled))
             static = static * weighted(f_coherence(ax, ay, prev_a[area_of], d_s), weights.w6)
             static = static * weighted(f_coherence(ex, ey, prev_e[area_of], d_s), weights.w7)
         t = tick("memberships", t)
-        g = greedy_layout(area_of, ax, ay, eid, cand.endpoints, static, len(labelled), da_px, de_px,
-                          weights.w4, weights.w5)
+        g = greedy_layout(
+            area_of, ax, ay, eid, cand.endpoints, static, len(labelled), da_px, de_px, weights.w4, weights.w5
+        )
         areas_in_order, picks, feas, prio = g.area_order, g.pick, g.feasibility, g.priority
         t = tick("greedy", t)
     else:
@@ -223,8 +262,19 @@ def solve(
     endpoints = np.column_stack([ex[pick_of], ey[pick_of]])
     sides = side[pick_of].astype(np.int64)
     prev_box = None if previous is None else _previous_frame(previous, slot, len(labelled))[2]
-    placements, stats = place_boxes(anchors, endpoints, sides, widths, style.box_height, ia, (w, h), rank, spacing,
-                                    prev_box, LAYOUTS[layout])
+    placements, stats = place_boxes(
+        anchors,
+        endpoints,
+        sides,
+        widths,
+        style.box_height,
+        ia,
+        (w, h),
+        rank,
+        spacing,
+        prev_box,
+        LAYOUTS[layout],
+    )
     t = tick("boxes", t)
 
     feas_of = np.full(len(labelled), np.nan)
@@ -239,20 +289,57 @@ def solve(
         if pl is None:
             unplaced.append((p, names[p]))
             continue
-        labels.append(Label(
-            part=p, name=names[p], text=texts[p], anchor=anchors[s], anchor_3d=anchors_3d[s],
-            endpoint=endpoints[s], leader=pl.leader, box=pl.box, side=SIDE_NAMES[pl.side], rank=int(rank[s]),
-            feasibility=float(feas_of[s]), priority=float(prio_of[s]), shift=pl.shift, tier=pl.tier,
-        ))
+        labels.append(
+            Label(
+                part=p,
+                name=names[p],
+                text=texts[p],
+                anchor=anchors[s],
+                anchor_3d=anchors_3d[s],
+                endpoint=endpoints[s],
+                leader=pl.leader,
+                box=pl.box,
+                side=SIDE_NAMES[pl.side],
+                rank=int(rank[s]),
+                feasibility=float(feas_of[s]),
+                priority=float(prio_of[s]),
+                shift=pl.shift,
+                tier=pl.tier,
+            )
+        )
     timings["layout_ms"] = 1000.0 * sum(timings.get(k, 0.0) for k in LAYOUT_STAGES)
     params = {
-        "layout": layout, "area": area, "margin": ia.margin, "method": method,
-        "weights": weights.as_dict(), "d_a": d_a, "d_e": (de_px / d_s) if d_e is None else d_e,
-        "d_a_px": da_px, "d_e_px": de_px, "d_max_px": cand.d_max, "min_pixels": int(min_pixels),
+        "layout": layout,
+        "area": area,
+        "margin": ia.margin,
+        "method": method,
+        "weights": weights.as_dict(),
+        "d_a": d_a,
+        "d_e": (de_px / d_s) if d_e is None else d_e,
+        "d_a_px": da_px,
+        "d_e_px": de_px,
+        "d_max_px": cand.d_max,
+        "min_pixels": int(min_pixels),
         "corrections": {"shifted": stats.shifted, "swaps": stats.swaps, "repaired": stats.repaired},
     }
-    result = LayoutResult(labels, invisible, unplaced, skipped, idbuf.image, idbuf.ids, idbuf.camera, layout,
-                          method, ia.polygon, style.font_size, style.box_height, d_s, params, {}, timings)
+    result = LayoutResult(
+        labels,
+        invisible,
+        unplaced,
+        skipped,
+        idbuf.image,
+        idbuf.ids,
+        idbuf.camera,
+        layout,
+        method,
+        ia.polygon,
+        style.font_size,
+        style.box_height,
+        d_s,
+        params,
+        {},
+        timings,
+    )
     if compute_metrics:
         t = time.perf_counter()
         result.metrics = frame_metrics(result, dist_sil)
@@ -272,11 +359,28 @@ def warm_up() -> None:
 
 def frame_metrics_empty() -> dict[str, Any]:
     """Metrics of a frame with nothing to label."""
-    return {"labels": 0, "labelling_rate": 1.0, "overlaps": 0, "overlap_area": 0.0, "crossings": 0,
-            "leaders_through_labels": 0, "label_over_model": 0, "label_over_model_frac": 0.0,
-            "leader_sum": 0.0, "leader_mean": 0.0, "leader_max": 0.0, "leader_sum_norm": 0.0,
-            "leader_mean_norm": 0.0, "leader_max_norm": 0.0, "invalid_anchors": 0, "salience_mean": 0.0,
-            "salience_min": 0.0, "shifted_labels": 0, "shift_mean": 0.0, "outside_image": 0}
+    return {
+        "labels": 0,
+        "labelling_rate": 1.0,
+        "overlaps": 0,
+        "overlap_area": 0.0,
+        "crossings": 0,
+        "leaders_through_labels": 0,
+        "label_over_model": 0,
+        "label_over_model_frac": 0.0,
+        "leader_sum": 0.0,
+        "leader_mean": 0.0,
+        "leader_max": 0.0,
+        "leader_sum_norm": 0.0,
+        "leader_mean_norm": 0.0,
+        "leader_max_norm": 0.0,
+        "invalid_anchors": 0,
+        "salience_mean": 0.0,
+        "salience_min": 0.0,
+        "shifted_labels": 0,
+        "shift_mean": 0.0,
+        "outside_image": 0,
+    }
 
 
 def layout(

@@ -1,4 +1,5 @@
 """The result of laying out the labels of one frame."""
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field

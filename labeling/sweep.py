@@ -11,11 +11,13 @@ divided by ``d_S``), and the mean layout time.
 
 ``meshvis bench labeling-sweep`` calls :func:`main`; Python code calls :func:`run`.
 """
+
 from __future__ import annotations
 
 import argparse
 import os
-from typing import Any, Callable, Sequence
+from collections.abc import Callable, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -32,7 +34,11 @@ from .pipeline import METHODS, fit_camera, solve, warm_up
 REAL = (
     ("truck", ("CesiumMilkTruck.glb",), (0.0, 1.0, 0.0)),
     ("boolean", ("boolean.glb",), (0.0, 0.0, 1.0)),
-    ("dog", tuple(f"dm_control__{n}.stl" for n in ("SKINbody", "BONEMergedSkull", "BONERibcage")), (0.0, 0.0, 1.0)),
+    (
+        "dog",
+        tuple(f"dm_control__{n}.stl" for n in ("SKINbody", "BONEMergedSkull", "BONERibcage")),
+        (0.0, 0.0, 1.0),
+    ),
 )
 
 
@@ -40,7 +46,9 @@ def default_models() -> list[tuple[str, Any, tuple[float, float, float]]]:
     """The generated engine assembly and the real multi-part models that are available."""
     from .bench import default_model
 
-    out: list[tuple[str, Any, tuple[float, float, float]]] = [("assembly", default_model()[0], (0.0, 0.0, 1.0))]
+    out: list[tuple[str, Any, tuple[float, float, float]]] = [
+        ("assembly", default_model()[0], (0.0, 0.0, 1.0))
+    ]
     folder = real_models_dir()
     for name, files, up in REAL:
         paths = [os.path.join(folder, f) for f in files]
@@ -94,10 +102,14 @@ def run(
                             r = solve(ib, texts, layout=layout, method=method)
                             m = r.metrics
                             cases[f"{name}|{az:g}|{el:g}|{n}|{layout}|{method}"] = {
-                                "labels": int(m["labels"]), "unplaced": len(r.unplaced),
+                                "labels": int(m["labels"]),
+                                "unplaced": len(r.unplaced),
                                 "clean": bool(is_clean(m) and m["leaders_through_labels"] == 0),
-                                "leader_mean": float(m["leader_mean_norm"]), "leader_max": float(m["leader_max_norm"]),
-                                "leader_sum": float(m["leader_sum_norm"]), "layout_ms": float(r.timings["layout_ms"])}
+                                "leader_mean": float(m["leader_mean_norm"]),
+                                "leader_max": float(m["leader_max_norm"]),
+                                "leader_sum": float(m["leader_sum_norm"]),
+                                "layout_ms": float(r.timings["layout_ms"]),
+                            }
         say(f"{name}: {len(cases)} layouts so far")
     return {"cases": cases, "summary": summarise(cases)}
 
@@ -112,37 +124,59 @@ def summarise(cases: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
         groups.setdefault((layout, method, int(n)), []).append(c)
     order = {name: i for i, name in enumerate(LAYOUTS)}
     rows = []
-    for (layout, method, n), cs in sorted(groups.items(), key=lambda kv: (order.get(kv[0][0], 99), kv[0][2], kv[0][1])):
+    for (layout, method, n), cs in sorted(
+        groups.items(), key=lambda kv: (order.get(kv[0][0], 99), kv[0][2], kv[0][1])
+    ):
         worst = np.array([c["leader_max"] for c in cs])
-        rows.append({"layout": layout, "method": method, "size": n, "layouts": len(cs),
-                     "clean": int(sum(c["clean"] for c in cs)), "labels": int(sum(c["labels"] for c in cs)),
-                     "unplaced": int(sum(c["unplaced"] for c in cs)),
-                     "leader_mean": float(np.mean([c["leader_mean"] for c in cs])),
-                     "leader_max_p90": float(np.percentile(worst, 90)), "leader_max": float(worst.max()),
-                     "layout_ms": float(np.mean([c["layout_ms"] for c in cs]))})
+        rows.append(
+            {
+                "layout": layout,
+                "method": method,
+                "size": n,
+                "layouts": len(cs),
+                "clean": int(sum(c["clean"] for c in cs)),
+                "labels": int(sum(c["labels"] for c in cs)),
+                "unplaced": int(sum(c["unplaced"] for c in cs)),
+                "leader_mean": float(np.mean([c["leader_mean"] for c in cs])),
+                "leader_max_p90": float(np.percentile(worst, 90)),
+                "leader_max": float(worst.max()),
+                "layout_ms": float(np.mean([c["layout_ms"] for c in cs])),
+            }
+        )
     return rows
 
 
 def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' common name
     """Plain-text table of a :func:`run` result."""
     rows = result["summary"]
-    lines = [f"labeling sweep: {len(result['cases'])} layouts; leader lengths / d_S; max = each layout's longest "
-             "leader (90th percentile and largest over the layouts)",
-             f"{'layout':11s} {'method':9s} {'size':>4s} {'layouts':>7s} {'clean':>5s} {'labels':>6s} "
-             f"{'unplaced':>8s} {'mean':>6s} {'max_p90':>7s} {'max':>6s} {'ms':>6s}"]
+    lines = [
+        f"labeling sweep: {len(result['cases'])} layouts; leader lengths / d_S; max = each layout's longest "
+        "leader (90th percentile and largest over the layouts)",
+        f"{'layout':11s} {'method':9s} {'size':>4s} {'layouts':>7s} {'clean':>5s} {'labels':>6s} "
+        f"{'unplaced':>8s} {'mean':>6s} {'max_p90':>7s} {'max':>6s} {'ms':>6s}",
+    ]
     for r in rows:
-        lines.append(f"{r['layout']:11s} {r['method']:9s} {r['size']:4d} {r['layouts']:7d} {r['clean']:5d} "
-                     f"{r['labels']:6d} {r['unplaced']:8d} {r['leader_mean']:6.3f} {r['leader_max_p90']:7.2f} "
-                     f"{r['leader_max']:6.2f} {r['layout_ms']:6.1f}")
+        lines.append(
+            f"{r['layout']:11s} {r['method']:9s} {r['size']:4d} {r['layouts']:7d} {r['clean']:5d} "
+            f"{r['labels']:6d} {r['unplaced']:8d} {r['leader_mean']:6.3f} {r['leader_max_p90']:7.2f} "
+            f"{r['leader_max']:6.2f} {r['layout_ms']:6.1f}"
+        )
     return "\n".join(lines)
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Options of ``meshvis bench labeling-sweep``."""
     parser.add_argument("--azimuths", type=int, default=8, help="views per elevation (default 8)")
-    parser.add_argument("--elevations", type=float, nargs="+", default=[10.0, 45.0, 80.0],
-                        help="camera elevations in degrees (default 10 45 80)")
-    parser.add_argument("--sizes", type=int, nargs="+", default=[192, 384, 512], help="image sizes (default 192 384 512)")
+    parser.add_argument(
+        "--elevations",
+        type=float,
+        nargs="+",
+        default=[10.0, 45.0, 80.0],
+        help="camera elevations in degrees (default 10 45 80)",
+    )
+    parser.add_argument(
+        "--sizes", type=int, nargs="+", default=[192, 384, 512], help="image sizes (default 192 384 512)"
+    )
     parser.add_argument("--layouts", nargs="+", choices=tuple(LAYOUTS), default=list(LAYOUTS))
     parser.add_argument("--json", metavar="FILE", help="also write every case and the summary as JSON")
 
@@ -151,6 +185,11 @@ def main(args: argparse.Namespace) -> int:
     """Entry point of ``meshvis bench labeling-sweep``."""
     from .bench import report
 
-    result = run(azimuths=args.azimuths, elevations=args.elevations, sizes=args.sizes, layouts=args.layouts,
-                 progress=lambda s: print(s, flush=True))
+    result = run(
+        azimuths=args.azimuths,
+        elevations=args.elevations,
+        sizes=args.sizes,
+        layouts=args.layouts,
+        progress=lambda s: print(s, flush=True),
+    )
     return report(result, format(result), args.json)

@@ -5,12 +5,13 @@ Pillow; the PNG writer draws with the same font and the SVG writer pins each tex
 measured width (``textLength``), so a text always fits its box whatever font the SVG
 viewer substitutes.
 """
+
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass
 from functools import lru_cache
-from typing import Sequence
 
 import numpy as np
 

@@ -1,4 +1,5 @@
 """``python -m meshvis`` is the ``meshvis`` command."""
+
 from meshvis.cli.main import main
 
 if __name__ == "__main__":

@@ -3,6 +3,7 @@
 Every error caused by the user's input derives from :class:`MeshvisError`; the command line
 prints its one-line message and exits with status 2.  Anything else is a bug.
 """
+
 from __future__ import annotations
 
 import os

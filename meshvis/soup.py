@@ -9,12 +9,14 @@ re-weld.
 Conventions (DESIGN.md §5): float64 vertices, int64 faces, side 0 of a face is the side its
 counter-clockwise normal points to.
 """
+
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from functools import cached_property
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -152,7 +154,7 @@ class Soup:
         return float(self.areas.sum())
 
     # ------------------------------------------------------------------ derived soups
-    def subset(self, index: np.ndarray) -> "Soup":
+    def subset(self, index: np.ndarray) -> Soup:
         """The soup made of the faces ``index`` (boolean mask or integer array), attributes kept.
 
         Vertices are not compacted: the new soup shares the vertex array.
@@ -170,7 +172,7 @@ class Soup:
             colors=None if self.colors is None else self.colors[index],
         )
 
-    def flipped(self, flip: np.ndarray) -> "Soup":
+    def flipped(self, flip: np.ndarray) -> Soup:
         """The soup with the faces where ``flip`` is True turned over (corners 1 and 2 swapped)."""
         flip = np.asarray(flip, bool).reshape(self.n_faces)
         order = np.where(flip[:, None], [0, 2, 1], [0, 1, 2])
@@ -185,7 +187,7 @@ class Soup:
             material_id=self.material_id.copy(),
         )
 
-    def transformed(self, matrix: np.ndarray) -> "Soup":
+    def transformed(self, matrix: np.ndarray) -> Soup:
         """The soup with its vertices mapped by a 4x4 homogeneous matrix (attributes kept).
 
         A transform with negative determinant would turn every face over, so the faces are
@@ -198,7 +200,7 @@ class Soup:
             out = out.flipped(np.ones(self.n_faces, bool))
         return out
 
-    def copy(self) -> "Soup":
+    def copy(self) -> Soup:
         return replace(
             self,
             vertices=self.vertices.copy(),
@@ -213,7 +215,7 @@ class Soup:
         )
 
     @classmethod
-    def concatenate(cls, soups: Sequence["Soup"]) -> "Soup":
+    def concatenate(cls, soups: Sequence[Soup]) -> Soup:
         """One soup from several; part and material indices are shifted, names kept."""
         soups = list(soups)
         if not soups:
@@ -238,7 +240,10 @@ class Soup:
             if has_uv
             else None,
             colors=np.concatenate(
-                [s.colors if s.colors is not None else np.full((s.n_faces, 3, 4), 255, np.uint8) for s in soups]
+                [
+                    s.colors if s.colors is not None else np.full((s.n_faces, 3, 4), 255, np.uint8)
+                    for s in soups
+                ]
             )
             if has_col
             else None,

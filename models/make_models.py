@@ -13,14 +13,15 @@ rounded to 6 decimals before writing (shorter files; rounding keeps coincident c
 and coplanar walls coincident, so no truth changes).  The output is identical byte for
 byte from run to run.
 """
+
 from __future__ import annotations
 
 import argparse
 import os
 import sys
+from collections.abc import Callable
 from dataclasses import replace
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
@@ -115,8 +116,10 @@ def build(out: str | os.PathLike = HERE, names: list[str] | None = None, verbose
         truth.save_arrays(tpath)
         written += [path, tpath]
         if verbose:
-            print(f"{fname:26s} {truth.n_faces:6d} faces  {path.stat().st_size / 1024:7.1f} KiB  "
-                  f"layers {np.bincount(truth.layer)[1:].tolist()}")
+            print(
+                f"{fname:26s} {truth.n_faces:6d} faces  {path.stat().st_size / 1024:7.1f} KiB  "
+                f"layers {np.bincount(truth.layer)[1:].tolist()}"
+            )
     return written
 
 

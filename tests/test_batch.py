@@ -1,5 +1,6 @@
 """Tests of meshvis.batch.runner and ``meshvis batch``: discovery, output names, per-file tasks,
 worker processes with time limit and crash recovery, resume, Ctrl-C, and Dask."""
+
 from __future__ import annotations
 
 import csv
@@ -7,10 +8,10 @@ import errno
 import glob
 import json
 import os
-import tempfile
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -41,7 +42,9 @@ def _nested(path) -> str:
     import trimesh
 
     a, b = trimesh.creation.icosphere(1), trimesh.creation.icosphere(1)
-    mio.save((np.vstack([a.vertices, 0.5 * b.vertices]), np.vstack([a.faces, b.faces + len(a.vertices)])), path)
+    mio.save(
+        (np.vstack([a.vertices, 0.5 * b.vertices]), np.vstack([a.faces, b.faces + len(a.vertices)])), path
+    )
     return str(path)
 
 
@@ -113,18 +116,31 @@ def test_discover_files_folders_patterns(tmp_path):
     a = _touch(d / "a.obj")
     _touch(d / "sub" / "b.ply")
     _touch(d / "sub" / "deep" / "c.STL")
-    for skipped in (".hidden/d.obj", ".e.obj", "notes.txt", "a.orient.obj", "a.remove-interior.report.json",
-                    "x.layers.ply"):
+    for skipped in (
+        ".hidden/d.obj",
+        ".e.obj",
+        "notes.txt",
+        "a.orient.obj",
+        "a.remove-interior.report.json",
+        "x.layers.ply",
+    ):
         _touch(d / skipped)
     found = mb.discover([str(d)])
-    assert [rel for _, rel in found] == ["a.obj", os.path.join("sub", "b.ply"), os.path.join("sub", "deep", "c.STL")]
+    assert [rel for _, rel in found] == [
+        "a.obj",
+        os.path.join("sub", "b.ply"),
+        os.path.join("sub", "deep", "c.STL"),
+    ]
     # a file given twice (directly and through its folder) is processed once, named by the first
     assert [rel for _, rel in mb.discover([a, str(d)])][:2] == ["a.obj", os.path.join("sub", "b.ply")]
     assert len(mb.discover([a, str(d)])) == 3
     # patterns: relative to their fixed leading folders; '**' spans folders
     assert [rel for _, rel in mb.discover([str(d / "**" / "*.ply")])] == [os.path.join("sub", "b.ply")]
-    assert [rel for _, rel in mb.discover([str(d / "*")])] == ["a.obj", os.path.join("sub", "b.ply"),
-                                                              os.path.join("sub", "deep", "c.STL")]
+    assert [rel for _, rel in mb.discover([str(d / "*")])] == [
+        "a.obj",
+        os.path.join("sub", "b.ply"),
+        os.path.join("sub", "deep", "c.STL"),
+    ]
     # a file named explicitly is taken whatever its name: its error shows up in its row
     assert mb.discover([str(d / "notes.txt")]) == [(str(d / "notes.txt"), "notes.txt")]
     with pytest.raises(ParameterError, match="no such file"):
@@ -138,20 +154,39 @@ def test_discover_files_folders_patterns(tmp_path):
 
 def test_plan_output_names(tmp_path):
     d = tmp_path / "in"
-    files = [_touch(d / "x.obj"), _touch(d / "x.stl"), _touch(d / "m.3mf"), _touch(d / "s.off"),
-             _touch(d / "one" / "y.obj"), _touch(d / "two" / "y.obj")]
+    files = [
+        _touch(d / "x.obj"),
+        _touch(d / "x.stl"),
+        _touch(d / "m.3mf"),
+        _touch(d / "s.off"),
+        _touch(d / "one" / "y.obj"),
+        _touch(d / "two" / "y.obj"),
+    ]
     out = str(tmp_path / "out")
     tasks = mb.plan(files, "layers", out, {"seed": 3})
     names = [os.path.relpath(t.output, out) for t in tasks]
-    assert names == ["x.obj.layers.obj", "x.stl.layers.ply", "m.layers.glb", "s.layers.ply",
-                     "y.layers.obj", "y-2.layers.obj"]
+    assert names == [
+        "x.obj.layers.obj",
+        "x.stl.layers.ply",
+        "m.layers.glb",
+        "s.layers.ply",
+        "y.layers.obj",
+        "y-2.layers.obj",
+    ]
     assert [os.path.relpath(t.report, out) for t in tasks][0] == "x.obj.layers.report.json"
     assert all(t.options == {"seed": 3} and t.op == "layers" for t in tasks)
     # orient keeps STL and OFF (they hold a turned face); a folder keeps its structure
     tasks = mb.plan([str(d)], "orient", out)
-    assert sorted(os.path.relpath(t.output, out) for t in tasks) == sorted([
-        "x.obj.orient.obj", "x.stl.orient.stl", "m.orient.glb", "s.orient.off",
-        os.path.join("one", "y.orient.obj"), os.path.join("two", "y.orient.obj")])
+    assert sorted(os.path.relpath(t.output, out) for t in tasks) == sorted(
+        [
+            "x.obj.orient.obj",
+            "x.stl.orient.stl",
+            "m.orient.glb",
+            "s.orient.off",
+            os.path.join("one", "y.orient.obj"),
+            os.path.join("two", "y.orient.obj"),
+        ]
+    )
     # an output may not overwrite an input
     victim = _touch(tmp_path / "out" / "x.orient.obj")
     with pytest.raises(ParameterError, match="overwrite an input"):
@@ -233,13 +268,19 @@ def test_batch_command_local_and_resume(tmp_path, capsys):
     _triangle(src / "sub" / "tri.stl")
     _noise(src / "noise.ply")
     out = str(tmp_path / "out")
-    rc = main(["batch", str(src), "--op", "remove-interior", "--out", out, "--jobs", "2", "--rays-per-node", "16"])
+    rc = main(
+        ["batch", str(src), "--op", "remove-interior", "--out", out, "--jobs", "2", "--rays-per-node", "16"]
+    )
     stdout, stderr = capsys.readouterr()
     assert rc == 1, stderr  # one file failed
     assert "Traceback" not in stderr
     rows = _rows(out)
-    assert {k: r["status"] for k, r in rows.items()} == {"ball.obj": "ok", "nested.ply": "ok", "tri.stl": "ok",
-                                                          "noise.ply": "error"}
+    assert {k: r["status"] for k, r in rows.items()} == {
+        "ball.obj": "ok",
+        "nested.ply": "ok",
+        "tri.stl": "ok",
+        "noise.ply": "error",
+    }
     assert rows["nested.ply"]["faces_in"] == "160" and rows["nested.ply"]["faces_out"] == "80"
     assert rows["noise.ply"]["error"].startswith(str(src / "noise.ply"))
     summary = json.load(open(os.path.join(out, "summary.json")))
@@ -254,17 +295,37 @@ def test_batch_command_local_and_resume(tmp_path, capsys):
     # --resume skips the finished files and retries the failed one
     done = os.path.join(out, "ball.remove-interior.obj")
     stamp = os.stat(done).st_mtime_ns
-    rc = main(["batch", str(src), "--op", "remove-interior", "--out", out, "--resume", "--rays-per-node", "16", "-q"])
+    rc = main(
+        [
+            "batch",
+            str(src),
+            "--op",
+            "remove-interior",
+            "--out",
+            out,
+            "--resume",
+            "--rays-per-node",
+            "16",
+            "-q",
+        ]
+    )
     assert rc == 1
     rows = _rows(out)
-    assert [rows[k]["status"] for k in ("ball.obj", "nested.ply", "tri.stl", "noise.ply")] == \
-        ["skipped", "skipped", "skipped", "error"]
+    assert [rows[k]["status"] for k in ("ball.obj", "nested.ply", "tri.stl", "noise.ply")] == [
+        "skipped",
+        "skipped",
+        "skipped",
+        "error",
+    ]
     assert rows["nested.ply"]["faces_out"] == "80"  # carried over from the earlier report
     assert os.stat(done).st_mtime_ns == stamp
     # other options, or an input newer than its report: not complete
     task = mb.plan([str(src / "ball.obj")], "remove-interior", out, {"rays_per_node": 16})[0]
     assert mb.completed_row(task) is not None
-    assert mb.completed_row(mb.plan([str(src / "ball.obj")], "remove-interior", out, {"rays_per_node": 8})[0]) is None
+    assert (
+        mb.completed_row(mb.plan([str(src / "ball.obj")], "remove-interior", out, {"rays_per_node": 8})[0])
+        is None
+    )
     later = time.time() + 10
     os.utime(src / "ball.obj", (later, later))
     assert mb.completed_row(task) is None
@@ -312,9 +373,28 @@ def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
     out = tmp_path / "out"
     env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
     proc = subprocess.Popen(
-        [sys.executable, "-m", "meshvis", "batch", str(src), "--op", "orient", "--out", str(out), "--jobs", "2",
-         "--rays-per-node", "2048", "--no-progressive"],
-        stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env, start_new_session=True)
+        [
+            sys.executable,
+            "-m",
+            "meshvis",
+            "batch",
+            str(src),
+            "--op",
+            "orient",
+            "--out",
+            str(out),
+            "--jobs",
+            "2",
+            "--rays-per-node",
+            "2048",
+            "--no-progressive",
+        ],
+        stdout=subprocess.PIPE,
+        stderr=subprocess.PIPE,
+        text=True,
+        env=env,
+        start_new_session=True,
+    )
     try:
         t0 = time.monotonic()
         while not (out / "a.orient.report.json").exists() and time.monotonic() - t0 < 120:
@@ -333,8 +413,14 @@ def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
     status = {os.path.basename(f["input"]): f["status"] for f in summary["files"]}
     assert status == {"a.obj": "ok", "b.obj": "ok", "slow.ply": "interrupted"}
     # every output that exists is complete: it has an 'ok' report and loads
-    assert sorted(os.listdir(out)) == ["a.orient.obj", "a.orient.report.json", "b.orient.obj",
-                                       "b.orient.report.json", "summary.csv", "summary.json"]
+    assert sorted(os.listdir(out)) == [
+        "a.orient.obj",
+        "a.orient.report.json",
+        "b.orient.obj",
+        "b.orient.report.json",
+        "summary.csv",
+        "summary.json",
+    ]
     for name in ("a", "b"):
         assert json.load(open(out / f"{name}.orient.report.json"))["status"] == "ok"
         assert mio.load(out / f"{name}.orient.obj").n_faces in (1, 80)
@@ -351,10 +437,25 @@ def test_usage_errors(tmp_path, capsys, monkeypatch):
         for w in words:
             assert w in err, err
 
-    one_line(["batch", str(tmp_path / "nope.obj"), "--op", "orient", "--out", str(tmp_path / "o")], "no such file")
+    one_line(
+        ["batch", str(tmp_path / "nope.obj"), "--op", "orient", "--out", str(tmp_path / "o")], "no such file"
+    )
     one_line(["batch", src, "--op", "orient", "--out", src], "is a file")
-    one_line(["batch", src, "--op", "orient", "--out", str(tmp_path / "o"), "--jobs", "2",
-              "--dask-scheduler", "tcp://127.0.0.1:1"], "--jobs")
+    one_line(
+        [
+            "batch",
+            src,
+            "--op",
+            "orient",
+            "--out",
+            str(tmp_path / "o"),
+            "--jobs",
+            "2",
+            "--dask-scheduler",
+            "tcp://127.0.0.1:1",
+        ],
+        "--jobs",
+    )
 
     def refuse(*args, **kwargs):
         raise PermissionError(errno.EACCES, "Permission denied")
@@ -367,8 +468,19 @@ def test_usage_errors(tmp_path, capsys, monkeypatch):
     assert exc.value.code == 2
     capsys.readouterr()
     monkeypatch.setattr(mb, "DASK_CONNECT_TIMEOUT", "1s")
-    one_line(["batch", src, "--op", "orient", "--out", str(tmp_path / "o"), "--dask-scheduler", "tcp://127.0.0.1:9"],
-             "cannot connect")
+    one_line(
+        [
+            "batch",
+            src,
+            "--op",
+            "orient",
+            "--out",
+            str(tmp_path / "o"),
+            "--dask-scheduler",
+            "tcp://127.0.0.1:9",
+        ],
+        "cannot connect",
+    )
 
 
 # ---------------------------------------------------------------- Dask
@@ -381,18 +493,28 @@ def test_dask_local_cluster_gives_the_same_outputs(tmp_path, capsys):
     _noise(src / "noise.stl")
     args = ["batch", str(src), "--op", "remove-interior", "--rays-per-node", "16", "-q"]
     assert main(args + ["--out", str(tmp_path / "local"), "--jobs", "1"]) == 1
-    with distributed.LocalCluster(n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1",
-                                  dashboard_address=":0") as cluster:
+    with distributed.LocalCluster(
+        n_workers=2, threads_per_worker=1, processes=True, host="127.0.0.1", dashboard_address=":0"
+    ) as cluster:
         address = cluster.scheduler_address
         assert main(args + ["--out", str(tmp_path / "dask"), "--dask-scheduler", address]) == 1
         # with a time limit every file runs in a child process of its Dask worker
-        assert main(args + ["--out", str(tmp_path / "dask_limit"), "--dask-scheduler", address,
-                            "--time-limit", "120"]) == 1
+        assert (
+            main(
+                args
+                + ["--out", str(tmp_path / "dask_limit"), "--dask-scheduler", address, "--time-limit", "120"]
+            )
+            == 1
+        )
     capsys.readouterr()
     local = _rows(tmp_path / "local")
     for name in ("dask", "dask_limit"):
         rows = _rows(tmp_path / name)
-        assert {k: r["status"] for k, r in rows.items()} == {"ball.obj": "ok", "nested.glb": "ok", "noise.stl": "error"}
+        assert {k: r["status"] for k, r in rows.items()} == {
+            "ball.obj": "ok",
+            "nested.glb": "ok",
+            "noise.stl": "error",
+        }
         assert {k: r["faces_out"] for k, r in rows.items()} == {k: r["faces_out"] for k, r in local.items()}
         for f in ("ball.remove-interior.obj", "nested.remove-interior.glb"):
             assert open(tmp_path / name / f, "rb").read() == open(tmp_path / "local" / f, "rb").read()
@@ -400,8 +522,12 @@ def test_dask_local_cluster_gives_the_same_outputs(tmp_path, capsys):
 
 
 def test_largest_files_start_first(tmp_path):
-    files = [_triangle(tmp_path / "small.obj"), _sphere(tmp_path / "big.obj", subdivisions=3),
-             _sphere(tmp_path / "mid.obj", subdivisions=2), str(tmp_path / "missing.obj")]
+    files = [
+        _triangle(tmp_path / "small.obj"),
+        _sphere(tmp_path / "big.obj", subdivisions=3),
+        _sphere(tmp_path / "mid.obj", subdivisions=2),
+        str(tmp_path / "missing.obj"),
+    ]
     tasks = mb.plan(files[:3], "orient", str(tmp_path / "out"))
     tasks.append(mb.FileTask(files[3], "missing", "x", "y", "orient"))
     assert mb.largest_first(tasks, [0, 1, 2, 3]) == [1, 2, 0, 3]

@@ -1,4 +1,5 @@
 """Error measures, baselines and the accuracy / compare benchmarks."""
+
 import csv
 import math
 
@@ -6,9 +7,9 @@ import numpy as np
 import pytest
 import trimesh
 
+from meshvis.errors import ParameterError
 from meshvis.eval import baselines as B
 from meshvis.eval import generators as gen
-from meshvis.errors import ParameterError
 from meshvis.eval.generators import GroundTruth
 from meshvis.eval.metrics import layer_accuracy, layer_error, orientation_error, removal_scores
 from meshvis.soup import Soup
@@ -109,8 +110,12 @@ def two_spheres():
     a, b = trimesh.creation.icosphere(2), trimesh.creation.icosphere(1, radius=0.5)
     V = np.vstack([a.vertices, b.vertices])
     F = np.vstack([a.faces, b.faces + len(a.vertices)])
-    t = GroundTruth(soup=Soup(V, F), outside=np.r_[[[True, False]] * len(a.faces), [[False, False]] * len(b.faces)],
-                    layer=np.r_[[1] * len(a.faces), [2] * len(b.faces)], outward=True)
+    t = GroundTruth(
+        soup=Soup(V, F),
+        outside=np.r_[[[True, False]] * len(a.faces), [[False, False]] * len(b.faces)],
+        layer=np.r_[[1] * len(a.faces), [2] * len(b.faces)],
+        outward=True,
+    )
     return gen.soupify(t, flip=0.5, seed=3)
 
 
@@ -189,7 +194,13 @@ def test_accuracy_quick_writes_finite_errors(tmp_path):
 
     out = tmp_path / "acc"
     assert main(["bench", "accuracy", "--quick", "--quiet", "--out", str(out)]) == 0
-    for name in ("accuracy.csv", "accuracy.md", "accuracy_orient.png", "accuracy_remove.png", "accuracy_layers.png"):
+    for name in (
+        "accuracy.csv",
+        "accuracy.md",
+        "accuracy_orient.png",
+        "accuracy_remove.png",
+        "accuracy_layers.png",
+    ):
         assert (out / name).stat().st_size > 0, name
     for task in ("orient", "remove", "layers"):
         assert (out / f"accuracy_{task}.png").read_bytes()[:8] == b"\x89PNG\r\n\x1a\n"
@@ -198,8 +209,14 @@ def test_accuracy_quick_writes_finite_errors(tmp_path):
     assert {r["task"] for r in rows} == {"orient", "remove", "layers"}
     assert {r["case"] for r in rows} == {"sphere_pair", "nested_shells", "cracked_box", "cow"}
     methods = {r["method"] for r in rows}
-    assert {"meshvis", "meshvis_default", "libigl_reorient", "trimesh_fix_normals", "pymeshlab_ao",
-            "libigl_peel"} <= methods
+    assert {
+        "meshvis",
+        "meshvis_default",
+        "libigl_reorient",
+        "trimesh_fix_normals",
+        "pymeshlab_ao",
+        "libigl_peel",
+    } <= methods
     rays = sorted({int(float(r["value"])) for r in rows if r["method"] == "meshvis"})
     assert rays == [1, 4, 16]
     for r in rows:

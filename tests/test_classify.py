@@ -1,12 +1,13 @@
 """Graph-cut classification on small constructed models with known answers."""
+
 import numpy as np
 import pytest
 import trimesh
 
 from meshvis import classify
 from meshvis.errors import ParameterError
-from meshvis.graphcut.mincut import cut_value, rounding_bound
 from meshvis.graphcut.hints import Hints
+from meshvis.graphcut.mincut import cut_value, rounding_bound
 from meshvis.soup import Soup
 
 
@@ -59,7 +60,7 @@ def test_small_crack_keeps_interior_inside():
     outer.update_faces(np.arange(len(outer.faces)) >= 6)  # a crack of 6 missing faces
     inner.vertices *= 0.5
     c = classify(stack(outer, inner), seed=0)
-    assert c.hidden[len(outer.faces):].all()
+    assert c.hidden[len(outer.faces) :].all()
 
 
 def test_overlapping_solids_hidden_parts_match_truth():
@@ -72,7 +73,7 @@ def test_overlapping_solids_hidden_parts_match_truth():
     truth = np.r_[np.linalg.norm(cent[:n] - [0.8, 0, 0], axis=1) < 1, np.linalg.norm(cent[n:], axis=1) < 1]
     area = Soup(v, f).areas
     assert c.flagged.sum() > 0  # the two spheres intersect: point nodes were needed
-    correct = (c.hidden == truth)
+    correct = c.hidden == truth
     assert (area * correct).sum() / area.sum() >= 0.995
 
 
@@ -145,7 +146,6 @@ def test_cosine_filter_damps_weak_links_without_cutting_them():
     f = cosine_filter(w, np.ones(3))
     assert np.all(f > 0)
     np.testing.assert_allclose(f, (np.pi * w / 2) ** 2 * w, rtol=1e-6)
-
 
 
 def test_bad_parameters():

@@ -1,5 +1,6 @@
 """End-to-end tests of the repair commands through the command line, on generated models
 with known answers and on a real textured model."""
+
 import json
 import os
 
@@ -41,13 +42,18 @@ def test_orient_cli_correct_area(sphere_pair_soup, tmp_path):
     b = np.sort(result.triangles.reshape(-1, 9), axis=1)
     assert np.allclose(a, b, atol=1e-6)
     assert png.stat().st_size > 1000
-    assert report["seed"] == 0 and report["classification"]["rays"] > 0 and "stages" in report["classification"]
+    assert (
+        report["seed"] == 0 and report["classification"]["rays"] > 0 and "stages" in report["classification"]
+    )
 
 
 def test_remove_interior_cli_removes_hidden_keeps_visible(sphere_pair_soup, tmp_path):
     truth, path = sphere_pair_soup
     out, removed, rep = tmp_path / "k.obj", tmp_path / "r.obj", tmp_path / "k.json"
-    assert main(["remove-interior", path, "-o", str(out), "--removed", str(removed), "--report", str(rep), "-q"]) == 0
+    assert (
+        main(["remove-interior", path, "-o", str(out), "--removed", str(removed), "--report", str(rep), "-q"])
+        == 0
+    )
     report = json.loads(rep.read_text())
     keep = np.array(report["per_face"]["keep"], bool)
     assert np.array_equal(keep, ~truth.hidden)  # every hidden face removed, no visible one
@@ -110,7 +116,10 @@ def test_orient_cli_options_two_sided_duplicate(tmp_path):
     path = tmp_path / "cup.obj"
     save(truth.soup, str(path))
     out, rep = tmp_path / "o.obj", tmp_path / "o.json"
-    assert main(["orient", str(path), "-o", str(out), "--two-sided", "duplicate", "--report", str(rep), "-q"]) == 0
+    assert (
+        main(["orient", str(path), "-o", str(out), "--two-sided", "duplicate", "--report", str(rep), "-q"])
+        == 0
+    )
     report = json.loads(rep.read_text())
     assert report["status_counts"]["two-sided"] == truth.soup.n_faces
     assert load(str(out)).n_faces == 2 * truth.soup.n_faces
@@ -137,11 +146,34 @@ def test_terrain_hints_from_the_command_line(tmp_path):
     save(truth.soup, str(path))
     rep = tmp_path / "t.json"
     lo, hi = truth.soup.bounds
-    below = ",".join(f"{x:.6g}" for x in [lo[0] + 0.4 * (hi[0] - lo[0]), lo[1] + 0.4 * (hi[1] - lo[1]), lo[2] - 1.0,
-                                          lo[0] + 0.6 * (hi[0] - lo[0]), lo[1] + 0.6 * (hi[1] - lo[1]), lo[2] - 0.5])
+    below = ",".join(
+        f"{x:.6g}"
+        for x in [
+            lo[0] + 0.4 * (hi[0] - lo[0]),
+            lo[1] + 0.4 * (hi[1] - lo[1]),
+            lo[2] - 1.0,
+            lo[0] + 0.6 * (hi[0] - lo[0]),
+            lo[1] + 0.6 * (hi[1] - lo[1]),
+            lo[2] - 0.5,
+        ]
+    )
     above = ",".join(f"{x:.6g}" for x in [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] + 1.0])
-    assert main(["classify", str(path), "--inside-box", below, "--outside-point", above,
-                 "--report", str(rep), "-q"]) == 0
+    assert (
+        main(
+            [
+                "classify",
+                str(path),
+                "--inside-box",
+                below,
+                "--outside-point",
+                above,
+                "--report",
+                str(rep),
+                "-q",
+            ]
+        )
+        == 0
+    )
     r = json.loads(rep.read_text())
     front = np.array(r["per_face"]["outside_front"]) > 0.5
     back = np.array(r["per_face"]["outside_back"]) > 0.5

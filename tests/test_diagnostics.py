@@ -1,5 +1,6 @@
 """Adjacency analysis (welding, edges, components, degenerate and duplicate faces),
 ``diagnose`` and ``meshvis info``."""
+
 from __future__ import annotations
 
 import json
@@ -8,9 +9,9 @@ import numpy as np
 import pytest
 import trimesh
 
+from meshvis.errors import ModelError
 from meshvis.geometry import adjacency
 from meshvis.geometry.diagnostics import diagnose, format_report
-from meshvis.errors import ModelError
 from meshvis.soup import Soup
 
 
@@ -159,8 +160,16 @@ def test_diagnose_clean_cube_report():
     d = diagnose(Soup(v, f, path="cube.obj"))
     assert d["faces"] == 12 and d["vertices"] == 36 and d["welded_vertices"] == 8
     assert d["closed"] and d["edge_manifold"] and d["winding_consistent"]
-    for key in ("boundary_edges", "nonmanifold_edges", "degenerate_faces", "duplicate_faces",
-                "intersecting_faces", "coplanar_faces", "too_close_faces", "inconsistent_edges"):
+    for key in (
+        "boundary_edges",
+        "nonmanifold_edges",
+        "degenerate_faces",
+        "duplicate_faces",
+        "intersecting_faces",
+        "coplanar_faces",
+        "too_close_faces",
+        "inconsistent_edges",
+    ):
         assert d[key] == 0, key
     assert np.allclose(d["bounds"], [[-0.5] * 3, [0.5] * 3])
     assert d["diagonal"] == pytest.approx(np.sqrt(3))

@@ -5,6 +5,7 @@ the generalised winding number of the model's closed parts at points pushed just
 each face, which says how many closed shells enclose each side.  A side is outside
 exactly when no shell encloses it, and the layer is one more than the smaller count.
 """
+
 from __future__ import annotations
 
 import importlib.util
@@ -15,10 +16,10 @@ import igl
 import numpy as np
 import pytest
 
-from meshvis.eval import generators as g
-from meshvis.geometry.adjacency import weld
 from meshvis.errors import ModelError, ParameterError
+from meshvis.eval import generators as g
 from meshvis.eval.generators import GroundTruth
+from meshvis.geometry.adjacency import weld
 from meshvis.soup import Soup, validate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -51,7 +52,7 @@ def _winding_sides(closed: Soup, query: Soup, eps: float) -> tuple[np.ndarray, n
     n = query.normals
     q = np.concatenate([c + eps * n, c - eps * n])
     w = igl.winding_number(closed.vertices, closed.faces, q)
-    return w[: len(c)], w[len(c):]
+    return w[: len(c)], w[len(c) :]
 
 
 def _assert_truth_matches_winding(t: GroundTruth, closed_mask: np.ndarray | None = None, tol: float = 0.3):
@@ -106,8 +107,19 @@ def test_valid_soup_and_truth_shapes(small, name):
     assert t.ambiguous.mean() < 0.3
 
 
-@pytest.mark.parametrize("name", ["nested_shells", "house", "cracked_box", "box_with_opening", "cup", "terrain",
-                                  "overlapping_solids", "sphere_pair"])
+@pytest.mark.parametrize(
+    "name",
+    [
+        "nested_shells",
+        "house",
+        "cracked_box",
+        "box_with_opening",
+        "cup",
+        "terrain",
+        "overlapping_solids",
+        "sphere_pair",
+    ],
+)
 def test_defaults_size(name):
     t = g.GENERATORS[name]()
     assert 1000 <= t.n_faces <= 20000
@@ -121,8 +133,9 @@ def test_assembly_default_size_and_parts():
     assert 25 <= s.n_parts <= 40
     assert g.is_closed(s)
     # sizes spread over more than an order of magnitude
-    diag = np.array([np.linalg.norm(np.ptp(s.triangles[s.part_id == p].reshape(-1, 3), axis=0))
-                     for p in range(s.n_parts)])
+    diag = np.array(
+        [np.linalg.norm(np.ptp(s.triangles[s.part_id == p].reshape(-1, 3), axis=0)) for p in range(s.n_parts)]
+    )
     assert diag.max() / diag.min() > 10
     names = s.part_names
     hidden_frac = np.array([t.hidden[s.part_id == p].mean() for p in range(s.n_parts)])
@@ -234,7 +247,7 @@ def test_sphere_pair_truth(small):
     t = small["sphere_pair"]
     s = t.soup
     outer, inner = s.part_id == 0, s.part_id == 1
-    assert outer.sum() == 20 * 4 ** 3 - 6
+    assert outer.sum() == 20 * 4**3 - 6
     assert not g.is_closed(s.subset(outer), oriented=False)
     assert g.is_closed(s.subset(inner))
     assert np.all(np.linalg.norm(s.vertices[s.faces[inner]], axis=-1) < 0.6)
@@ -282,7 +295,7 @@ def test_box_with_opening_truth(small):
     assert len(border) and np.allclose(pos[border.ravel()][:, 1], -0.75)
     # missing area ~ opening**2 of the side
     missing = 2.0 * 1.0 - tri.areas[np.isclose(tri.triangles[:, :, 1], -0.75).all(1)].sum()
-    assert abs(missing - 0.6 ** 2 * 2.0) < 0.15 * 2.0
+    assert abs(missing - 0.6**2 * 2.0) < 0.15 * 2.0
     with pytest.raises(ParameterError):
         g.box_with_opening(side="top")
 
@@ -333,8 +346,9 @@ def test_soupify_bookkeeping(small, unweld, shuffle):
     else:
         assert np.all(np.diff(o[:m0]) > 0)
     # the oriented soup is the original orientation again
-    np.testing.assert_allclose(s.oriented().normals, np.where(t.outward[o], 1, -1)[:, None] * t.soup.normals[o],
-                               atol=1e-12)
+    np.testing.assert_allclose(
+        s.oriented().normals, np.where(t.outward[o], 1, -1)[:, None] * t.soup.normals[o], atol=1e-12
+    )
 
 
 def test_soupify_holes_and_winding():
@@ -388,7 +402,7 @@ def _exact_sides_winding(V, F, faces, eps):
     n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
     n /= np.linalg.norm(n, axis=1, keepdims=True)
     w = np.asarray(igl.winding_number(V, F, np.concatenate([c + eps * n, c - eps * n])))
-    return w[:len(faces)], w[len(faces):]
+    return w[: len(faces)], w[len(faces) :]
 
 
 def test_from_closed_real_model():

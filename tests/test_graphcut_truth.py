@@ -1,5 +1,6 @@
 """Classification against the ground-truth generators and soupified real models
 (issue: area-weighted correct classification >= 99.5% at default settings)."""
+
 import numpy as np
 import pytest
 

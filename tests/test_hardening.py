@@ -6,6 +6,7 @@ test, so "no traceback" is checked too); a few run ``python -m meshvis`` to chec
 stderr.  Cases that must *work* (a single triangle, many-vertex polygons, coordinates
 around 1e30) check the output instead.
 """
+
 from __future__ import annotations
 
 import errno
@@ -25,8 +26,10 @@ ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
 FORMATS = ("obj", "ply", "stl", "off", "glb", "gltf", "3mf")
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 
-PLY_HEAD = ("ply\nformat ascii 1.0\nelement vertex {nv}\nproperty float x\nproperty float y\nproperty float z\n"
-            "element face {nf}\nproperty list uchar int vertex_indices\nend_header\n")
+PLY_HEAD = (
+    "ply\nformat ascii 1.0\nelement vertex {nv}\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face {nf}\nproperty list uchar int vertex_indices\nend_header\n"
+)
 TRI = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
 
 
@@ -36,7 +39,9 @@ def _available() -> set[str]:
 
 
 COMMANDS_HERE = _available()
-MODEL_COMMANDS = [c for c in ("info", "classify", "orient", "remove-interior", "layers", "render") if c in COMMANDS_HERE]
+MODEL_COMMANDS = [
+    c for c in ("info", "classify", "orient", "remove-interior", "layers", "render") if c in COMMANDS_HERE
+]
 
 
 def _argv(cmd: str, path: str, tmp_path, out: str | None = None) -> list[str]:
@@ -89,9 +94,12 @@ def good_files(tmp_path_factory) -> dict[str, str]:
         mio.save((sphere.vertices, sphere.faces), files[ext])
     files["3mf"] = str(folder / "sphere.3mf")
     sphere.export(files["3mf"])
-    files["ply-ascii"] = _write(folder / "ascii.ply", PLY_HEAD.format(nv=len(sphere.vertices), nf=len(sphere.faces))
-                                + "".join("%r %r %r\n" % tuple(v) for v in sphere.vertices)
-                                + "".join("3 %d %d %d\n" % tuple(f) for f in sphere.faces))
+    files["ply-ascii"] = _write(
+        folder / "ascii.ply",
+        PLY_HEAD.format(nv=len(sphere.vertices), nf=len(sphere.faces))
+        + "".join("%r %r %r\n" % tuple(v) for v in sphere.vertices)
+        + "".join("3 %d %d %d\n" % tuple(f) for f in sphere.faces),
+    )
     return files
 
 
@@ -128,8 +136,18 @@ def test_random_bytes(tmp_path, capsys, cmd, ext):
     _assert_one_line_error(rc, err, path)
 
 
-@pytest.mark.parametrize("content,ext", [("obj", "stl"), ("ply", "obj"), ("stl", "ply"), ("glb", "obj"),
-                                         ("off", "ply"), ("3mf", "glb"), ("obj", "off")])
+@pytest.mark.parametrize(
+    "content,ext",
+    [
+        ("obj", "stl"),
+        ("ply", "obj"),
+        ("stl", "ply"),
+        ("glb", "obj"),
+        ("off", "ply"),
+        ("3mf", "glb"),
+        ("obj", "off"),
+    ],
+)
 def test_wrong_extension(tmp_path, capsys, good_files, content, ext):
     path = _write(tmp_path / f"model.{ext}", open(good_files[content], "rb").read())
     rc, _, err = _cli(capsys, _argv("remove-interior", path, tmp_path))
@@ -148,16 +166,27 @@ def _text_model(ext: str, vertices: list[str], faces: list[list[int]]) -> str:
     """A model file in a text format with the vertex lines given as text."""
     if ext == "obj":
         return "".join(f"v {v}\n" for v in vertices) + "".join(
-            "f " + " ".join(str(i + 1 if i >= 0 else i) for i in f) + "\n" for f in faces)
+            "f " + " ".join(str(i + 1 if i >= 0 else i) for i in f) + "\n" for f in faces
+        )
     if ext == "off":
-        return f"OFF\n{len(vertices)} {len(faces)} 0\n" + "".join(f"{v}\n" for v in vertices) + "".join(
-            f"{len(f)} " + " ".join(map(str, f)) + "\n" for f in faces)
+        return (
+            f"OFF\n{len(vertices)} {len(faces)} 0\n"
+            + "".join(f"{v}\n" for v in vertices)
+            + "".join(f"{len(f)} " + " ".join(map(str, f)) + "\n" for f in faces)
+        )
     if ext == "ply":
-        return PLY_HEAD.format(nv=len(vertices), nf=len(faces)) + "".join(f"{v}\n" for v in vertices) + "".join(
-            f"{len(f)} " + " ".join(map(str, f)) + "\n" for f in faces)
+        return (
+            PLY_HEAD.format(nv=len(vertices), nf=len(faces))
+            + "".join(f"{v}\n" for v in vertices)
+            + "".join(f"{len(f)} " + " ".join(map(str, f)) + "\n" for f in faces)
+        )
     if ext == "stl":  # ASCII STL: faces are given by position
-        body = "".join("facet normal 0 0 1\nouter loop\n" + "".join(f"vertex {vertices[i]}\n" for i in f)
-                       + "endloop\nendfacet\n" for f in faces)
+        body = "".join(
+            "facet normal 0 0 1\nouter loop\n"
+            + "".join(f"vertex {vertices[i]}\n" for i in f)
+            + "endloop\nendfacet\n"
+            for f in faces
+        )
         return f"solid t\n{body}endsolid t\n"
     raise ValueError(ext)
 
@@ -203,7 +232,9 @@ def test_faces_with_fewer_than_three_vertices(tmp_path, capsys, ext, corners):
 
 @pytest.mark.parametrize("ext", ["obj", "off", "ply"])
 def test_two_vertex_record_next_to_a_face_is_skipped_with_a_warning(tmp_path, capsys, ext):
-    path = _write(tmp_path / f"mixed.{ext}", _text_model(ext, ["0 0 0", "1 0 0", "0 1 0"], [[0, 1, 2], [0, 1]]))
+    path = _write(
+        tmp_path / f"mixed.{ext}", _text_model(ext, ["0 0 0", "1 0 0", "0 1 0"], [[0, 1, 2], [0, 1]])
+    )
     out = str(tmp_path / f"out.{ext}")
     rc, _, err = _cli(capsys, _argv("orient", path, tmp_path, out=out))
     assert rc == 0, err
@@ -232,8 +263,11 @@ def test_zero_faces(tmp_path, capsys, fmt):
     elif fmt in ("gltf", "glb"):
         js = json.dumps({"asset": {"version": "2.0"}}).encode()
         js += b" " * (-len(js) % 4)
-        data = js if fmt == "gltf" else (b"glTF" + struct.pack("<II", 2, 20 + len(js))
-                                          + struct.pack("<I", len(js)) + b"JSON" + js)
+        data = (
+            js
+            if fmt == "gltf"
+            else (b"glTF" + struct.pack("<II", 2, 20 + len(js)) + struct.pack("<I", len(js)) + b"JSON" + js)
+        )
         path = _write(tmp_path / f"empty.{fmt}", data)
     else:
         path = _write(tmp_path / f"empty.{fmt}", _text_model(fmt, ["0 0 0", "1 0 0", "0 1 0"], []))
@@ -251,7 +285,9 @@ def test_only_degenerate_faces(tmp_path, capsys):
     _assert_one_line_error(*_cli(capsys, _argv("orient", path, tmp_path))[::2], path, "degenerate")
 
 
-@pytest.mark.parametrize("cmd", [c for c in ("classify", "orient", "remove-interior", "layers") if c in COMMANDS_HERE])
+@pytest.mark.parametrize(
+    "cmd", [c for c in ("classify", "orient", "remove-interior", "layers") if c in COMMANDS_HERE]
+)
 def test_single_triangle_works(tmp_path, capsys, cmd):
     path = _write(tmp_path / "tri.obj", _text_model("obj", ["0 0 0", "1 0 0", "0 1 0"], [[0, 1, 2]]))
     report = str(tmp_path / "report.json")
@@ -319,6 +355,7 @@ def test_missing_file(tmp_path, capsys, cmd):
 def test_unreadable_file(tmp_path, capsys, monkeypatch, good_files):
     path = _write(tmp_path / "locked.obj", open(good_files["obj"], "rb").read())
     if IS_ROOT:  # root reads every file: make the loader's open() refuse, as the system would
+
         def refuse(*args, **kwargs):
             raise PermissionError(errno.EACCES, "Permission denied")
 
@@ -334,8 +371,11 @@ def test_unwritable_output_folder(tmp_path, capsys, monkeypatch, good_files):
     folder.mkdir()
     if IS_ROOT:  # root writes everywhere: make the folder look read-only to the checks
         real_access = os.access
-        monkeypatch.setattr(os, "access", lambda p, mode, **kw: False if os.path.abspath(p) == str(folder)
-                            else real_access(p, mode, **kw))
+        monkeypatch.setattr(
+            os,
+            "access",
+            lambda p, mode, **kw: False if os.path.abspath(p) == str(folder) else real_access(p, mode, **kw),
+        )
     else:
         os.chmod(folder, 0o500)
     out = str(folder / "out.obj")
@@ -362,8 +402,9 @@ def test_output_path_is_the_input(tmp_path, capsys, good_files):
             rc, _, err = _cli(capsys, _argv("remove-interior", path, tmp_path, out=out) + force)
             _assert_one_line_error(rc, err, os.path.basename(out), "input")
     # --removed and --report may not hit the input either
-    rc, _, err = _cli(capsys, _argv("remove-interior", path, tmp_path, out=str(tmp_path / "o.obj"))
-                      + ["--removed", path])
+    rc, _, err = _cli(
+        capsys, _argv("remove-interior", path, tmp_path, out=str(tmp_path / "o.obj")) + ["--removed", path]
+    )
     _assert_one_line_error(rc, err, path, "input")
     assert open(path, "rb").read() == before
 
@@ -415,8 +456,10 @@ def test_disk_full_on_the_report(tmp_path, capsys, monkeypatch, good_files):
 
     monkeypatch.setattr(os, "fdopen", fdopen)
     report = str(tmp_path / "report.json")
-    rc, _, err = _cli(capsys, _argv("orient", good_files["ply"], tmp_path, out=str(tmp_path / "out.ply"))
-                      + ["--report", report])
+    rc, _, err = _cli(
+        capsys,
+        _argv("orient", good_files["ply"], tmp_path, out=str(tmp_path / "out.ply")) + ["--report", report],
+    )
     _assert_one_line_error(rc, err, report, "no space left")
     assert sorted(os.listdir(tmp_path)) == ["out.ply"]
 
@@ -424,8 +467,14 @@ def test_disk_full_on_the_report(tmp_path, capsys, monkeypatch, good_files):
 # ------------------------------------------------------------------ the real stderr
 def _run_cli(*args: str, cwd: str) -> subprocess.CompletedProcess:
     env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
-    return subprocess.run([sys.executable, "-m", "meshvis", *args], cwd=cwd, capture_output=True, text=True,
-                          env=env, timeout=120)
+    return subprocess.run(
+        [sys.executable, "-m", "meshvis", *args],
+        cwd=cwd,
+        capture_output=True,
+        text=True,
+        env=env,
+        timeout=120,
+    )
 
 
 def test_real_stderr_has_one_line_and_no_traceback(tmp_path):
@@ -445,6 +494,7 @@ def test_real_stderr_has_one_line_and_no_traceback(tmp_path):
 
 def test_io_error_while_reading(tmp_path, capsys, monkeypatch, good_files):
     """An OSError from the system (here: EIO while reading the file's first bytes) is one line too."""
+
     def broken(*args, **kwargs):
         raise OSError(errno.EIO, os.strerror(errno.EIO), good_files["obj"])
 

@@ -1,4 +1,5 @@
 """Broad phase, conservative triangle intersection and coplanarity tests (appendix H §2)."""
+
 from __future__ import annotations
 
 import numpy as np
@@ -195,10 +196,14 @@ def mixed_scene():
     base = np.array([[0, 0, 4], [1, 0, 4], [0, 1, 4]], float)
     tris += [base, base + [0.2, 0.1, 0]]  # coplanar overlap
     eps = EPS * 6.0  # roughly the diagonal of the scene times EPS
-    tris += [np.array([[6, 0, 0], [7, 0, 0], [6, 1, 0]], float),
-             np.array([[6.2, 0.2, 10 * eps], [6.4, 0.2, 1], [6.2, 0.4, 1]])]  # near miss
-    tris += [np.array([[6, 3, 0], [7, 3, 0], [6, 4, 0]], float),
-             np.array([[6.2, 3.2, 0.01 * eps], [6.4, 3.2, 1], [6.2, 3.4, 1]])]  # within eps
+    tris += [
+        np.array([[6, 0, 0], [7, 0, 0], [6, 1, 0]], float),
+        np.array([[6.2, 0.2, 10 * eps], [6.4, 0.2, 1], [6.2, 0.4, 1]]),
+    ]  # near miss
+    tris += [
+        np.array([[6, 3, 0], [7, 3, 0], [6, 4, 0]], float),
+        np.array([[6.2, 3.2, 0.01 * eps], [6.4, 3.2, 1], [6.2, 3.4, 1]]),
+    ]  # within eps
     return soup(*tris)
 
 

@@ -1,9 +1,10 @@
 """Tests of meshvis.io: readers, writers, round trips, bad input, atomic writes."""
+
 from __future__ import annotations
 
 import os
-import tempfile
 import re
+import tempfile
 import warnings
 
 import numpy as np
@@ -11,10 +12,10 @@ import pytest
 
 import meshvis.io as mio
 from meshvis.errors import ModelError, ModelFormatError, OutputError, ParameterError
+from meshvis.io import as_soup
 from meshvis.io.obj import MtlSource
 from meshvis.io.ply import read_elements
 from meshvis.io.triangulate import ear_clip, triangulate
-from meshvis.io import as_soup
 from meshvis.soup import Material, Soup
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -63,7 +64,8 @@ def _colour_soup() -> Soup:
     v = rng.normal(size=(30, 3))
     f = np.array([rng.choice(30, 3, replace=False) for _ in range(40)])
     return Soup(
-        v, f,
+        v,
+        f,
         part_id=np.repeat([0, 1], 20),
         part_names=["body", "lid"],
         material_id=np.tile([0, 0, 1, -1], 10),
@@ -149,7 +151,9 @@ def test_obj_line_continuation_and_concave_polygons():
     # ear clipping covers every polygon exactly: triangle areas add up per polygon
     text = open(real("wallhole.obj")).read().replace("\\\n", " ")
     verts = np.array([ln.split()[1:4] for ln in text.splitlines() if ln.startswith("v ")], float)
-    polys = [[int(c.split("/")[0]) - 1 for c in ln.split()[1:]] for ln in text.splitlines() if ln.startswith("f ")]
+    polys = [
+        [int(c.split("/")[0]) - 1 for c in ln.split()[1:]] for ln in text.splitlines() if ln.startswith("f ")
+    ]
     for k, poly in enumerate(polys):
         assert soup.areas[soup.source_face == k].sum() == pytest.approx(_polygon_area(verts[poly]), rel=1e-9)
 
@@ -211,7 +215,10 @@ def test_obj_polygon_with_many_vertices(tmp_path):
     notch = ring.copy()
     notch[::2, :2] *= 0.5  # a concave star with as many corners
     lines = [f"v {x!r} {y!r} {z!r}" for x, y, z in np.concatenate([ring, notch]).tolist()]
-    lines += ["f " + " ".join(str(i + 1) for i in range(n)), "f " + " ".join(str(n + i + 1) for i in range(n))]
+    lines += [
+        "f " + " ".join(str(i + 1) for i in range(n)),
+        "f " + " ".join(str(n + i + 1) for i in range(n)),
+    ]
     soup = mio.load(_write(tmp_path / "big.obj", "\n".join(lines) + "\n"))
     assert soup.n_faces == 2 * (n - 2)
     assert np.bincount(soup.source_face).tolist() == [n - 2, n - 2]
@@ -232,14 +239,17 @@ def test_off_polygons_source_face(tmp_path):
 
 def test_ply_mixed_polygons_ascii_and_binary(tmp_path):
     v = np.concatenate([SEVEN, QUAD])
-    head = ("ply\nformat {fmt} 1.0\nelement vertex 11\nproperty double x\nproperty double y\nproperty double z\n"
-            "element face 3\nproperty list uchar int vertex_indices\nend_header\n")
+    head = (
+        "ply\nformat {fmt} 1.0\nelement vertex 11\nproperty double x\nproperty double y\nproperty double z\n"
+        "element face 3\nproperty list uchar int vertex_indices\nend_header\n"
+    )
     faces = [list(range(7)), [7, 8, 9, 10], [0, 1, 2]]
     text = head.format(fmt="ascii") + "\n".join(" ".join(map(str, p)) for p in v) + "\n"
     text += "\n".join(f"{len(f)} " + " ".join(map(str, f)) for f in faces) + "\n"
     a = mio.load(_write(tmp_path / "poly_ascii.ply", text))
     body = v.astype("<f8").tobytes() + b"".join(
-        np.uint8(len(f)).tobytes() + np.array(f, "<i4").tobytes() for f in faces)
+        np.uint8(len(f)).tobytes() + np.array(f, "<i4").tobytes() for f in faces
+    )
     b = mio.load(_write(tmp_path / "poly_bin.ply", head.format(fmt="binary_little_endian").encode() + body))
     for s in (a, b):
         assert s.source_face.tolist() == [0] * 5 + [1] * 2 + [2]
@@ -249,8 +259,10 @@ def test_ply_mixed_polygons_ascii_and_binary(tmp_path):
 
 # ---------------------------------------------------------------------------- OBJ details
 def test_obj_relative_indices(tmp_path):
-    text = ("v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n"
-            "v 5 0 0\nv 6 0 0\nv 5 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf -3/-3 -2/-2 -1/-1\nf 1 -2 -1\n")
+    text = (
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nf -3 -2 -1\n"
+        "v 5 0 0\nv 6 0 0\nv 5 1 0\nvt 0 0\nvt 1 0\nvt 0 1\nf -3/-3 -2/-2 -1/-1\nf 1 -2 -1\n"
+    )
     soup = mio.load(_write(tmp_path / "rel.obj", text))
     assert soup.faces.tolist() == [[0, 1, 2], [3, 4, 5], [0, 4, 5]]
     assert np.array_equal(soup.uv[1], [[0, 0], [1, 0], [0, 1]])
@@ -265,22 +277,33 @@ def test_two_vertex_records_are_skipped_with_a_warning(tmp_path):
 
 
 def test_obj_corner_layouts_colours_groups(tmp_path):
-    text = "\n".join([
-        "mtllib missing.mtl",
-        "v 0 0 0 1 0 0", "v 1 0 0 0 1 0", "v 0 1 0 0 0 1", "v 1 1 0 1 1 1",
-        "vt 0 0", "vt 1 0", "vt 0 1", "vn 0 0 1",
-        "f 1 2 3",
-        "o lid",
-        "usemtl shiny",
-        "f 1/1/1 2/2/1 3/3/1",
-        "g hinge",
-        "f 2//1 4//1 3//1  # trailing comment",
-        "o body",
-        "f 2/2 4/1 3/3",
-        "o lid",
-        "usemtl dull",
-        "f 1/1 2/2 4/3",
-    ]) + "\n"
+    text = (
+        "\n".join(
+            [
+                "mtllib missing.mtl",
+                "v 0 0 0 1 0 0",
+                "v 1 0 0 0 1 0",
+                "v 0 1 0 0 0 1",
+                "v 1 1 0 1 1 1",
+                "vt 0 0",
+                "vt 1 0",
+                "vt 0 1",
+                "vn 0 0 1",
+                "f 1 2 3",
+                "o lid",
+                "usemtl shiny",
+                "f 1/1/1 2/2/1 3/3/1",
+                "g hinge",
+                "f 2//1 4//1 3//1  # trailing comment",
+                "o body",
+                "f 2/2 4/1 3/3",
+                "o lid",
+                "usemtl dull",
+                "f 1/1 2/2 4/3",
+            ]
+        )
+        + "\n"
+    )
     soup = mio.load(_write(tmp_path / "layouts.obj", text))
     assert soup.n_faces == 5
     assert soup.part_names == ["layouts", "lid", "lid/hinge", "body"]
@@ -300,8 +323,11 @@ def test_obj_mtl_and_texture_are_written_back(tmp_path):
     src.mkdir()
     Image.new("RGB", (4, 4), (200, 10, 10)).save(src / "skin.png")
     _write(src / "m.mtl", "newmtl skin\nKd 1 0.5 0.25\nmap_Kd skin.png\n\nnewmtl plain\nKd 0 1 0\n")
-    obj = _write(src / "m.obj", "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
-                               "usemtl skin\nf 1/1 2/2 3/3\nusemtl plain\nf 1/1 3/3 2/2\n")
+    obj = _write(
+        src / "m.obj",
+        "mtllib m.mtl\nv 0 0 0\nv 1 0 0\nv 0 1 0\nvt 0 0\nvt 1 0\nvt 0 1\n"
+        "usemtl skin\nf 1/1 2/2 3/3\nusemtl plain\nf 1/1 3/3 2/2\n",
+    )
     soup = mio.load(obj)
     assert isinstance(soup.materials[0].source, MtlSource)
     assert soup.materials[0].source.textures() == [("map_Kd", "skin.png")]
@@ -400,8 +426,12 @@ def test_three_mf_and_scene(tmp_path):
 
     scene = trimesh.Scene()
     scene.add_geometry(trimesh.creation.box(), node_name="box", geom_name="box")
-    scene.add_geometry(trimesh.creation.icosphere(subdivisions=1), node_name="ball", geom_name="ball",
-                       transform=trimesh.transformations.translation_matrix([3, 0, 0]))
+    scene.add_geometry(
+        trimesh.creation.icosphere(subdivisions=1),
+        node_name="ball",
+        geom_name="ball",
+        transform=trimesh.transformations.translation_matrix([3, 0, 0]),
+    )
     soup = as_soup(scene)
     assert sorted(soup.part_names) == ["ball", "box"]
     assert soup.n_faces == 12 + 80
@@ -421,8 +451,10 @@ def test_load_name_and_as_soup(tmp_path):
 
 # ---------------------------------------------------------------------------- bad input
 _TRI = "v 0 0 0\nv 1 0 0\nv 0 1 0\n"
-_PLY_HEAD = ("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
-             "element face 1\nproperty list uchar int vertex_indices\nend_header\n")
+_PLY_HEAD = (
+    "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\nproperty float z\n"
+    "element face 1\nproperty list uchar int vertex_indices\nend_header\n"
+)
 
 BAD_TEXT = {
     "nan.obj": ("v nan 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 3\n", ModelError, "NaN"),
@@ -445,25 +477,34 @@ BAD_TEXT = {
     "negative.ply": (_PLY_HEAD + "0 0 0\n1 0 0\n0 1 0\n3 0 -1 2\n", ModelError, "out of range"),
     "short.ply": (_PLY_HEAD + "0 0 0\n1 0 0\n0 1 0\n1 0\n", ModelFormatError, "at least 3"),
     "truncated.ply": (_PLY_HEAD + "0 0 0\n1 0 0\n", ModelFormatError, "truncated"),
-    "nan.stl": ("solid s\nfacet normal 0 0 1\nouter loop\nvertex nan 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
-                "endloop\nendfacet\nendsolid s\n", ModelError, "NaN"),
-    "truncated_ascii.stl": ("solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n",
-                            ModelFormatError, "truncated"),
+    "nan.stl": (
+        "solid s\nfacet normal 0 0 1\nouter loop\nvertex nan 0 0\nvertex 1 0 0\nvertex 0 1 0\n"
+        "endloop\nendfacet\nendsolid s\n",
+        ModelError,
+        "NaN",
+    ),
+    "truncated_ascii.stl": (
+        "solid s\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\n",
+        ModelFormatError,
+        "truncated",
+    ),
     "unknown.xyz": (_TRI, ModelFormatError, "unknown file extension"),
     "obj_named.stl": (_TRI + "f 1 2 3\n", ModelFormatError, "looks like OBJ"),
     "obj_named.ply": (_TRI + "f 1 2 3\n", ModelFormatError, "looks like OBJ"),
     "obj_named.glb": (_TRI + "f 1 2 3\n", ModelFormatError, "looks like OBJ"),
     "off_named.obj": ("OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n", ModelFormatError, "looks like OFF"),
-    "bad.gltf": ('{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 5}}]}]}',
-                 ModelError, ""),
+    "bad.gltf": (
+        '{"asset": {"version": "2.0"}, "meshes": [{"primitives": [{"attributes": {"POSITION": 5}}]}]}',
+        ModelError,
+        "",
+    ),
 }
 
 
 def _check(path: str, cls, fragment: str) -> ModelError:
-    with pytest.raises(cls) as info:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            mio.load(path)
+    with pytest.raises(cls) as info, warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        mio.load(path)
     msg = str(info.value)
     assert os.path.basename(path) in msg
     assert "\n" not in msg and "Traceback" not in msg
@@ -496,17 +537,26 @@ def test_empty_files(tmp_path, ext):
 
 
 @needs_real
-@pytest.mark.parametrize("name,keep", [("pins.glb", 20000), ("CesiumMilkTruck.glb", 3000),
-                                       ("pyvista__ant.ply", 9000), ("busted.STL", 50000),
-                                       ("cycloidal.ply", 600000)])
+@pytest.mark.parametrize(
+    "name,keep",
+    [
+        ("pins.glb", 20000),
+        ("CesiumMilkTruck.glb", 3000),
+        ("pyvista__ant.ply", 9000),
+        ("busted.STL", 50000),
+        ("cycloidal.ply", 600000),
+    ],
+)
 def test_truncated_real_files(tmp_path, name, keep):
     data = open(real(name), "rb").read()[:keep]
     _check(_write(tmp_path / name, data), ModelFormatError, "truncated")
 
 
 def test_binary_ply_truncated_in_variable_lists(tmp_path):
-    head = ("ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
-            "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n")
+    head = (
+        "ply\nformat binary_little_endian 1.0\nelement vertex 4\nproperty float x\nproperty float y\n"
+        "property float z\nelement face 2\nproperty list uchar int vertex_indices\nend_header\n"
+    )
     body = np.eye(4, 3, dtype="<f4").tobytes() + bytes([3]) + np.arange(3, dtype="<i4").tobytes()
     body += bytes([4]) + np.arange(2, dtype="<i4").tobytes()  # second face cut short
     _check(_write(tmp_path / "cut.ply", head.encode() + body), ModelFormatError, "truncated")
@@ -521,6 +571,7 @@ def test_folder_missing_and_unreadable(tmp_path, monkeypatch):
     if hasattr(os, "geteuid") and os.geteuid() != 0:
         os.chmod(path, 0)
     else:  # root reads everything: simulate the permission error
+
         def refuse(*args, **kwargs):
             raise PermissionError(13, "Permission denied")
 
@@ -533,10 +584,9 @@ def test_folder_missing_and_unreadable(tmp_path, monkeypatch):
 def test_atomic_write_keeps_old_file_on_error(tmp_path):
     path = tmp_path / "out.txt"
     path.write_text("old")
-    with pytest.raises(RuntimeError):
-        with mio.atomic_write(path, "w") as fh:
-            fh.write("partial")
-            raise RuntimeError("boom")
+    with pytest.raises(RuntimeError), mio.atomic_write(path, "w") as fh:
+        fh.write("partial")
+        raise RuntimeError("boom")
     assert path.read_text() == "old"
     assert os.listdir(tmp_path) == ["out.txt"]
     with mio.atomic_write(path, "wb") as fh:

@@ -1,4 +1,5 @@
 """Tests of the external labeling (package ``labeling``, thesis appendix I)."""
+
 from __future__ import annotations
 
 import json
@@ -10,6 +11,7 @@ import pytest
 import trimesh
 
 from meshvis import labeling
+from meshvis.errors import MeshvisError, ParameterError
 from meshvis.labeling import boxes, geometry2d, membership
 from meshvis.labeling.baselines import adjust_text, two_step
 from meshvis.labeling.candidates import EAST, NORTH, RADIAL, SOUTH, WEST, leader_candidates
@@ -22,7 +24,6 @@ from meshvis.labeling.metrics import frame_metrics, is_clean, motion_metrics
 from meshvis.labeling.output import to_svg, write, write_gif, write_json, write_png
 from meshvis.labeling.pipeline import fit_camera, solve
 from meshvis.rays.camera import Camera
-from meshvis.errors import MeshvisError, ParameterError
 from meshvis.soup import Soup
 
 ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
@@ -162,7 +163,17 @@ def test_layout_api_end_to_end(scene, tmp_path):
     assert (5, "pipe") in r.skipped
     assert r.size == (200, 160) and r.ids.shape == (160, 200)
     assert all(lab.side == "west" for lab in r.labels)
-    for key in ("setup", "idbuffer", "area", "candidates", "salience", "memberships", "greedy", "boxes", "layout_ms"):
+    for key in (
+        "setup",
+        "idbuffer",
+        "area",
+        "candidates",
+        "salience",
+        "memberships",
+        "greedy",
+        "boxes",
+        "layout_ms",
+    ):
         assert key in r.timings
 
 
@@ -237,8 +248,10 @@ def test_candidates_follow_the_principal_directions():
     pix = (30, 25)  # row, col
     a = np.array([pix[1] + 0.5, pix[0] + 0.5])
     for layout, side, e in [
-        ("left", WEST, (x0, a[1])), ("right", EAST, (x1, a[1])),
-        ("top", NORTH, (a[0], y0)), ("bottom", SOUTH, (a[0], y1)),
+        ("left", WEST, (x0, a[1])),
+        ("right", EAST, (x1, a[1])),
+        ("top", NORTH, (a[0], y0)),
+        ("bottom", SOUTH, (a[0], y1)),
     ]:
         c = leader_candidates(ia, layout)
         assert c.side[pix] == side
@@ -272,7 +285,9 @@ def test_membership_formulas():
     assert np.allclose(membership.f2_length(np.array([0.0, 5.0, 10.0]), 10.0), [1.0, 0.5, 0.0])  # Eq. 2
     assert np.allclose(membership.f3_salience(np.array([2.0, 20.0]), 10.0), [0.2, 1.0])  # Eq. 3 (clipped)
     # Eq. 4-5: the nearest placed anchor decides, saturating at d_a
-    f4 = membership.f4_anchor_distance(np.array([0.0, 3.0, 50.0]), np.zeros(3), np.array([[0.0, 4.0], [1.0, 0.0]]), 10.0)
+    f4 = membership.f4_anchor_distance(
+        np.array([0.0, 3.0, 50.0]), np.zeros(3), np.array([[0.0, 4.0], [1.0, 0.0]]), 10.0
+    )
     assert np.allclose(f4, [0.1, 0.2, 1.0])
     assert np.allclose(membership.dist_threshold(np.array([3.0]), np.array([4.0]), 0.0), 1.0)
     # Eq. 8-9: coherence, NaN = no previous frame
@@ -284,8 +299,17 @@ def test_membership_formulas():
     F = membership.aggregate({"f2": np.array([0.25]), "f3": np.array([0.5]), "f4": np.array([0.0])}, w)
     assert np.allclose(F, 0.5 * 0.5)
     # Eq. 14
-    assert np.allclose(membership.priority(np.array([0.5, 1.0, 0.0]), np.array([0, 0, 1]), 3), [0.5, 1.0, 0.0])
-    assert membership.Weights().as_dict() == {"w2": 0.2, "w3": 1.0, "w4": 1.0, "w5": 1.0, "w6": 0.7, "w7": 0.7}
+    assert np.allclose(
+        membership.priority(np.array([0.5, 1.0, 0.0]), np.array([0, 0, 1]), 3), [0.5, 1.0, 0.0]
+    )
+    assert membership.Weights().as_dict() == {
+        "w2": 0.2,
+        "w3": 1.0,
+        "w4": 1.0,
+        "w5": 1.0,
+        "w6": 0.7,
+        "w7": 0.7,
+    }
     with pytest.raises(ParameterError):
         membership.Weights(w2=1.5)
 
@@ -489,8 +513,18 @@ def test_cli(tmp_path, scene):
 def test_bench_runs_small(scene):
     from meshvis.labeling import bench
 
-    r = bench.run(scene, size=128, layouts=("left-right", "silhouette"), sizes=(96, 128), orbit_frames=3,
-                  repeat=1, adjusttext=False, views=3, d_e=0.1, rotate=32)
+    r = bench.run(
+        scene,
+        size=128,
+        layouts=("left-right", "silhouette"),
+        sizes=(96, 128),
+        orbit_frames=3,
+        repeat=1,
+        adjusttext=False,
+        views=3,
+        d_e=0.1,
+        rotate=32,
+    )
     assert set(r["layouts"]) == {"left-right", "silhouette"}
     assert r["layouts"]["left-right"]["fuzzy"]["metrics"]["overlaps"] == 0
     assert r["sizes"][128]["fuzzy"]["error"] == 0.0  # the largest size is the reference
@@ -498,18 +532,30 @@ def test_bench_runs_small(scene):
     v = r["views"]["silhouette"]
     assert v["views"] == 6 and 0 <= v["fuzzy_shorter"] <= 6
     assert v["fuzzy"]["clean"] == v["two-step"]["clean"] == 6
-    assert v["fuzzy"]["labels"] + v["fuzzy"]["unplaced"] == v["two-step"]["labels"] + v["two-step"]["unplaced"]
+    assert (
+        v["fuzzy"]["labels"] + v["fuzzy"]["unplaced"] == v["two-step"]["labels"] + v["two-step"]["unplaced"]
+    )
     for m in ("fuzzy", "two-step"):
         assert 0 < v["common_first_segment"][m] <= v["common_leader"][m]
     text = bench.format(r)
-    assert "per-stage time" in text and "orbit of 3 frames" in text and "6 views" in text and "d_e 0.1, rotate 32.0 px" in text
+    assert (
+        "per-stage time" in text
+        and "orbit of 3 frames" in text
+        and "6 views" in text
+        and "d_e 0.1, rotate 32.0 px" in text
+    )
 
 
 def test_sweep_runs_small(scene):
     from meshvis.labeling import sweep
 
-    r = sweep.run([("scene", scene, (0, 0, 1))], azimuths=2, elevations=(30.0,), sizes=(128,),
-                  layouts=("left", "silhouette"))
+    r = sweep.run(
+        [("scene", scene, (0, 0, 1))],
+        azimuths=2,
+        elevations=(30.0,),
+        sizes=(128,),
+        layouts=("left", "silhouette"),
+    )
     assert len(r["cases"]) == 2 * 2 * 2  # views x layouts x methods
     assert all(c["clean"] and c["unplaced"] == 0 and c["labels"] > 0 for c in r["cases"].values())
     rows = {(row["layout"], row["method"]): row for row in r["summary"]}
@@ -549,7 +595,9 @@ def test_rotated_leaders_shorten_the_silhouette_layout(request, which):
         assert np.allclose(lab.leader[0], lab.anchor) and len(lab.leader) == 3
         poly = rotated.area_polygon
         a, b = poly, np.roll(poly, -1, axis=0)
-        t = np.clip(np.einsum("ij,ij->i", lab.leader[1] - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0, 1)
+        t = np.clip(
+            np.einsum("ij,ij->i", lab.leader[1] - a, b - a) / np.einsum("ij,ij->i", b - a, b - a), 0, 1
+        )
         assert np.hypot(*(a + t[:, None] * (b - a) - lab.leader[1]).T).min() < 2.0
 
     def total(r):
@@ -571,8 +619,9 @@ def test_silhouette_endpoints_that_coincide_are_parted():
     widths = np.full(4, 30.0)
 
     def place(gap):
-        return boxes.place_boxes(anchors, endpoints, sides, widths, 10.0, ia, (160, 120),
-                                 spacing=boxes.Spacing(endpoint_gap=gap))
+        return boxes.place_boxes(
+            anchors, endpoints, sides, widths, 10.0, ia, (160, 120), spacing=boxes.Spacing(endpoint_gap=gap)
+        )
 
     placed, stats = place(3.0)
     assert not stats.unplaced and all(p is not None for p in placed)
@@ -602,10 +651,12 @@ def test_silhouette_inside_parts_that_cross_are_swapped():
     # long, nearly parallel inside parts that cross (as parted endpoints can make them)
     anchors = np.array([[70.5, 75.5], [76.5, 60.5]])
     endpoints = np.array([[80.0, y0], [66.0, y0]])
-    assert geometry2d.segments_intersect(np.stack([anchors, endpoints], axis=1)[:1],
-                                         np.stack([anchors, endpoints], axis=1)[1:]).all()
-    placed, stats = boxes.place_boxes(anchors, endpoints, np.full(2, RADIAL), np.full(2, 30.0), 10.0, ia,
-                                      (160, 120))
+    assert geometry2d.segments_intersect(
+        np.stack([anchors, endpoints], axis=1)[:1], np.stack([anchors, endpoints], axis=1)[1:]
+    ).all()
+    placed, stats = boxes.place_boxes(
+        anchors, endpoints, np.full(2, RADIAL), np.full(2, 30.0), 10.0, ia, (160, 120)
+    )
     assert not stats.unplaced and stats.swaps == 1
     segs = [np.stack([p.leader[:-1], p.leader[1:]], axis=1) for p in placed]
     assert not geometry2d.segments_intersect(segs[0], segs[1]).any()
@@ -626,8 +677,9 @@ def test_silhouette_crowded_run_is_placed_from_both_ends(monkeypatch):
     endpoints = np.column_stack([xs, np.full(n, y0)])
 
     def place():
-        placed, stats = boxes.place_boxes(anchors, endpoints, np.full(n, RADIAL), np.full(n, 40.0), 10.0, ia,
-                                          (300, 200))
+        placed, stats = boxes.place_boxes(
+            anchors, endpoints, np.full(n, RADIAL), np.full(n, 40.0), 10.0, ia, (300, 200)
+        )
         assert not stats.unplaced
         bx = np.array([p.box for p in placed])
         overlap = geometry2d.boxes_overlap(bx, bx, 0.0)
@@ -643,8 +695,17 @@ def test_silhouette_crowded_run_is_placed_from_both_ends(monkeypatch):
     # labels far apart are no run: the order along the boundary stays
     monkeypatch.undo()
     wide = np.column_stack([np.linspace(70.0, 230.0, 4), np.full(4, y0)])
-    ctx = boxes._Context(wide + [0.5, 15.5], wide, np.full(4, RADIAL), np.full(4, 30.0), 10.0, ia, (300, 200),
-                         boxes.Spacing(), np.arange(4))
+    ctx = boxes._Context(
+        wide + [0.5, 15.5],
+        wide,
+        np.full(4, RADIAL),
+        np.full(4, 30.0),
+        10.0,
+        ia,
+        (300, 200),
+        boxes.Spacing(),
+        np.arange(4),
+    )
     ctx.ray_direction(0)
     assert boxes._run_order(ctx, np.arange(4)) == [0, 1, 2, 3]
 
@@ -687,7 +748,8 @@ def test_endpoint_towards_each_side_of_a_rectangle():
     mask[30:70, 20:100] = True
     ia = internal_area(mask, "rectangle", margin=2.0)
     x0, y0, x1, y1 = ia.bbox
-    ctx = boxes._Context([[50.5, 40.5]], [[50.5, y0]], [NORTH], [20.0], 8.0, ia, (120, 100), boxes.Spacing(),
-                         [0])
+    ctx = boxes._Context(
+        [[50.5, 40.5]], [[50.5, y0]], [NORTH], [20.0], 8.0, ia, (120, 100), boxes.Spacing(), [0]
+    )
     for side, want in ((WEST, (x0, 40.5)), (EAST, (x1, 40.5)), (NORTH, (50.5, y0)), (SOUTH, (50.5, y1))):
         assert np.allclose(boxes._endpoint_towards(ctx, 0, side), want, atol=1.0)

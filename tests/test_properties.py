@@ -14,6 +14,7 @@ collinear corners) and turned-over faces.  For every soup:
 Examples are derandomised so that CI sees the same soups on every run.  For a longer hunt,
 set ``MESHVIS_PROPERTY_EXAMPLES=500``: the examples are then random.
 """
+
 from __future__ import annotations
 
 import os
@@ -26,28 +27,36 @@ from hypothesis import HealthCheck, given, settings  # noqa: E402
 from hypothesis import strategies as st  # noqa: E402
 from hypothesis.extra import numpy as hnp  # noqa: E402
 
+from meshvis.errors import MeshvisError, ModelError  # noqa: E402
 from meshvis.geometry.adjacency import degenerate_faces  # noqa: E402
 from meshvis.graphcut.classify import classify  # noqa: E402
-from meshvis.errors import MeshvisError, ModelError  # noqa: E402
+from meshvis.graphcut.preprocess import DEGENERATE_TOL  # noqa: E402
 from meshvis.repair.layers import layers  # noqa: E402
 from meshvis.repair.orient import orient  # noqa: E402
-from meshvis.graphcut.preprocess import DEGENERATE_TOL  # noqa: E402
 from meshvis.repair.remove import remove_interior  # noqa: E402
 from meshvis.soup import Soup  # noqa: E402
 
 # small budgets: the properties do not depend on the ray count
 KW = dict(rays_per_node=8, seed=3)
 EXAMPLES = int(os.environ.get("MESHVIS_PROPERTY_EXAMPLES", "40"))
-SETTINGS = settings(max_examples=EXAMPLES, deadline=None, derandomize=EXAMPLES == 40, database=None,
-                    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large])
+SETTINGS = settings(
+    max_examples=EXAMPLES,
+    deadline=None,
+    derandomize=EXAMPLES == 40,
+    database=None,
+    suppress_health_check=[HealthCheck.too_slow, HealthCheck.data_too_large],
+)
 
 
 @st.composite
 def soups(draw) -> Soup:
     """A random small soup with duplicates, degenerate and turned-over faces."""
     n = draw(st.integers(1, 30))
-    coords = draw(hnp.arrays(np.float64, (n, 3, 3),
-                             elements=st.floats(-1, 1, allow_nan=False, allow_subnormal=False, width=32)))
+    coords = draw(
+        hnp.arrays(
+            np.float64, (n, 3, 3), elements=st.floats(-1, 1, allow_nan=False, allow_subnormal=False, width=32)
+        )
+    )
     scale = draw(st.sampled_from([1e-6, 1.0, 1e6]))
     tris = coords * scale
     idx = st.integers(0, n - 1)
@@ -119,8 +128,9 @@ def test_remove_interior_accounts_for_every_face(soup):
     assert r.kept.n_faces + r.removed.n_faces == m
     assert np.array_equal(r.kept.faces, soup.faces[r.keep])
     assert np.array_equal(r.removed.faces, soup.faces[~r.keep])
-    assert np.array_equal(np.sort(np.concatenate([r.kept.source_face, r.removed.source_face])),
-                          np.sort(soup.source_face))
+    assert np.array_equal(
+        np.sort(np.concatenate([r.kept.source_face, r.removed.source_face])), np.sort(soup.source_face)
+    )
     assert np.array_equal(r.keep, remove_interior(soup, **KW).keep)
 
 
@@ -141,7 +151,9 @@ def test_layers_give_every_face_a_layer(soup):
 
 
 @SETTINGS
-@given(soups(), st.sampled_from(["keep", "duplicate", "strongest"]), st.sampled_from(["majority", "duplicate"]))
+@given(
+    soups(), st.sampled_from(["keep", "duplicate", "strongest"]), st.sampled_from(["majority", "duplicate"])
+)
 def test_orient_turns_faces_over_and_nothing_else(soup, two_sided, conflicts):
     r = _run(orient, soup, two_sided=two_sided, conflicts=conflicts, **KW)
     if r is None:

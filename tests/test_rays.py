@@ -1,5 +1,6 @@
 """The ray backend: hit side, distances, offsets, occlusion, and invariance under extreme
 translations and scales (the scene is built on a centred unit-size float32 copy)."""
+
 import numpy as np
 import pytest
 import trimesh
@@ -73,7 +74,9 @@ def test_occluded_segments():
     assert not rc.occluded(np.array([[0, 0, 5.0]]), np.array([[0, 0, 0.5]]))[0]
 
 
-@pytest.mark.parametrize("scale,shift", [(1.0, 0.0), (1e-6, 0.0), (1e6, 0.0), (1.0, 1e6), (1e-6, 1e6), (1e6, 1e6)])
+@pytest.mark.parametrize(
+    "scale,shift", [(1.0, 0.0), (1e-6, 0.0), (1e6, 0.0), (1.0, 1e6), (1e-6, 1e6), (1e6, 1e6)]
+)
 def test_same_results_under_translation_and_scale(scale, shift):
     """Translation by 1e6 x size and scales 1e-6 / 1e6 give the same faces, sides and
     relative distances as the untouched model."""
@@ -107,8 +110,12 @@ def test_part_ids():
     a = trimesh.creation.box()
     b = trimesh.creation.box()
     b.apply_translation([5, 0, 0])
-    s = Soup(np.vstack([a.vertices, b.vertices]), np.vstack([a.faces, b.faces + 8]),
-             part_id=np.r_[np.zeros(12, int), np.ones(12, int)], part_names=["a", "b"])
+    s = Soup(
+        np.vstack([a.vertices, b.vertices]),
+        np.vstack([a.faces, b.faces + 8]),
+        part_id=np.r_[np.zeros(12, int), np.ones(12, int)],
+        part_names=["a", "b"],
+    )
     rc = RayCaster(s)
     h = rc.intersect(np.array([[0, 0, 5.0], [5, 0, 5.0], [20, 0, 5.0]]), np.array([[0, 0, -1.0]] * 3))
     assert rc.part_of(h.face).tolist() == [0, 1, -1]

@@ -1,4 +1,5 @@
 """Stability benchmark: the quick run through the command line, and the trickiest cases directly."""
+
 import argparse
 import json
 
@@ -7,10 +8,10 @@ import pytest
 import trimesh
 
 from meshvis.cli.main import main as cli_main
+from meshvis.errors import ModelError
 from meshvis.eval import generators
 from meshvis.eval.bench import stability as st
 from meshvis.graphcut.classify import classify
-from meshvis.errors import ModelError
 from meshvis.graphcut.mincut import min_cut, rounding_bound
 
 
@@ -68,19 +69,34 @@ def test_stressed_copies_keep_the_original_faces_first():
     for s in (st.add_zero_area(soup), st.add_duplicates(soup), st.add_near_coplanar(soup, 1e-7)):
         assert s.n_faces > m
         assert np.array_equal(s.triangles[:m], soup.triangles)
-    assert (st.add_zero_area(soup).areas[m:] < 1e-15 * soup.diagonal**2).all()  # round-off of collinear corners
+    assert (
+        st.add_zero_area(soup).areas[m:] < 1e-15 * soup.diagonal**2
+    ).all()  # round-off of collinear corners
     near = st.add_near_coplanar(soup, 1e-7)
-    shift = np.abs(np.einsum("ij,ij->i", near.triangles[m:, 0] - soup.triangles[:, 0][
-        np.argmin(np.linalg.norm(near.triangles[m:, None, 0] - soup.triangles[None, :, 0], axis=2), axis=1)],
-        near.normals[m:]))
+    shift = np.abs(
+        np.einsum(
+            "ij,ij->i",
+            near.triangles[m:, 0]
+            - soup.triangles[:, 0][
+                np.argmin(
+                    np.linalg.norm(near.triangles[m:, None, 0] - soup.triangles[None, :, 0], axis=2), axis=1
+                )
+            ],
+            near.normals[m:],
+        )
+    )
     assert np.allclose(shift, 1e-7 * soup.diagonal, rtol=1e-3)
 
 
 def test_far_translation_and_extreme_scales_give_identical_labels():
     soup = generators.cracked_box(cell=0.1, crack_width=1e-3).soup
     ref = classify(soup, rays_per_node=8, seed=3)
-    for s in (st.similarity(soup, "translate", 1e6), st.similarity(soup, "scale", 1e-6),
-              st.similarity(soup, "scale", 1e6), st.similarity(soup, "rotate", seed=2)):
+    for s in (
+        st.similarity(soup, "translate", 1e6),
+        st.similarity(soup, "scale", 1e-6),
+        st.similarity(soup, "scale", 1e6),
+        st.similarity(soup, "rotate", seed=2),
+    ):
         c = classify(s, rays_per_node=8, seed=3)
         assert st.area_agreement(ref.side_outside, c.side_outside, soup.areas) >= st.AGREEMENT
 
@@ -136,10 +152,13 @@ def test_pymaxflow_cut_of_an_empty_graph():
     assert cut.outside.shape == (0,) and cut.value == 0.0
 
 
-@pytest.mark.parametrize("text, problem", [
-    ("", "the file is empty"),
-    ("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "degenerate"),
-])
+@pytest.mark.parametrize(
+    "text, problem",
+    [
+        ("", "the file is empty"),
+        ("v 0 0 0\nv 1 0 0\nv 2 0 0\nf 1 2 3\n", "degenerate"),
+    ],
+)
 def test_empty_and_degenerate_files_fail_cleanly_naming_the_file(tmp_path, capsys, text, problem):
     path = tmp_path / "model.obj"
     path.write_text(text)
@@ -165,15 +184,15 @@ def test_sample_origin_next_to_a_perpendicular_wall_stays_on_its_side():
     # instead of being pushed through B.
     from meshvis.graphcut.nodes import _pushed_origins
 
-    tri = np.array([[[0, 0, 0], [0, 1, 0], [0, 0, 1]],
-                    [[-1, 0, -1], [1, 0, -1], [0, 0, 2]]], float)
+    tri = np.array([[[0, 0, 0], [0, 1, 0], [0, 0, 1]], [[-1, 0, -1], [1, 0, -1], [0, 0, 2]]], float)
     nrm = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
     nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
     assert np.allclose(nrm, [[1, 0, 0], [0, -1, 0]])
     pos = np.array([[0.0, 1e-5, 0.3]])
     offset = 1e-4
     for side in (0, 1):
-        o = _pushed_origins(pos, np.array([0]), side, tri, nrm, np.array([0, -1]), np.array([[0, 1]]),
-                            1, offset, 2 * offset)
+        o = _pushed_origins(
+            pos, np.array([0]), side, tri, nrm, np.array([0, -1]), np.array([[0, 1]]), 1, offset, 2 * offset
+        )
         assert o[0, 1] > 0  # still in front of the wall
         assert o[0, 0] == pytest.approx(offset if side == 0 else -offset)

@@ -33,6 +33,7 @@ its report is deleted, so ``DIR`` never holds a partial result.  The report of a
 successful file has ``"status": "ok"``; ``resume`` skips files whose output exists and
 whose report says ``ok`` for the same operation and options and is newer than the input.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -54,8 +55,9 @@ import traceback
 import uuid
 import warnings
 from collections import deque
+from collections.abc import Callable, Sequence
 from dataclasses import asdict, dataclass, field, replace
-from typing import Any, Callable, Sequence
+from typing import Any
 
 from meshvis.errors import MeshvisError, OutputError, ParameterError
 from meshvis.io import READ_FORMATS, WRITE_FORMATS, atomic_write, one_line
@@ -65,10 +67,28 @@ OPERATIONS = ("orient", "remove-interior", "layers")
 #: the per-file operation: ``module:function`` called as ``f(op, soup, options, progress) -> report``
 DEFAULT_RUNNER = "meshvis.repair.operation:run_operation"
 #: columns of a summary row, in the order of ``summary.csv``
-COLUMNS = ("input", "status", "error", "faces_in", "faces_out", "rays", "seconds", "output", "report", "warnings")
+COLUMNS = (
+    "input",
+    "status",
+    "error",
+    "faces_in",
+    "faces_out",
+    "rays",
+    "seconds",
+    "output",
+    "report",
+    "warnings",
+)
 #: statuses of a summary row; the first two count as success
 OK, SKIPPED, ERROR, TIMEOUT, CRASHED, INTERRUPTED, NOT_RUN = (
-    "ok", "skipped", "error", "timeout", "crashed", "interrupted", "not run")
+    "ok",
+    "skipped",
+    "error",
+    "timeout",
+    "crashed",
+    "interrupted",
+    "not run",
+)
 SUCCESS = (OK, SKIPPED)
 #: seconds a fresh worker process may take to import meshvis before it counts as crashed
 STARTUP_LIMIT = 300.0
@@ -126,8 +146,18 @@ class BatchResult:
 
 def empty_row(task: FileTask, status: str = NOT_RUN, error: str = "") -> dict:
     """A summary row for ``task`` with nothing measured yet."""
-    return {"input": task.input, "status": status, "error": error, "faces_in": None, "faces_out": None,
-            "rays": None, "seconds": None, "output": task.output, "report": task.report, "warnings": ""}
+    return {
+        "input": task.input,
+        "status": status,
+        "error": error,
+        "faces_in": None,
+        "faces_out": None,
+        "rays": None,
+        "seconds": None,
+        "output": task.output,
+        "report": task.report,
+        "warnings": "",
+    }
 
 
 # --------------------------------------------------------------------------- discovery
@@ -138,8 +168,11 @@ def _is_output_name(filename: str) -> bool:
 
 
 def _is_model_name(filename: str) -> bool:
-    return (not filename.startswith(".") and os.path.splitext(filename)[1].lower() in READ_FORMATS
-            and not _is_output_name(filename))
+    return (
+        not filename.startswith(".")
+        and os.path.splitext(filename)[1].lower() in READ_FORMATS
+        and not _is_output_name(filename)
+    )
 
 
 def _walk(folder: str) -> list[str]:
@@ -199,8 +232,10 @@ def discover(inputs: Sequence[str]) -> list[tuple[str, str]]:
         if os.path.isdir(spec):
             files = _walk(spec)
             if not files:
-                raise ParameterError(f"{spec}: no model files in this folder "
-                                     f"(known extensions: {', '.join(sorted(READ_FORMATS))})")
+                raise ParameterError(
+                    f"{spec}: no model files in this folder "
+                    f"(known extensions: {', '.join(sorted(READ_FORMATS))})"
+                )
             for f in files:
                 add(f, os.path.relpath(f, spec))
         elif os.path.lexists(spec):
@@ -235,8 +270,9 @@ def output_extension(path: str, op: str) -> str:
     return ext
 
 
-def plan(inputs: Sequence[str], op: str, out_dir: str, options: dict | None = None,
-         runner: str = DEFAULT_RUNNER) -> list[FileTask]:
+def plan(
+    inputs: Sequence[str], op: str, out_dir: str, options: dict | None = None, runner: str = DEFAULT_RUNNER
+) -> list[FileTask]:
     """Make the tasks of a batch: which file goes where.
 
     Output names are ``<relative path without extension>.<op>.<ext>`` (see
@@ -259,8 +295,10 @@ def plan(inputs: Sequence[str], op: str, out_dir: str, options: dict | None = No
     for key in [n.casefold() for n in names] + [rel.casefold() for _, rel in found]:
         count[key] = count.get(key, 0) + 1
     # x.obj next to x.stl: keep the extensions in the names; the same name twice: numbered below
-    names = [rel if count[n.casefold()] > 1 and count[rel.casefold()] == 1 else n
-             for n, (_, rel) in zip(names, found)]
+    names = [
+        rel if count[n.casefold()] > 1 and count[rel.casefold()] == 1 else n
+        for n, (_, rel) in zip(names, found)
+    ]
     used: set[str] = set()
     tasks = []
     in_paths = {os.path.realpath(p) for p, _ in found}
@@ -271,11 +309,20 @@ def plan(inputs: Sequence[str], op: str, out_dir: str, options: dict | None = No
             name = f"{base}-{k}"
         used.add(name.casefold())
         stem = os.path.join(out_dir, f"{name}.{op}")
-        task = FileTask(path, name, stem + output_extension(path, op), stem + ".report.json", op,
-                        dict(options or {}), runner)
+        task = FileTask(
+            path,
+            name,
+            stem + output_extension(path, op),
+            stem + ".report.json",
+            op,
+            dict(options or {}),
+            runner,
+        )
         for p in (task.output, task.report):
             if os.path.realpath(p) in in_paths:
-                raise ParameterError(f"{p}: the output of {path} would overwrite an input file; choose another --out")
+                raise ParameterError(
+                    f"{p}: the output of {path} would overwrite an input file; choose another --out"
+                )
         tasks.append(task)
     return tasks
 
@@ -292,8 +339,6 @@ def _resolve(runner: str) -> Callable:
     return getattr(importlib.import_module(module), name)
 
 
-
-
 def operation_args(task: FileTask) -> dict:
     """Every option of the task's operation: the library defaults
     (:func:`meshvis.repair.operation.default_options`, which the single-file command uses too)
@@ -301,8 +346,15 @@ def operation_args(task: FileTask) -> dict:
     from meshvis.repair.operation import default_options
 
     ns = {**default_options(task.op), **task.options}
-    ns.update(input=task.input, output=task.output, op=task.op, report=None, preview=None,
-              removed=None, graphml=None)
+    ns.update(
+        input=task.input,
+        output=task.output,
+        op=task.op,
+        report=None,
+        preview=None,
+        removed=None,
+        graphml=None,
+    )
     return ns
 
 
@@ -369,8 +421,13 @@ def _fail(task: FileTask, row: dict, status: str, error: str, detail: str | None
     row.update(status=status, error=error)
     discard_partial(task)
     _remove(task.output)
-    data = {"status": status, "error": error, "input": task.input, "operation": task.op,
-            "batch": {**row, "options": task.options}}
+    data = {
+        "status": status,
+        "error": error,
+        "input": task.input,
+        "operation": task.op,
+        "batch": {**row, "options": task.options},
+    }
     if detail:
         data["traceback"] = detail
     with contextlib.suppress(Exception):
@@ -410,7 +467,9 @@ def run_file(task: FileTask) -> dict:
                     try:
                         os.makedirs(folder, exist_ok=True)
                     except OSError as exc:
-                        raise OutputError(f"cannot create the folder: {one_line(exc.strerror or exc)}", folder) from None
+                        raise OutputError(
+                            f"cannot create the folder: {one_line(exc.strerror or exc)}", folder
+                        ) from None
                 check_output(path, [task.input], True)
             soup = load(task.input)
             row["faces_in"] = soup.n_faces
@@ -420,8 +479,12 @@ def run_file(task: FileTask) -> dict:
             row["status"] = OK
             row["seconds"] = round(time.perf_counter() - t0, 3)
             row["warnings"] = _warning_text(caught)
-            report.update(status=OK, input=task.input, seconds_total=time.perf_counter() - t0,
-                          batch={**row, "options": task.options})
+            report.update(
+                status=OK,
+                input=task.input,
+                seconds_total=time.perf_counter() - t0,
+                batch={**row, "options": task.options},
+            )
             _write_json(task.report, report)
         return row
     except MeshvisError as exc:
@@ -462,7 +525,9 @@ def completed_row(task: FileTask) -> dict | None:
     if rep is None or rep.get("status") != OK or rep.get("operation") != task.op:
         return None
     prev = rep.get("batch") or {}
-    if not isinstance(prev.get("options"), dict) or _effective(task, prev["options"]) != _effective(task, task.options):
+    if not isinstance(prev.get("options"), dict) or _effective(task, prev["options"]) != _effective(
+        task, task.options
+    ):
         return None
     row = empty_row(task, SKIPPED)
     for key in ("faces_in", "faces_out", "rays", "seconds", "warnings"):
@@ -523,8 +588,9 @@ class _Worker:
 
     def __init__(self, ctx, threads: int | None, runner: str):
         self.conn, child = ctx.Pipe()
-        self.proc = ctx.Process(target=_worker_main, args=(child, threads, runner), daemon=True,
-                                name="meshvis-batch-worker")
+        self.proc = ctx.Process(
+            target=_worker_main, args=(child, threads, runner), daemon=True, name="meshvis-batch-worker"
+        )
         with _sigint_ignored():  # a Ctrl-C during the child's start-up must not print a traceback there
             self.proc.start()
         child.close()
@@ -565,8 +631,15 @@ def _exit_text(code: int | None) -> str:
     return f"exit code {code}"
 
 
-def _run_local(tasks: list[FileTask], todo: list[int], rows: list[dict], jobs: int, time_limit: float | None,
-               on_start: Callable, on_done: Callable) -> bool:
+def _run_local(
+    tasks: list[FileTask],
+    todo: list[int],
+    rows: list[dict],
+    jobs: int,
+    time_limit: float | None,
+    on_start: Callable,
+    on_done: Callable,
+) -> bool:
     """Run the tasks ``todo`` on ``jobs`` worker processes; return True if interrupted."""
     ctx = multiprocessing.get_context("spawn")
     cores = default_jobs(10**6)
@@ -588,7 +661,9 @@ def _run_local(tasks: list[FileTask], todo: list[int], rows: list[dict], jobs: i
                     on_start(i)
             deadlines = [d for d in (w.deadline(time_limit) for w in workers) if d is not None]
             timeout = max(0.0, min(deadlines) - time.monotonic()) if deadlines else None
-            multiprocessing.connection.wait([w.conn for w in workers] + [w.proc.sentinel for w in workers], timeout)
+            multiprocessing.connection.wait(
+                [w.conn for w in workers] + [w.proc.sentinel for w in workers], timeout
+            )
             now = time.monotonic()
             for w in list(workers):
                 kind = payload = None
@@ -620,16 +695,27 @@ def _run_local(tasks: list[FileTask], todo: list[int], rows: list[dict], jobs: i
                         row = empty_row(task)
                         row["seconds"] = round(now - w.since, 3)
                         if kind == "timeout":
-                            _fail(task, row, TIMEOUT, f"{task.input}: stopped after the time limit of {time_limit:g} s")
+                            _fail(
+                                task,
+                                row,
+                                TIMEOUT,
+                                f"{task.input}: stopped after the time limit of {time_limit:g} s",
+                            )
                         else:
-                            _fail(task, row, CRASHED,
-                                  f"{task.input}: the worker process died ({_exit_text(w.proc.exitcode)})")
+                            _fail(
+                                task,
+                                row,
+                                CRASHED,
+                                f"{task.input}: the worker process died ({_exit_text(w.proc.exitcode)})",
+                            )
                         rows[w.index] = row
                         on_done(w.index, row)
                     elif was_starting:
                         failed_starts += 1
                         if failed_starts >= 3:
-                            raise RuntimeError(f"batch worker processes fail to start ({_exit_text(w.proc.exitcode)})")
+                            raise RuntimeError(
+                                f"batch worker processes fail to start ({_exit_text(w.proc.exitcode)})"
+                            )
         return False
     except KeyboardInterrupt:
         with _sigint_ignored():
@@ -637,7 +723,9 @@ def _run_local(tasks: list[FileTask], todo: list[int], rows: list[dict], jobs: i
                 w.stop()
                 if w.index is not None:
                     discard_partial(tasks[w.index])
-                    rows[w.index] = empty_row(tasks[w.index], INTERRUPTED, f"{tasks[w.index].input}: interrupted")
+                    rows[w.index] = empty_row(
+                        tasks[w.index], INTERRUPTED, f"{tasks[w.index].input}: interrupted"
+                    )
             workers.clear()
         return True
     finally:
@@ -661,12 +749,15 @@ def run_file_isolated(task: FileTask, time_limit: float, threads: int | None = N
     local workers.  Usable where ``multiprocessing`` is not (daemonic Dask workers).
     """
     env = dict(os.environ)
-    env["PYTHONPATH"] = os.pathsep.join([p for p in sys.path if p] + [env.get("PYTHONPATH", "")]).rstrip(os.pathsep)
+    env["PYTHONPATH"] = os.pathsep.join([p for p in sys.path if p] + [env.get("PYTHONPATH", "")]).rstrip(
+        os.pathsep
+    )
     if threads:
         env.setdefault("MESHVIS_THREADS", str(threads))
     cmd = [sys.executable, "-c", "from meshvis.batch.runner import _task_main; _task_main()"]
-    proc = subprocess.Popen(cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL,
-                            env=env, bufsize=0)
+    proc = subprocess.Popen(
+        cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env, bufsize=0
+    )
     row = empty_row(task)
     t0 = time.monotonic()
     try:
@@ -677,7 +768,12 @@ def run_file_isolated(task: FileTask, time_limit: float, threads: int | None = N
         if not ready or proc.stdout.readline() != b"ready\n":
             proc.kill()
             proc.wait()
-            return _fail(task, row, CRASHED, f"{task.input}: the worker process did not start ({_exit_text(proc.returncode)})")
+            return _fail(
+                task,
+                row,
+                CRASHED,
+                f"{task.input}: the worker process did not start ({_exit_text(proc.returncode)})",
+            )
         t0 = time.monotonic()
         try:
             out, _ = proc.communicate(timeout=time_limit)
@@ -685,7 +781,9 @@ def run_file_isolated(task: FileTask, time_limit: float, threads: int | None = N
             proc.kill()
             proc.communicate()
             row["seconds"] = round(time.monotonic() - t0, 3)
-            return _fail(task, row, TIMEOUT, f"{task.input}: stopped after the time limit of {time_limit:g} s")
+            return _fail(
+                task, row, TIMEOUT, f"{task.input}: stopped after the time limit of {time_limit:g} s"
+            )
     except BaseException:
         proc.kill()
         proc.wait()
@@ -696,7 +794,9 @@ def run_file_isolated(task: FileTask, time_limit: float, threads: int | None = N
         return json.loads(lines[-1])
     except (IndexError, ValueError):
         row["seconds"] = round(time.monotonic() - t0, 3)
-        return _fail(task, row, CRASHED, f"{task.input}: the worker process died ({_exit_text(proc.returncode)})")
+        return _fail(
+            task, row, CRASHED, f"{task.input}: the worker process died ({_exit_text(proc.returncode)})"
+        )
 
 
 def _task_main() -> None:  # pragma: no cover - child process of run_file_isolated
@@ -710,8 +810,15 @@ def _task_main() -> None:  # pragma: no cover - child process of run_file_isolat
     sys.stdout.flush()
 
 
-def _run_dask(tasks: list[FileTask], todo: list[int], rows: list[dict], address: str,
-              time_limit: float | None, on_start: Callable, on_done: Callable) -> bool:
+def _run_dask(
+    tasks: list[FileTask],
+    todo: list[int],
+    rows: list[dict],
+    address: str,
+    time_limit: float | None,
+    on_start: Callable,
+    on_done: Callable,
+) -> bool:
     """Submit the tasks to the Dask scheduler at ``address``; return True if interrupted."""
     try:
         from distributed import Client, as_completed
@@ -726,8 +833,9 @@ def _run_dask(tasks: list[FileTask], todo: list[int], rows: list[dict], address:
         with client:
             token = uuid.uuid4().hex[:8]
             for i in todo:
-                fut = client.submit(run_file_limited, tasks[i], time_limit, key=f"meshvis-batch-{token}-{i}",
-                                    pure=False)
+                fut = client.submit(
+                    run_file_limited, tasks[i], time_limit, key=f"meshvis-batch-{token}-{i}", pure=False
+                )
                 futures[fut] = i
                 on_start(i)
             try:
@@ -737,8 +845,12 @@ def _run_dask(tasks: list[FileTask], todo: list[int], rows: list[dict], address:
                         row = fut.result()
                     except Exception as exc:  # the worker died (KilledWorker) or the task was lost
                         task = tasks[i]
-                        row = _fail(task, empty_row(task), CRASHED,
-                                    f"{task.input}: the task failed on the cluster: {type(exc).__name__}: {one_line(exc)}")
+                        row = _fail(
+                            task,
+                            empty_row(task),
+                            CRASHED,
+                            f"{task.input}: the task failed on the cluster: {type(exc).__name__}: {one_line(exc)}",
+                        )
                     rows[i] = row
                     on_done(i, row)
             except KeyboardInterrupt:
@@ -760,6 +872,7 @@ def largest_first(tasks: Sequence[FileTask], todo: list[int]) -> list[int]:
     Starting the longest files first keeps one big model from finishing alone at the
     end (longest-processing-time-first scheduling); file size stands in for time.
     """
+
     def size(i: int) -> int:
         try:
             return os.path.getsize(tasks[i].input)
@@ -830,8 +943,9 @@ def run_batch(
         if scheduler:
             interrupted = _run_dask(tasks, todo, rows, scheduler, time_limit, on_start, on_done)
         else:
-            interrupted = _run_local(tasks, todo, rows, jobs or default_jobs(len(todo)), time_limit,
-                                     on_start, on_done)
+            interrupted = _run_local(
+                tasks, todo, rows, jobs or default_jobs(len(todo)), time_limit, on_start, on_done
+            )
     return BatchResult(rows, time.perf_counter() - t0, interrupted)
 
 
@@ -853,8 +967,13 @@ def write_summary(result: BatchResult, out_dir: str, meta: dict | None = None) -
         writer.writerow({k: "" if r.get(k) is None else r.get(k) for k in COLUMNS})
     with atomic_write(csv_path, "w") as fh:
         fh.write(buf.getvalue())
-    data = {"meshvis": __version__, **(meta or {}), "seconds_total": round(result.seconds, 3),
-            "interrupted": result.interrupted, "counts": result.counts,
-            "files": [{k: r.get(k) for k in COLUMNS} for r in result.rows]}
+    data = {
+        "meshvis": __version__,
+        **(meta or {}),
+        "seconds_total": round(result.seconds, 3),
+        "interrupted": result.interrupted,
+        "counts": result.counts,
+        "files": [{k: r.get(k) for k in COLUMNS} for r in result.rows],
+    }
     _write_json(json_path, data)
     return csv_path, json_path

@@ -26,14 +26,16 @@ whole process on input that is not piecewise-constant winding — a crash or a t
 the worker process) is returned as ``ok=False`` with the message, never raised.
 None of these libraries takes a seed: libigl and MeshLab draw their own random rays.
 """
+
 from __future__ import annotations
 
 import contextlib
 import io
 import os
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
@@ -110,8 +112,9 @@ def _failed(method: str, task: str, t0: float, exc: BaseException, params: dict)
 
 
 # ============================================================================ orientation
-def libigl_reorient(model: Any, *, rays_total: int | None = None, rays_minimum: int = 10,
-                    facet_wise: bool = False) -> BaselineResult:
+def libigl_reorient(
+    model: Any, *, rays_total: int | None = None, rays_minimum: int = 10, facet_wise: bool = False
+) -> BaselineResult:
     """libigl's ray-cast reorientation (Takayama et al. 2014) on the welded model.
 
     Faces are grouped into manifold patches that are oriented consistently; each patch is
@@ -136,8 +139,12 @@ def libigl_reorient(model: Any, *, rays_total: int | None = None, rays_minimum: 
 
         V, F = welded(model)
         flip, _patch = igl.embree.reorient_facets_raycast(
-            V, F, rays_total=-1 if rays_total is None else int(rays_total), rays_minimum=int(rays_minimum),
-            facet_wise=bool(facet_wise))
+            V,
+            F,
+            rays_total=-1 if rays_total is None else int(rays_total),
+            rays_minimum=int(rays_minimum),
+            facet_wise=bool(facet_wise),
+        )
         values = np.asarray(flip, bool).reshape(len(F))
     except Exception as exc:  # a library failure is a result, not a crash
         return _failed("libigl_reorient", "orient", t0, exc, params)
@@ -283,18 +290,35 @@ def libigl_peel(model: Any, *, timeout: float = 300.0) -> BaselineResult:
         np.savez(src, V=V, F=F)
         code = f"from meshvis.eval.baselines import _peel_main; _peel_main({src!r}, {dst!r})"
         try:
-            run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout)
+            run = subprocess.run(
+                [sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout
+            )
         except subprocess.TimeoutExpired:
-            return BaselineResult("libigl_peel", "layers", None, time.perf_counter() - t0, False,
-                                  f"no answer within {timeout:g} s", params)
+            return BaselineResult(
+                "libigl_peel",
+                "layers",
+                None,
+                time.perf_counter() - t0,
+                False,
+                f"no answer within {timeout:g} s",
+                params,
+            )
         if run.returncode != 0 or not os.path.exists(dst):
             tail = (run.stderr.strip().splitlines() or [""])[-1][:200]
-            return BaselineResult("libigl_peel", "layers", None, time.perf_counter() - t0, False,
-                                  f"worker died (exit code {run.returncode}) {tail}".strip(), params)
+            return BaselineResult(
+                "libigl_peel",
+                "layers",
+                None,
+                time.perf_counter() - t0,
+                False,
+                f"worker died (exit code {run.returncode}) {tail}".strip(),
+                params,
+            )
         with np.load(dst) as z:
             if "error" in z.files:
-                return BaselineResult("libigl_peel", "layers", None, time.perf_counter() - t0, False,
-                                      str(z["error"]), params)
+                return BaselineResult(
+                    "libigl_peel", "layers", None, time.perf_counter() - t0, False, str(z["error"]), params
+                )
             layer = z["index"] + 1
             n, seconds = int(z["n"]), float(z["seconds"])
     return BaselineResult("libigl_peel", "layers", layer, t_weld + seconds, params=dict(params, layers=n))
@@ -324,13 +348,28 @@ class Baseline:
 
 #: name -> Baseline; the sweeps are those of ``meshvis bench accuracy``
 BASELINES: dict[str, Baseline] = {
-    "libigl_reorient": Baseline(libigl_reorient, "orient", "libigl reorient_facets_raycast", "rays_total",
-                                100, (1, 3, 10, 30, 100), per_face=True),
+    "libigl_reorient": Baseline(
+        libigl_reorient,
+        "orient",
+        "libigl reorient_facets_raycast",
+        "rays_total",
+        100,
+        (1, 3, 10, 30, 100),
+        per_face=True,
+    ),
     "trimesh_fix_normals": Baseline(trimesh_fix_normals, "orient", "trimesh fix_normals"),
-    "pymeshlab_reorient": Baseline(pymeshlab_reorient, "orient", "MeshLab re-orient by geometry", "rays",
-                                   64, (4, 16, 64, 256)),
+    "pymeshlab_reorient": Baseline(
+        pymeshlab_reorient, "orient", "MeshLab re-orient by geometry", "rays", 64, (4, 16, 64, 256)
+    ),
     "pymeshlab_ao": Baseline(pymeshlab_ao, "remove", "MeshLab AO, fq == 0", "rays", 64, (4, 16, 64, 256)),
-    "pymeshlab_ao_2sided": Baseline(pymeshlab_ao, "remove", "MeshLab AO both sides, fq == 0", "rays", 64,
-                                    (4, 16, 64, 256), fixed={"both_sides": True}),
+    "pymeshlab_ao_2sided": Baseline(
+        pymeshlab_ao,
+        "remove",
+        "MeshLab AO both sides, fq == 0",
+        "rays",
+        64,
+        (4, 16, 64, 256),
+        fixed={"both_sides": True},
+    ),
     "libigl_peel": Baseline(libigl_peel, "layers", "libigl peel_outer_hull_layers"),
 }

@@ -23,17 +23,19 @@ records for every output face which input face it came from and whether it was f
 All geometry is float64 and deterministic for a given ``seed`` (randomness only from
 ``numpy.random.default_rng(seed)``).
 """
+
 from __future__ import annotations
 
 import os
+from collections.abc import Sequence
 from dataclasses import dataclass, field, replace
 from pathlib import Path
-from typing import Any, Sequence
+from typing import Any
 
 import numpy as np
 
-from meshvis.geometry.adjacency import WELD_TOL, components, edges, face_adjacency, weld
 from meshvis.errors import ModelError, ParameterError
+from meshvis.geometry.adjacency import WELD_TOL, components, edges, face_adjacency, weld
 from meshvis.soup import Soup
 
 __all__ = [
@@ -104,13 +106,24 @@ class GroundTruth:
         self.outside = np.array(np.broadcast_to(np.asarray(self.outside, bool), (m, 2)))
         self.layer = np.array(np.broadcast_to(np.asarray(self.layer, np.int64), (m,)))
         self.outward = np.array(np.broadcast_to(np.asarray(self.outward, bool), (m,)))
-        self.two_sided = np.zeros(m, bool) if self.two_sided is None else np.array(
-            np.broadcast_to(np.asarray(self.two_sided, bool), (m,)))
-        self.ambiguous = np.zeros(m, bool) if self.ambiguous is None else np.array(
-            np.broadcast_to(np.asarray(self.ambiguous, bool), (m,)))
-        self.origin_face = np.arange(m, dtype=np.int64) if self.origin_face is None else np.asarray(
-            self.origin_face, np.int64).reshape(m)
-        self.flipped = np.zeros(m, bool) if self.flipped is None else np.asarray(self.flipped, bool).reshape(m)
+        self.two_sided = (
+            np.zeros(m, bool)
+            if self.two_sided is None
+            else np.array(np.broadcast_to(np.asarray(self.two_sided, bool), (m,)))
+        )
+        self.ambiguous = (
+            np.zeros(m, bool)
+            if self.ambiguous is None
+            else np.array(np.broadcast_to(np.asarray(self.ambiguous, bool), (m,)))
+        )
+        self.origin_face = (
+            np.arange(m, dtype=np.int64)
+            if self.origin_face is None
+            else np.asarray(self.origin_face, np.int64).reshape(m)
+        )
+        self.flipped = (
+            np.zeros(m, bool) if self.flipped is None else np.asarray(self.flipped, bool).reshape(m)
+        )
         self.hints = {k: np.asarray(v, np.float64).reshape(-1, 3) for k, v in self.hints.items()}
 
     # ------------------------------------------------------------------ views
@@ -145,7 +158,9 @@ class GroundTruth:
         if np.any((self.layer == 1) != self.visible):
             problems.append("layer 1 is not the set of faces with an outside side")
         one = self.visible & ~self.two_sided
-        if np.any(self.outside[one, 0] != self.outward[one]) or np.any(self.outside[one, 1] == self.outward[one]):
+        if np.any(self.outside[one, 0] != self.outward[one]) or np.any(
+            self.outside[one, 1] == self.outward[one]
+        ):
             problems.append("a visible one-sided face's outside side is not its outward side")
         two = self.visible & self.two_sided
         if np.any(~self.outside[two].all(axis=1)):
@@ -153,7 +168,7 @@ class GroundTruth:
         return problems
 
     # ------------------------------------------------------------------ derived truths
-    def subset(self, index: np.ndarray) -> "GroundTruth":
+    def subset(self, index: np.ndarray) -> GroundTruth:
         """The truth of the faces ``index`` (mask or integer array; repeats allowed)."""
         index = np.asarray(index)
         if index.dtype == bool:
@@ -171,7 +186,7 @@ class GroundTruth:
             hints=dict(self.hints),
         )
 
-    def flip_faces(self, flip: np.ndarray) -> "GroundTruth":
+    def flip_faces(self, flip: np.ndarray) -> GroundTruth:
         """The truth with the faces where ``flip`` is True turned over.
 
         Turning a face over swaps its sides, so the two ``outside`` columns swap and
@@ -197,7 +212,7 @@ class GroundTruth:
         return self.soup.flipped(~self.outward)
 
     @classmethod
-    def concatenate(cls, truths: Sequence["GroundTruth"], name: str = "", notes: str = "") -> "GroundTruth":
+    def concatenate(cls, truths: Sequence[GroundTruth], name: str = "", notes: str = "") -> GroundTruth:
         """One truth from several (parts are kept apart, hints are merged)."""
         truths = list(truths)
         offsets = np.cumsum([0] + [t.n_faces for t in truths[:-1]])
@@ -227,32 +242,50 @@ class GroundTruth:
         written from the same soup (faces in the same order).
         """
         arrays = dict(
-            outside=self.outside, layer=self.layer, outward=self.outward, two_sided=self.two_sided,
-            ambiguous=self.ambiguous, origin_face=self.origin_face, flipped=self.flipped,
-            part_id=self.soup.part_id, part_names=np.array(self.soup.part_names),
-            name=np.array(self.name), notes=np.array(self.notes),
+            outside=self.outside,
+            layer=self.layer,
+            outward=self.outward,
+            two_sided=self.two_sided,
+            ambiguous=self.ambiguous,
+            origin_face=self.origin_face,
+            flipped=self.flipped,
+            part_id=self.soup.part_id,
+            part_names=np.array(self.soup.part_names),
+            name=np.array(self.name),
+            notes=np.array(self.notes),
         )
         for k, v in self.hints.items():
             arrays[f"hint_{k}"] = v
         _write_npz(os.fspath(path), arrays)
 
     @classmethod
-    def load_arrays(cls, path: str | os.PathLike, soup: Soup) -> "GroundTruth":
+    def load_arrays(cls, path: str | os.PathLike, soup: Soup) -> GroundTruth:
         """Pair truth arrays written by :meth:`save_arrays` with a soup loaded from the model file."""
         with np.load(os.fspath(path), allow_pickle=False) as z:
             if len(z["layer"]) != soup.n_faces:
                 raise ModelError(
-                    f"truth has {len(z['layer'])} faces but the model has {soup.n_faces}", os.fspath(path))
+                    f"truth has {len(z['layer'])} faces but the model has {soup.n_faces}", os.fspath(path)
+                )
             hints = {k[5:]: z[k] for k in z.files if k.startswith("hint_")}
             return cls(
-                soup=soup, outside=z["outside"], layer=z["layer"], outward=z["outward"],
-                two_sided=z["two_sided"], ambiguous=z["ambiguous"], hints=hints,
-                name=str(z["name"]), notes=str(z["notes"]), origin_face=z["origin_face"], flipped=z["flipped"],
+                soup=soup,
+                outside=z["outside"],
+                layer=z["layer"],
+                outward=z["outward"],
+                two_sided=z["two_sided"],
+                ambiguous=z["ambiguous"],
+                hints=hints,
+                name=str(z["name"]),
+                notes=str(z["notes"]),
+                origin_face=z["origin_face"],
+                flipped=z["flipped"],
             )
 
     def __repr__(self) -> str:
-        return (f"<GroundTruth {self.name!r}: {self.n_faces} faces, {int(self.visible.sum())} visible, "
-                f"{self.n_layers} layers, {self.soup.n_parts} parts>")
+        return (
+            f"<GroundTruth {self.name!r}: {self.n_faces} faces, {int(self.visible.sum())} visible, "
+            f"{self.n_layers} layers, {self.soup.n_parts} parts>"
+        )
 
 
 def _write_npz(path: str, arrays: dict[str, np.ndarray]) -> None:
@@ -354,8 +387,9 @@ def _reverse(tris: np.ndarray) -> np.ndarray:
     return tris[:, [0, 2, 1]]
 
 
-def _axis_patch(a: int, value: float, sign: int, ub: np.ndarray, vc: np.ndarray,
-                keep: np.ndarray | None = None) -> np.ndarray:
+def _axis_patch(
+    a: int, value: float, sign: int, ub: np.ndarray, vc: np.ndarray, keep: np.ndarray | None = None
+) -> np.ndarray:
     """Triangles of an axis-aligned rectangle ``x_a = value`` over the coordinate arrays
     ``ub`` (along axis a+1) and ``vc`` (along axis a+2), normal ``sign * e_a``."""
     b, c = (a + 1) % 3, (a + 2) % 3
@@ -405,8 +439,9 @@ def _random_rotation(rng: np.random.Generator) -> np.ndarray:
     return q
 
 
-def _icosphere(subdivisions: int, radius: float = 1.0, center=(0.0, 0.0, 0.0),
-               rotation: np.ndarray | None = None) -> tuple[np.ndarray, np.ndarray]:
+def _icosphere(
+    subdivisions: int, radius: float = 1.0, center=(0.0, 0.0, 0.0), rotation: np.ndarray | None = None
+) -> tuple[np.ndarray, np.ndarray]:
     import trimesh
 
     m = trimesh.creation.icosphere(subdivisions=int(subdivisions), radius=1.0)
@@ -425,8 +460,9 @@ def _revolve(r: np.ndarray, z: np.ndarray, sections: int) -> np.ndarray:
     phi = np.linspace(0, 2 * np.pi, sections + 1)
     cos, sin = np.cos(phi), np.sin(phi)
     cos[-1], sin[-1] = 1.0, 0.0
-    P = np.stack([r[:, None] * cos[None], r[:, None] * sin[None],
-                  np.broadcast_to(z[:, None], (len(r), len(phi)))], -1)
+    P = np.stack(
+        [r[:, None] * cos[None], r[:, None] * sin[None], np.broadcast_to(z[:, None], (len(r), len(phi)))], -1
+    )
     P[r == 0, :, :2] = 0.0
     tris = _grid_tris(P)
     area = np.linalg.norm(np.cross(tris[:, 1] - tris[:, 0], tris[:, 2] - tris[:, 0]), axis=1)
@@ -520,8 +556,9 @@ def _outward_bodies(soup: Soup) -> tuple[np.ndarray, np.ndarray]:
     return labels, (vol >= 0)[labels]
 
 
-def _containment(pieces: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
-                 fast: bool = False) -> tuple[list[np.ndarray], list[np.ndarray]]:
+def _containment(
+    pieces: Sequence[tuple[np.ndarray, np.ndarray]], eps: float, fast: bool = False
+) -> tuple[list[np.ndarray], list[np.ndarray]]:
     """How deep inside the closed pieces each face lies, and which faces are ambiguous.
 
     For every face of piece ``p`` the generalised winding number of all pieces (its own
@@ -539,7 +576,9 @@ def _containment(pieces: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
     # winding numbers add up over closed pieces: evaluate the whole model once
     offsets = np.cumsum([0] + [len(V) for V, _ in pieces[:-1]])
     Vall = np.ascontiguousarray(np.concatenate([V for V, _ in pieces]), np.float64)
-    Fall = np.ascontiguousarray(np.concatenate([np.asarray(F, np.int64) + o for (_, F), o in zip(pieces, offsets)]))
+    Fall = np.ascontiguousarray(
+        np.concatenate([np.asarray(F, np.int64) + o for (_, F), o in zip(pieces, offsets)])
+    )
     t = Vall[Fall]
     c = t.mean(axis=1)
     n = np.cross(t[:, 1] - t[:, 0], t[:, 2] - t[:, 0])
@@ -547,7 +586,7 @@ def _containment(pieces: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
     corners = (c[:, None] + 0.98 * (t - c[:, None]) + eps * n[:, None]).reshape(-1, 3)
     w = np.asarray(wn(Vall, Fall, np.concatenate([c + eps * n, c - eps * n, corners])))
     m = len(Fall)
-    front, back, corner = w[:m], w[m:2 * m], w[2 * m:].reshape(m, 3)
+    front, back, corner = w[:m], w[m : 2 * m], w[2 * m :].reshape(m, 3)
     d = np.maximum(np.rint(front), 0).astype(np.int64)
     amb = (np.rint(back) - np.rint(front) != 1) | np.any(np.rint(corner) != np.rint(front)[:, None], axis=1)
     amb |= np.abs(front - np.rint(front)) > 0.25
@@ -556,8 +595,13 @@ def _containment(pieces: Sequence[tuple[np.ndarray, np.ndarray]], eps: float,
     return depth, ambiguous
 
 
-def _closed_pieces_truth(pieces: Sequence[tuple[np.ndarray, np.ndarray]], parts: Sequence[str],
-                         name: str, notes: str, fast: bool = False) -> GroundTruth:
+def _closed_pieces_truth(
+    pieces: Sequence[tuple[np.ndarray, np.ndarray]],
+    parts: Sequence[str],
+    name: str,
+    notes: str,
+    fast: bool = False,
+) -> GroundTruth:
     """Truth of a set of closed, outward pieces that may overlap or nest.
 
     A face inside ``d`` other pieces is hidden when ``d > 0``; its layer is ``d + 1``
@@ -571,14 +615,24 @@ def _closed_pieces_truth(pieces: Sequence[tuple[np.ndarray, np.ndarray]], parts:
     out = []
     for (V, F), part, d, a in zip(pieces, parts, depth, amb):
         vis = d == 0
-        out.append(_Piece(V, F, part, outside=np.stack([vis, np.zeros_like(vis)], 1), layer=d + 1,
-                          outward=True, ambiguous=a))
+        out.append(
+            _Piece(
+                V,
+                F,
+                part,
+                outside=np.stack([vis, np.zeros_like(vis)], 1),
+                layer=d + 1,
+                outward=True,
+                ambiguous=a,
+            )
+        )
     return _compose(out, name, notes)
 
 
 # ====================================================================== 1. nested shells
-def nested_shells(n: int = 3, kind: str = "sphere", subdivisions: int = 3, cell: float = 0.1,
-                  seed: int = 0) -> GroundTruth:
+def nested_shells(
+    n: int = 3, kind: str = "sphere", subdivisions: int = 3, cell: float = 0.1, seed: int = 0
+) -> GroundTruth:
     """Concentric closed shells that do not touch: the textbook layer test.
 
     Parameters
@@ -623,15 +677,25 @@ def nested_shells(n: int = 3, kind: str = "sphere", subdivisions: int = 3, cell:
         else:
             V, F = _icosphere(subdivisions, r, rotation=rot)
         pieces.append(_Piece(V, F, f"shell_{i + 1}", outside=(i == 0, False), layer=i + 1))
-    return _compose(pieces, "nested_shells",
-                    f"{n} concentric closed {kind} shells; layer i = shell i, all faces outward; "
-                    "tests layers and inside removal (everything but shell 1 is hidden)")
+    return _compose(
+        pieces,
+        "nested_shells",
+        f"{n} concentric closed {kind} shells; layer i = shell i, all faces outward; "
+        "tests layers and inside removal (everything but shell 1 is hidden)",
+    )
 
 
 # ====================================================================== 2. house
-def house(rooms: tuple[int, int] = (3, 2), floors: int = 2, room_size: tuple[float, float, float] = (4.0, 3.5, 2.8),
-          cell: float = 0.5, furniture: int = 2, roof: bool = True, partition: bool = True,
-          seed: int = 0) -> GroundTruth:
+def house(
+    rooms: tuple[int, int] = (3, 2),
+    floors: int = 2,
+    room_size: tuple[float, float, float] = (4.0, 3.5, 2.8),
+    cell: float = 0.5,
+    furniture: int = 2,
+    roof: bool = True,
+    partition: bool = True,
+    seed: int = 0,
+) -> GroundTruth:
     """A closed house of stacked room boxes with furniture: hidden interiors and coplanar walls.
 
     Every room is a closed box facing out of the room, with its own tessellation (cell size
@@ -674,11 +738,14 @@ def house(rooms: tuple[int, int] = (3, 2), floors: int = 2, room_size: tuple[flo
     nx, ny = int(rooms[0]), int(rooms[1])
     floors = int(floors)
     if nx < 1 or ny < 1 or floors < 1:
-        raise ParameterError(f"house needs at least one room and one floor, got rooms={rooms}, floors={floors}")
+        raise ParameterError(
+            f"house needs at least one room and one floor, got rooms={rooms}, floors={floors}"
+        )
     if nx > 2 and ny > 2 and floors > 1:
         raise ParameterError(
             f"rooms={rooms} with {floors} floors has rooms that do not touch the exterior "
-            "(their layer would depend on coplanar duplicates); use at most 2 rooms along x or y")
+            "(their layer would depend on coplanar duplicates); use at most 2 rooms along x or y"
+        )
     if not 0 <= furniture <= 4:
         raise ParameterError(f"furniture must be 0..4 per room, got {furniture}")
     rng = np.random.default_rng(seed)
@@ -715,7 +782,9 @@ def house(rooms: tuple[int, int] = (3, 2), floors: int = 2, room_size: tuple[flo
                     fV, fF = _weld(f_tris)
                     # the bottom stands on the floor: coplanar contact, a matter of convention
                     f_amb = f_side == 4  # _weld keeps the triangle order
-                    furn_pieces.append(_Piece(fV, fF, fname, outside=(False, False), layer=2, ambiguous=f_amb))
+                    furn_pieces.append(
+                        _Piece(fV, fF, fname, outside=(False, False), layer=2, ambiguous=f_amb)
+                    )
                     if first:
                         c, e = (f_lo + f_hi) / 2, (f_hi - f_lo) / 2
                         sV, sF = _box(c - 0.45 * e, c + 0.45 * e, 0.25 * cell)
@@ -728,27 +797,51 @@ def house(rooms: tuple[int, int] = (3, 2), floors: int = 2, room_size: tuple[flo
                         amb |= under & (side == 4)
                 V, F = _weld(tris)
                 vis = ~inner
-                pieces.append(_Piece(V, F, f"room_{i}{j}{k}", outside=np.stack([vis, np.zeros_like(vis)], 1),
-                                     layer=np.where(inner, 2, 1), outward=vis, ambiguous=amb))
+                pieces.append(
+                    _Piece(
+                        V,
+                        F,
+                        f"room_{i}{j}{k}",
+                        outside=np.stack([vis, np.zeros_like(vis)], 1),
+                        layer=np.where(inner, 2, 1),
+                        outward=vis,
+                        ambiguous=amb,
+                    )
+                )
                 if partition and (i, j, k) == (nx - 1, ny - 1, floors - 1):
                     cy = 0.5 * (lo[1] + hi[1])
                     ub = np.linspace(lo[2], lo[2] + 0.6 * H, max(2, int(round(0.6 * H / cell)) + 1))
-                    vc = np.linspace(lo[0] + 0.2 * (hi[0] - lo[0]), hi[0] - 0.2 * (hi[0] - lo[0]),
-                                     max(2, int(round(0.6 * (hi[0] - lo[0]) / cell)) + 1))
+                    vc = np.linspace(
+                        lo[0] + 0.2 * (hi[0] - lo[0]),
+                        hi[0] - 0.2 * (hi[0] - lo[0]),
+                        max(2, int(round(0.6 * (hi[0] - lo[0]) / cell)) + 1),
+                    )
                     pV, pF = _weld(_axis_patch(1, cy, 1, ub, vc))
-                    furn_pieces.append(_Piece(pV, pF, "partition", outside=(False, False), layer=2,
-                                              two_sided=True))
+                    furn_pieces.append(
+                        _Piece(pV, pF, "partition", outside=(False, False), layer=2, two_sided=True)
+                    )
     if roof:
         Z0, Y, X = zs[-1], ys[-1], xs[-1]
         section = np.array([[0.0, Z0], [Y, Z0], [Y / 2, Z0 + 0.45 * Y]])
         rV, rF = _prism_x(xs[0], X, section, cell)
         bottom = np.all(rV[rF][..., 2] == Z0, axis=1)
-        pieces.append(_Piece(rV, rF, "roof", outside=np.stack([~bottom, np.zeros_like(bottom)], 1),
-                             layer=np.where(bottom, 2, 1), outward=~bottom))
-    return _compose(pieces + furn_pieces, "house",
-                    "closed house of room boxes with coplanar duplicate walls, roof, furniture, a cabinet "
-                    "with a safe inside (layer 3) and a two-sided partition; tests inside removal "
-                    "(only the hull is outside), coplanar handling and layers")
+        pieces.append(
+            _Piece(
+                rV,
+                rF,
+                "roof",
+                outside=np.stack([~bottom, np.zeros_like(bottom)], 1),
+                layer=np.where(bottom, 2, 1),
+                outward=~bottom,
+            )
+        )
+    return _compose(
+        pieces + furn_pieces,
+        "house",
+        "closed house of room boxes with coplanar duplicate walls, roof, furniture, a cabinet "
+        "with a safe inside (layer 3) and a two-sided partition; tests inside removal "
+        "(only the hull is outside), coplanar handling and layers",
+    )
 
 
 def _prism_x(x0: float, x1: float, section: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray]:
@@ -761,11 +854,13 @@ def _prism_x(x0: float, x1: float, section: np.ndarray, cell: float) -> tuple[np
     k = max(1, int(round(max(np.linalg.norm(B - A), np.linalg.norm(C - B), np.linalg.norm(A - C)) / cell)))
     i, j = np.meshgrid(np.arange(k + 1), np.arange(k + 1), indexing="ij")
     L = A + (i[..., None] / k) * (B - A) + (j[..., None] / k) * (C - A)  # (k+1, k+1, 2), valid where i+j<=k
-    loop = np.concatenate([
-        L[np.arange(k + 1), 0],                           # A -> B
-        L[k - np.arange(1, k + 1), np.arange(1, k + 1)],  # B -> C
-        L[0, k - np.arange(1, k + 1)],                    # C -> A (ends at A)
-    ])
+    loop = np.concatenate(
+        [
+            L[np.arange(k + 1), 0],  # A -> B
+            L[k - np.arange(1, k + 1), np.arange(1, k + 1)],  # B -> C
+            L[0, k - np.arange(1, k + 1)],  # C -> A (ends at A)
+        ]
+    )
     xs = np.linspace(x0, x1, max(1, int(round((x1 - x0) / cell))) + 1)
     P = np.empty((len(xs), len(loop), 3))
     P[..., 0] = xs[:, None]
@@ -791,8 +886,14 @@ def _prism_x(x0: float, x1: float, section: np.ndarray, cell: float) -> tuple[np
 _SIDES = ["-x", "+x", "-y", "+y", "-z", "+z"]
 
 
-def _box_sheet(lo, hi, cell: float, gap: float = 0.0, splits: dict | None = None,
-               opening: tuple[str, float] | None = None) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def _box_sheet(
+    lo,
+    hi,
+    cell: float,
+    gap: float = 0.0,
+    splits: dict | None = None,
+    opening: tuple[str, float] | None = None,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """A single-sheet box surface facing outward, optionally cracked or opened.
 
     Parameters
@@ -851,9 +952,14 @@ def _box_sheet(lo, hi, cell: float, gap: float = 0.0, splits: dict | None = None
     return V, F, np.concatenate(side)
 
 
-def cracked_box(size: tuple[float, float, float] = (2.0, 1.5, 1.0), cell: float = 0.05,
-                crack_width: float = 1e-3, face_cracks: int = 3, inner: bool = True,
-                seed: int = 0) -> GroundTruth:
+def cracked_box(
+    size: tuple[float, float, float] = (2.0, 1.5, 1.0),
+    cell: float = 0.05,
+    crack_width: float = 1e-3,
+    face_cracks: int = 3,
+    inner: bool = True,
+    seed: int = 0,
+) -> GroundTruth:
     """A single-sheet closed box with hairline cracks, and a small box inside it.
 
     The six sides are separate sheets pulled back from the box edges, leaving slits of
@@ -891,14 +997,23 @@ def cracked_box(size: tuple[float, float, float] = (2.0, 1.5, 1.0), cell: float 
     if inner:
         iV, iF = _box(-0.3 * half, 0.3 * half, cell)
         pieces.append(_Piece(iV, iF, "inner_box", outside=(False, False), layer=2))
-    return _compose(pieces, "cracked_box",
-                    f"single-sheet box with slits of {crack_width:g} x diagonal along all edges and across "
-                    f"{len(chosen)} sides, a closed box inside; cracks must not let the outside in")
+    return _compose(
+        pieces,
+        "cracked_box",
+        f"single-sheet box with slits of {crack_width:g} x diagonal along all edges and across "
+        f"{len(chosen)} sides, a closed box inside; cracks must not let the outside in",
+    )
 
 
-def box_with_opening(size: tuple[float, float, float] = (2.0, 1.5, 1.0), cell: float = 0.05,
-                     opening: float = 0.6, side: str = "-y", crack_width: float = 0.0,
-                     inner: bool = True, seed: int = 0) -> GroundTruth:
+def box_with_opening(
+    size: tuple[float, float, float] = (2.0, 1.5, 1.0),
+    cell: float = 0.05,
+    opening: float = 0.6,
+    side: str = "-y",
+    crack_width: float = 0.0,
+    inner: bool = True,
+    seed: int = 0,
+) -> GroundTruth:
     """A single-sheet box with a large opening in one side: a cave (appendix H, Fig. 7).
 
     Parameters
@@ -936,14 +1051,23 @@ def box_with_opening(size: tuple[float, float, float] = (2.0, 1.5, 1.0), cell: f
     if inner:
         iV, iF = _box(-0.3 * half, 0.3 * half, cell)
         pieces.append(_Piece(iV, iF, "inner_box", outside=(True, False), layer=1))
-    return _compose(pieces, "box_with_opening",
-                    f"single-sheet box with a {opening:g} x {opening:g} opening in side {side}; the inside is "
-                    "reachable, so both sides of the walls and the inner box are outside")
+    return _compose(
+        pieces,
+        "box_with_opening",
+        f"single-sheet box with a {opening:g} x {opening:g} opening in side {side}; the inside is "
+        "reachable, so both sides of the walls and the inner box are outside",
+    )
 
 
 # ====================================================================== 5. cup
-def cup(radius: float = 1.0, height: float = 1.2, flare: float = 0.15, sections: int = 64,
-        bottom_rings: int = 8, wall_rings: int = 16) -> GroundTruth:
+def cup(
+    radius: float = 1.0,
+    height: float = 1.2,
+    flare: float = 0.15,
+    sections: int = 64,
+    bottom_rings: int = 8,
+    wall_rings: int = 16,
+) -> GroundTruth:
     """A cup modelled as a single sheet (open top): every face is two-sided.
 
     A surface of revolution about z: a flat bottom disc of ``bottom_rings`` rings and a
@@ -955,18 +1079,26 @@ def cup(radius: float = 1.0, height: float = 1.2, flare: float = 0.15, sections:
         Both sides of every face are outside, layer 1, ``two_sided``; the front faces the
         larger open region (away from the axis and downward), so ``outward`` is True.
     """
-    r = np.concatenate([np.linspace(0, radius, bottom_rings + 1),
-                        radius * (1 + flare * np.linspace(0, 1, wall_rings + 1)[1:])])
+    r = np.concatenate(
+        [
+            np.linspace(0, radius, bottom_rings + 1),
+            radius * (1 + flare * np.linspace(0, 1, wall_rings + 1)[1:]),
+        ]
+    )
     z = np.concatenate([np.zeros(bottom_rings + 1), height * np.linspace(0, 1, wall_rings + 1)[1:]])
     V, F = _weld(_revolve(r, z, sections))
     F = _orient_from(V, F, (0.0, 0.0, 0.5 * height))
-    return _compose([_Piece(V, F, "cup", outside=(True, True), layer=1, two_sided=True)], "cup",
-                    "single-sheet cup with an open top: both sides of every face are outside")
+    return _compose(
+        [_Piece(V, F, "cup", outside=(True, True), layer=1, two_sided=True)],
+        "cup",
+        "single-sheet cup with an open top: both sides of every face are outside",
+    )
 
 
 # ====================================================================== 6. terrain
-def terrain(n: int = 64, size: float = 1.0, amplitude: float = 0.15, bumps: int = 12,
-            seed: int = 0) -> GroundTruth:
+def terrain(
+    n: int = 64, size: float = 1.0, amplitude: float = 0.15, bumps: int = 12, seed: int = 0
+) -> GroundTruth:
     """A heightfield sheet: open, with no inherent inside; the user names the sides.
 
     Heights are a sum of ``bumps`` random Gaussian hills and pits plus a gentle slope.
@@ -993,7 +1125,7 @@ def terrain(n: int = 64, size: float = 1.0, amplitude: float = 0.15, bumps: int 
     s = rng.uniform(0.05, 0.25, bumps) * size
     a = rng.uniform(-1, 1, bumps) * amplitude
     d2 = (X[..., None] - c[:, 0]) ** 2 + (Y[..., None] - c[:, 1]) ** 2
-    Z = (a * np.exp(-d2 / (2 * s ** 2))).sum(-1) + 0.2 * amplitude * (X + 0.5 * Y) / size
+    Z = (a * np.exp(-d2 / (2 * s**2))).sum(-1) + 0.2 * amplitude * (X + 0.5 * Y) / size
     P = np.stack([X, Y, Z], -1)
     V, F = _weld(_grid_tris(P))  # normal e_x x e_y = +z: front up
     mid = np.array([size / 2, size / 2])
@@ -1001,8 +1133,12 @@ def terrain(n: int = 64, size: float = 1.0, amplitude: float = 0.15, bumps: int 
         "inside_points": [[*mid, Z.min() - 0.25 * size]],
         "outside_points": [[*mid, Z.max() + 0.25 * size]],
     }
-    return _compose([_Piece(V, F, "terrain", outside=(True, False), layer=1)], "terrain",
-                    "open heightfield; with the hints the top side is outside, the bottom inside", hints)
+    return _compose(
+        [_Piece(V, F, "terrain", outside=(True, False), layer=1)],
+        "terrain",
+        "open heightfield; with the hints the top side is outside, the bottom inside",
+        hints,
+    )
 
 
 # ====================================================================== 7. overlapping solids
@@ -1030,14 +1166,18 @@ def overlapping_solids(subdivisions: int = 4, cell: float = 0.1, seed: int = 0) 
     sV, sF = _icosphere(subdivisions, 1.0, rotation=_random_rotation(rng))
     shift = rng.uniform(-0.05, 0.05, 3)
     bV, bF = _box(np.array([0.25, -0.7, -0.6]) + shift, np.array([2.0, 0.7, 0.6]) + shift, cell)
-    return _closed_pieces_truth([(sV, sF), (bV, bF)], ["sphere", "box"], "overlapping_solids",
-                                "a sphere and a box that interpenetrate; faces inside the other solid "
-                                "(winding number 1) are hidden")
+    return _closed_pieces_truth(
+        [(sV, sF), (bV, bF)],
+        ["sphere", "box"],
+        "overlapping_solids",
+        "a sphere and a box that interpenetrate; faces inside the other solid (winding number 1) are hidden",
+    )
 
 
 # ====================================================================== 8. sphere pair
-def sphere_pair(subdivisions: int = 4, crack: int = 6, inner_radius: float = 0.5,
-                seed: int = 0) -> GroundTruth:
+def sphere_pair(
+    subdivisions: int = 4, crack: int = 6, inner_radius: float = 0.5, seed: int = 0
+) -> GroundTruth:
     """An outer sphere with a small hole of ``crack`` missing faces, and an inner sphere.
 
     The hole is the ``crack`` faces nearest to a random vertex (its one-ring for 6 on a
@@ -1056,11 +1196,16 @@ def sphere_pair(subdivisions: int = 4, crack: int = 6, inner_radius: float = 0.5
     keep = np.ones(len(F), bool)
     keep[np.argsort(dist, kind="stable")[: int(crack)]] = False
     iV, iF = _icosphere(max(subdivisions - 1, 1), inner_radius, rotation=_random_rotation(rng))
-    pieces = [_Piece(V, F[keep], "outer_sphere", outside=(True, False), layer=1),
-              _Piece(iV, iF, "inner_sphere", outside=(False, False), layer=2)]
-    return _compose(pieces, "sphere_pair",
-                    f"outer sphere missing {int(crack)} faces around one vertex, inner sphere hidden; "
-                    "tests that a small hole does not let the outside in")
+    pieces = [
+        _Piece(V, F[keep], "outer_sphere", outside=(True, False), layer=1),
+        _Piece(iV, iF, "inner_sphere", outside=(False, False), layer=2),
+    ]
+    return _compose(
+        pieces,
+        "sphere_pair",
+        f"outer sphere missing {int(crack)} faces around one vertex, inner sphere hidden; "
+        "tests that a small hole does not let the outside in",
+    )
 
 
 # ====================================================================== 9. skin and ribcage
@@ -1202,11 +1347,11 @@ def assembly(sections: int = 24, cell: float = 0.2) -> GroundTruth:
     box((-1.8, -0.9, -0.6), (1.8, 0.9, 0.02), "oil_pan")
     xs = np.array([-1.35, -0.45, 0.45, 1.35])
     for n, x in enumerate(xs, 1):
-        cyl((x, 0, 0.9), (x, 0, 1.5), 0.36, f"piston_{n}")             # inside the block
+        cyl((x, 0, 0.9), (x, 0, 1.5), 0.36, f"piston_{n}")  # inside the block
         cyl((x, 0.35, 2.85), (x, 0.35, 3.35), 0.07, f"spark_plug_{n}")  # sunk into the cover
     bolt_x = np.array([-1.6, -0.55, 0.55, 1.6])
     for n, (x, y) in enumerate([(x, y) for y in (-0.55, 0.55) for x in bolt_x], 1):
-        cyl((x, y, 2.9), (x, y, 3.12), 0.06, f"bolt_{n}", sec=6)       # hexagonal heads
+        cyl((x, y, 2.9), (x, y, 3.12), 0.06, f"bolt_{n}", sec=6)  # hexagonal heads
     # front accessories (front = -x)
     box((-2.1, -0.9, 0.2), (-1.98, 0.9, 1.9), "timing_cover", c=0.2)
     cyl((-2.05, 0.0, 0.5), (-2.35, 0.0, 0.5), 0.55, "crankshaft_pulley")
@@ -1239,14 +1384,25 @@ def assembly(sections: int = 24, cell: float = 0.2) -> GroundTruth:
     cyl((1.0, 1.0, 0.5), (1.0, 1.5, 3.1), 0.03, "dipstick", sec=8)
     box((-0.8, 1.08, 0.4), (0.8, 1.4, 0.8), "engine_mount_left", c=0.2)
     box((-0.8, -1.4, 0.4), (0.8, -1.08, 0.8), "engine_mount_right", c=0.2)
-    return _closed_pieces_truth(pieces, parts, "assembly",
-                                "engine-like assembly of named closed parts of very different sizes; pistons "
-                                "hidden in the block, bolts and plugs half sunk; for labeling and inside removal")
+    return _closed_pieces_truth(
+        pieces,
+        parts,
+        "assembly",
+        "engine-like assembly of named closed parts of very different sizes; pistons "
+        "hidden in the block, bolts and plugs half sunk; for labeling and inside removal",
+    )
 
 
 # ====================================================================== 10. soupify, closed meshes
-def soupify(truth: GroundTruth, flip: float = 0.3, unweld: bool = True, shuffle: bool = True,
-            duplicate: float = 0.0, holes: int = 0, seed: int = 0) -> GroundTruth:
+def soupify(
+    truth: GroundTruth,
+    flip: float = 0.3,
+    unweld: bool = True,
+    shuffle: bool = True,
+    duplicate: float = 0.0,
+    holes: int = 0,
+    seed: int = 0,
+) -> GroundTruth:
     """Turn a truth into a messy triangle soup whose truth is still known.
 
     Steps, in this order: punch ``holes`` small holes (a random face and every face sharing
@@ -1301,16 +1457,32 @@ def soupify(truth: GroundTruth, flip: float = 0.3, unweld: bool = True, shuffle:
         order = (np.arange(3)[None, :] + shift[:, None]) % 3  # cyclic: keeps the winding
         rows = np.arange(t.n_faces)[:, None]
         s = t.soup
-        t = replace(t, soup=replace(
-            s, faces=s.faces[rows, order],
-            uv=None if s.uv is None else s.uv[rows, order],
-            colors=None if s.colors is None else s.colors[rows, order]))
+        t = replace(
+            t,
+            soup=replace(
+                s,
+                faces=s.faces[rows, order],
+                uv=None if s.uv is None else s.uv[rows, order],
+                colors=None if s.colors is None else s.colors[rows, order],
+            ),
+        )
     if unweld:
         s = t.soup
-        t = replace(t, soup=replace(s, vertices=s.triangles.reshape(-1, 3).copy(),
-                                    faces=np.arange(3 * s.n_faces, dtype=np.int64).reshape(-1, 3)))
-    bits = [f"flip={flip:g}"] + (["unwelded"] if unweld else []) + (["shuffled"] if shuffle else []) \
-        + ([f"duplicate={duplicate:g}"] if duplicate else []) + ([f"holes={holes}"] if holes else [])
+        t = replace(
+            t,
+            soup=replace(
+                s,
+                vertices=s.triangles.reshape(-1, 3).copy(),
+                faces=np.arange(3 * s.n_faces, dtype=np.int64).reshape(-1, 3),
+            ),
+        )
+    bits = (
+        [f"flip={flip:g}"]
+        + (["unwelded"] if unweld else [])
+        + (["shuffled"] if shuffle else [])
+        + ([f"duplicate={duplicate:g}"] if duplicate else [])
+        + ([f"holes={holes}"] if holes else [])
+    )
     return replace(t, name=f"{truth.name}_soup", notes=f"{truth.notes} | soupified: {', '.join(bits)}")
 
 
@@ -1336,9 +1508,12 @@ def _folded_onto_neighbour(soup: Soup, degrees: float = FOLD_DEGREES, max_fan: i
     welded = _welded(soup, 0.0)
     table = edges(welded)
     start = np.searchsorted(table.half_edge, np.arange(len(table.count)))
-    pairs = [np.stack([start[e] + i, start[e] + j], axis=1)
-             for i in range(max_fan) for j in range(i + 1, max_fan)
-             for e in [np.flatnonzero((table.count > j) & (table.count <= max_fan))]]
+    pairs = [
+        np.stack([start[e] + i, start[e] + j], axis=1)
+        for i in range(max_fan)
+        for j in range(i + 1, max_fan)
+        for e in [np.flatnonzero((table.count > j) & (table.count <= max_fan))]
+    ]
     h = np.concatenate(pairs) if pairs else np.zeros((0, 2), np.int64)
     f, g = table.half_face[h[:, 0]], table.half_face[h[:, 1]]
     n = soup.normals
@@ -1397,7 +1572,7 @@ def from_closed_mesh(model: Any, name: str | None = None) -> GroundTruth:
     bounds = np.searchsorted(labels[order], np.arange(labels.max() + 2))
     bodies = []
     for b in range(labels.max() + 1):
-        used, f = np.unique(fixed.faces[order[bounds[b]:bounds[b + 1]]], return_inverse=True)
+        used, f = np.unique(fixed.faces[order[bounds[b] : bounds[b + 1]]], return_inverse=True)
         bodies.append((fixed.vertices[used], f.reshape(-1, 3)))
     depth, amb = _containment(bodies, 1e-6 * soup.diagonal, fast=True)
     d = np.empty(soup.n_faces, np.int64)
@@ -1412,8 +1587,15 @@ def from_closed_mesh(model: Any, name: str | None = None) -> GroundTruth:
     vis = d == 0
     outside = np.stack([vis & outward, vis & ~outward], 1)
     nm = name or (os.path.splitext(os.path.basename(soup.path))[0] if soup.path else "closed_mesh")
-    return GroundTruth(soup=soup, outside=outside, layer=d + 1, outward=outward, ambiguous=a, name=nm,
-                       notes="closed model: every body outward, nested bodies hidden")
+    return GroundTruth(
+        soup=soup,
+        outside=outside,
+        layer=d + 1,
+        outward=outward,
+        ambiguous=a,
+        name=nm,
+        notes="closed model: every body outward, nested bodies hidden",
+    )
 
 
 #: name -> generator, for benchmarks and the models script

@@ -9,6 +9,7 @@ outweigh a coarse one (DESIGN.md §7).
 Notation: ``A_f`` area of face ``f``, ``E`` the evaluated faces (not ambiguous),
 ``A(S) = Σ_{f ∈ S ∩ E} A_f``.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

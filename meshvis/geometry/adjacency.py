@@ -7,6 +7,7 @@ candidates, triangle clustering) can share it.
 Welding is for *adjacency only*: it decides which faces touch, it never changes the model.
 Tolerances are fractions of the bounding-box diagonal of the used vertices.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

@@ -5,6 +5,7 @@ conservative intersection / coplanarity tests of :mod:`meshvis.geometry.intersec
 preprocessing the graph cut uses, appendix H §2) and returns plain JSON-ready values, with
 the time each stage took.  :func:`format_report` turns them into a short table.
 """
+
 from __future__ import annotations
 
 import os

@@ -58,14 +58,15 @@ the distance condition is the real test, the angle only guards tiny triangles fo
 every corner is trivially within ``eps`` of any plane), weld tolerance 1e-7.  ``eps`` below
 about 1e-9 approaches float64 round-off of the normalised coordinates and is refused.
 """
+
 from __future__ import annotations
 
 import functools
 
 import numpy as np
 
-from meshvis.geometry.adjacency import WELD_TOL, weld
 from meshvis.errors import ParameterError
+from meshvis.geometry.adjacency import WELD_TOL, weld
 
 #: default distance tolerance, as a fraction of the bounding-box diagonal
 EPS = 1e-6
@@ -253,7 +254,7 @@ class _FaceAxes:
         self.low, self.high = _lmin(proj), _lmax(proj)
 
 
-def _cross_beyond_vertex(fi, fj, Ti, Tj, fa: "_FaceAxes", i, j, tau: float) -> np.ndarray:
+def _cross_beyond_vertex(fi, fj, Ti, Tj, fa: _FaceAxes, i, j, tau: float) -> np.ndarray:
     """(k,) bool: two non-coplanar triangles sharing exactly one corner meet beyond it.
 
     Both triangles are convex and contain the shared corner ``v``, so they share another
@@ -454,7 +455,9 @@ def intersection_flags(
     eps = EPS if eps is None else float(eps)
     near = eps if near is None else float(near)
     if not (1e-9 <= eps < 1) or not (1e-9 <= near < 1):
-        raise ParameterError(f"eps and near must lie in [1e-9, 1) (fractions of the diagonal), got {eps}, {near}")
+        raise ParameterError(
+            f"eps and near must lie in [1e-9, 1) (fractions of the diagonal), got {eps}, {near}"
+        )
     if not (0 <= angle_eps < np.pi / 2):
         raise ParameterError(f"angle_eps must lie in [0, pi/2), got {angle_eps}")
     faces = np.asarray(faces, np.int64).reshape(-1, 3)

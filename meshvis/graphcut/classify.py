@@ -16,25 +16,27 @@ adaptive global visibility sampling (AGVS).  A clean closed model stops after
 one small round.  Stages a model does not need (point nodes when nothing is
 flagged, hint rays without hints) are skipped, and the result says so.
 """
+
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
-from typing import Any, Callable
+from typing import Any
 
 import numpy as np
 
 from meshvis import __version__
 from meshvis.errors import ModelError, ParameterError
-from meshvis.graphcut.mincut import SOLVERS, Cut, VisibilityGraph
 from meshvis.graphcut.hints import Hints, hint_weights
+from meshvis.graphcut.mincut import SOLVERS, Cut, VisibilityGraph
 from meshvis.graphcut.nodes import NodeSet, build_nodes
 from meshvis.graphcut.preprocess import Preprocessed, preprocess
-from meshvis.rays.caster import RayCaster
-from meshvis.io import as_soup
-from meshvis.soup import Soup
 from meshvis.graphcut.sampling import VisibilityCounts, sample_round
 from meshvis.graphcut.weights import DEFAULT_OPENING, graph_weights
+from meshvis.io import as_soup
+from meshvis.rays.caster import RayCaster
+from meshvis.soup import Soup
 
 #: rays of the first progressive round, per node (before the cluster-size factor)
 FIRST_ROUND_RAYS = 4
@@ -132,7 +134,9 @@ class Classification:
             "stages": [s.__dict__ for s in self.stages],
             "embree_seconds": self.counts.time_embree,
             "sampling_seconds": self.counts.time_total,
-            "embree_share_of_sampling": self.counts.time_embree / self.counts.time_total if self.counts.time_total else 0.0,
+            "embree_share_of_sampling": self.counts.time_embree / self.counts.time_total
+            if self.counts.time_total
+            else 0.0,
             "params": self.params,
             "outside_area_fraction": float(
                 (self.side_outside.any(axis=1) * self.soup.areas).sum() / max(self.soup.total_area, 1e-300)
@@ -273,16 +277,32 @@ def classify(
     if pre.degenerate.all():  # no side has an area: there is no graph to cut
         what = "the only face is" if soup.n_faces == 1 else f"all {soup.n_faces} faces are"
         raise ModelError(f"{what} degenerate (zero area): nothing to classify", soup.path)
-    stages.append(Stage("preprocess", True, time.perf_counter() - t,
-                        f"{pre.clustering.n_clusters} clusters, {int(pre.flagged.sum())} flagged faces"))
+    stages.append(
+        Stage(
+            "preprocess",
+            True,
+            time.perf_counter() - t,
+            f"{pre.clustering.n_clusters} clusters, {int(pre.flagged.sum())} flagged faces",
+        )
+    )
 
     t = time.perf_counter()
     off_abs = caster.offset * caster.diagonal
     nodes = build_nodes(
-        soup.triangles, soup.normals, soup.areas, pre.clustering, pre.flagged, pre.partner_pairs,
-        samples=samples_per_face, scheme=sampling_scheme, offset=off_abs, proximity=2 * off_abs,
+        soup.triangles,
+        soup.normals,
+        soup.areas,
+        pre.clustering,
+        pre.flagged,
+        pre.partner_pairs,
+        samples=samples_per_face,
+        scheme=sampling_scheme,
+        offset=off_abs,
+        proximity=2 * off_abs,
     )
-    point_note = f"{nodes.n_points} sample points" if nodes.n_points else "skipped point nodes: no flagged faces"
+    point_note = (
+        f"{nodes.n_points} sample points" if nodes.n_points else "skipped point nodes: no flagged faces"
+    )
     stages.append(Stage("nodes", True, time.perf_counter() - t, f"{nodes.n} nodes; {point_note}"))
 
     hint_out = hint_in = None
@@ -312,18 +332,38 @@ def classify(
 
         t = time.perf_counter()
         counted = counts.cast - counts.discarded
-        weights = graph_weights(counts.hits, counted, counts.escaped, nodes.area, nodes.opposite, is_point,
-                                hint_out=hint_out, hint_in=hint_in, use_filter=use_filter, opening=opening)
+        weights = graph_weights(
+            counts.hits,
+            counted,
+            counts.escaped,
+            nodes.area,
+            nodes.opposite,
+            is_point,
+            hint_out=hint_out,
+            hint_in=hint_in,
+            use_filter=use_filter,
+            opening=opening,
+        )
         graph = VisibilityGraph(nodes.n, weights)
         cut = graph.cut(solver)
         labels = face_labels(nodes, cut.outside, soup.n_faces, pre.degenerate)
         t_cut += time.perf_counter() - t
 
-        changed = None if prev is None else float(
-            (np.abs(labels - prev).sum(axis=1) * soup.areas).sum() / max(2 * soup.total_area, 1e-300)
+        changed = (
+            None
+            if prev is None
+            else float(
+                (np.abs(labels - prev).sum(axis=1) * soup.areas).sum() / max(2 * soup.total_area, 1e-300)
+            )
         )
-        rounds.append({"rays": int(counts.rays), "nodes_sampled": int((give > 0).sum()),
-                       "edges": graph.n_edges, "changed_area_fraction": changed})
+        rounds.append(
+            {
+                "rays": int(counts.rays),
+                "nodes_sampled": int((give > 0).sum()),
+                "edges": graph.n_edges,
+                "changed_area_fraction": changed,
+            }
+        )
         if not progressive:
             break
         if changed is not None and changed <= tolerance:
@@ -354,16 +394,46 @@ def classify(
             stop_reason = f"ray budget reached after {len(rounds)} rounds"
             break
 
-    stages.append(Stage("sampling", True, t_sample, f"{counts.rays} rays + {counts.reverse_rays} reverse; {stop_reason}"))
-    stages.append(Stage("cut", True, t_cut, f"{graph.n_edges} edges, solver {cut.solver}, filter {'on' if use_filter else 'off'}"))
+    stages.append(
+        Stage(
+            "sampling", True, t_sample, f"{counts.rays} rays + {counts.reverse_rays} reverse; {stop_reason}"
+        )
+    )
+    stages.append(
+        Stage(
+            "cut",
+            True,
+            t_cut,
+            f"{graph.n_edges} edges, solver {cut.solver}, filter {'on' if use_filter else 'off'}",
+        )
+    )
     report("done", 1.0)
     params = {
-        "rays_per_node": rays_per_node, "seed": seed, "samples_per_face": samples_per_face,
-        "sampling_scheme": sampling_scheme, "use_filter": use_filter, "opening": opening, "progressive": progressive,
-        "tolerance": tolerance, "solver": solver, "offset": caster.offset, "hint_rays": hint_rays,
+        "rays_per_node": rays_per_node,
+        "seed": seed,
+        "samples_per_face": samples_per_face,
+        "sampling_scheme": sampling_scheme,
+        "use_filter": use_filter,
+        "opening": opening,
+        "progressive": progressive,
+        "tolerance": tolerance,
+        "solver": solver,
+        "offset": caster.offset,
+        "hint_rays": hint_rays,
     }
     return Classification(
-        soup=soup, outside=labels, degenerate=pre.degenerate, flagged=pre.flagged,
-        cluster=pre.clustering.cluster, nodes=nodes, graph=graph, counts=counts, cut=cut,
-        caster=caster, pre=pre, stages=stages, rounds=rounds, params=params,
+        soup=soup,
+        outside=labels,
+        degenerate=pre.degenerate,
+        flagged=pre.flagged,
+        cluster=pre.clustering.cluster,
+        nodes=nodes,
+        graph=graph,
+        counts=counts,
+        cut=cut,
+        caster=caster,
+        pre=pre,
+        stages=stages,
+        rounds=rounds,
+        params=params,
     )

@@ -14,6 +14,7 @@ graph are exactly the cluster half-space nodes.  A non-orientable cluster (a Mö
 would put both sides of a face in one component; its faces are split into single-face
 clusters instead.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -67,7 +68,9 @@ def manifold_face_pairs(table: EdgeTable) -> tuple[np.ndarray, np.ndarray, np.nd
     return f[keep], g[keep], consistent[keep]
 
 
-def cluster_sides(table: EdgeTable, clusterable: np.ndarray, joinable: np.ndarray | None = None) -> Clustering:
+def cluster_sides(
+    table: EdgeTable, clusterable: np.ndarray, joinable: np.ndarray | None = None
+) -> Clustering:
     """Cluster the sides of the clusterable faces into half-space nodes.
 
     Parameters

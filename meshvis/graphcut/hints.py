@@ -6,6 +6,7 @@ from the hint in uniform directions; every node they reach gets an extra termina
 weight ``A · n_hj / n_h`` (the share of the hint's rays that land on node *j*, scaled by
 the model's total area ``A``, as in the ray-measure reading of Eq. 6).
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass, field
@@ -53,7 +54,7 @@ class Hints:
             raise ParameterError("hint rays must be at least 1")
 
     @classmethod
-    def coerce(cls, hints) -> "Hints | None":
+    def coerce(cls, hints) -> Hints | None:
         """Accept None, a Hints, or a dict with the same keys."""
         if hints is None or isinstance(hints, Hints):
             return hints
@@ -63,7 +64,12 @@ class Hints:
 
     @property
     def empty(self) -> bool:
-        return not (len(self.inside_points) or len(self.outside_points) or len(self.inside_boxes) or len(self.outside_boxes))
+        return not (
+            len(self.inside_points)
+            or len(self.outside_points)
+            or len(self.inside_boxes)
+            or len(self.outside_boxes)
+        )
 
 
 def _hint_origins(points: np.ndarray, boxes: np.ndarray, rays: int, rng: np.random.Generator) -> np.ndarray:
@@ -73,14 +79,19 @@ def _hint_origins(points: np.ndarray, boxes: np.ndarray, rays: int, rng: np.rand
     return np.concatenate(parts) if parts else np.zeros((0, 3))
 
 
-def hint_weights(caster: RayCaster, nodes: NodeSet, hints: Hints, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray, int]:
+def hint_weights(
+    caster: RayCaster, nodes: NodeSet, hints: Hints, rng: np.random.Generator
+) -> tuple[np.ndarray, np.ndarray, int]:
     """Extra terminal weights (to OUTSIDE, to INSIDE) from the hints, and the rays cast."""
     from meshvis.graphcut.sampling import snap_to_points
 
     total_area = float(nodes.area.sum()) / 2  # each triangle has two sides
     out = []
     n_cast = 0
-    for points, boxes in ((hints.outside_points, hints.outside_boxes), (hints.inside_points, hints.inside_boxes)):
+    for points, boxes in (
+        (hints.outside_points, hints.outside_boxes),
+        (hints.inside_points, hints.inside_boxes),
+    ):
         origins = _hint_origins(points, boxes, hints.rays, rng)
         w = np.zeros(nodes.n)
         if len(origins):

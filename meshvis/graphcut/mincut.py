@@ -10,6 +10,7 @@ sit behind one function:
   become 0.  The cut value then differs from the exact one by at most
   ``0.5 / scale`` per cut edge: :func:`rounding_bound` returns that bound.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass

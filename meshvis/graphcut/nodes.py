@@ -8,6 +8,7 @@ Node ids are laid out as:
 
 The two virtual terminals OUTSIDE and INSIDE are not stored here; the cut adds them.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -15,7 +16,12 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshvis.graphcut.clusters import Clustering
-from meshvis.rays.samples import cosine_hemisphere, sample_scheme_barycentric, tangent_frames, uniform_in_triangles
+from meshvis.rays.samples import (
+    cosine_hemisphere,
+    sample_scheme_barycentric,
+    tangent_frames,
+    uniform_in_triangles,
+)
 
 
 @dataclass
@@ -74,7 +80,7 @@ class NodeSet:
     @property
     def is_point(self) -> np.ndarray:
         out = np.zeros(self.n, bool)
-        out[self.n_cluster:] = True
+        out[self.n_cluster :] = True
         return out
 
     def point_node(self, p: np.ndarray, side: np.ndarray) -> np.ndarray:
@@ -137,13 +143,15 @@ def build_nodes(
     point_face = np.repeat(flagged_faces, samples)
     origin = np.empty((len(point_face), 2, 3))
     for s in (0, 1):
-        origin[:, s] = _pushed_origins(pos, point_face, s, triangles, normals, flagged_index,
-                                       partner_pairs, samples, offset, proximity)
+        origin[:, s] = _pushed_origins(
+            pos, point_face, s, triangles, normals, flagged_index, partner_pairs, samples, offset, proximity
+        )
 
     tf = triangles[flagged_faces]
     e1, e2 = tf[:, 1] - tf[:, 0], tf[:, 2] - tf[:, 0]
-    metric = np.stack([np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2),
-                       np.einsum("ij,ij->i", e2, e2)], axis=1)
+    metric = np.stack(
+        [np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2), np.einsum("ij,ij->i", e2, e2)], axis=1
+    )
     p_area = np.repeat(areas[flagged_faces] / samples, samples)
     n_points = len(point_face)
     n = n_cluster + 2 * n_points
@@ -151,11 +159,26 @@ def build_nodes(
     opposite = np.concatenate([clustering.opposite, n_cluster + (np.arange(2 * n_points) ^ 1)])
     n_faces = np.concatenate([c_faces, np.ones(2 * n_points, np.int64)])
     return NodeSet(
-        n=n, n_cluster=n_cluster, area=area, opposite=opposite, n_faces=n_faces, side_node=side_node,
-        entry_node=e_node, entry_face=e_face, entry_side=e_side, entry_cumarea=np.cumsum(areas[e_face]),
-        node_start=node_start, flagged=flagged_faces, samples=samples, point_face=point_face,
-        point_pos=pos, point_origin=origin, flagged_index=flagged_index, sample_bary=bary,
-        flagged_metric=metric, tangents=tangent_frames(normals),
+        n=n,
+        n_cluster=n_cluster,
+        area=area,
+        opposite=opposite,
+        n_faces=n_faces,
+        side_node=side_node,
+        entry_node=e_node,
+        entry_face=e_face,
+        entry_side=e_side,
+        entry_cumarea=np.cumsum(areas[e_face]),
+        node_start=node_start,
+        flagged=flagged_faces,
+        samples=samples,
+        point_face=point_face,
+        point_pos=pos,
+        point_origin=origin,
+        flagged_index=flagged_index,
+        sample_bary=bary,
+        flagged_metric=metric,
+        tangents=tangent_frames(normals),
     )
 
 
@@ -164,7 +187,9 @@ def build_nodes(
 PERPENDICULAR_COS = 1e-3
 
 
-def _pushed_origins(pos, point_face, side, triangles, normals, flagged_index, pairs, samples, offset, proximity):
+def _pushed_origins(
+    pos, point_face, side, triangles, normals, flagged_index, pairs, samples, offset, proximity
+):
     """Ray origins of sample points on one side, pushed off the surface (appendix H Fig. 6).
 
     A point is first pushed by ``offset`` along its face's side normal.  If it also lies on a
@@ -233,8 +258,14 @@ def _inside_triangle(p: np.ndarray, tri: np.ndarray, tol: float) -> np.ndarray:
     return ok & (u >= -t) & (v >= -t) & (w >= -t)
 
 
-def node_rays(nodes: NodeSet, normals: np.ndarray, triangles: np.ndarray, counts: np.ndarray,
-              rng: np.random.Generator, offset: float) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def node_rays(
+    nodes: NodeSet,
+    normals: np.ndarray,
+    triangles: np.ndarray,
+    counts: np.ndarray,
+    rng: np.random.Generator,
+    offset: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Origins and cosine-distributed directions of ``counts[i]`` rays from every node i.
 
     Cluster nodes: pick a triangle of the node by area, a uniform point on it, push it off
@@ -274,4 +305,3 @@ def node_rays(nodes: NodeSet, normals: np.ndarray, triangles: np.ndarray, counts
     t1, t2 = nodes.tangents
     directions = cosine_hemisphere(side_normals(normals[face], side), rng, (t1[face], t2[face]))
     return source, origins, directions
-

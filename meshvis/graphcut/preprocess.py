@@ -4,6 +4,7 @@ Only the required steps run (flags and clustering); the optional re-triangulatio
 intersections and removal of coplanar faces are not performed, so the output always keeps
 the input's faces.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -11,8 +12,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshvis.geometry.adjacency import WELD_TOL, degenerate_faces, edges, weld
-from meshvis.graphcut.clusters import Clustering, cluster_sides
 from meshvis.geometry.intersect import intersection_flags
+from meshvis.graphcut.clusters import Clustering, cluster_sides
 from meshvis.soup import Soup
 
 #: a face whose smallest altitude is below this fraction of the diagonal is not classified
@@ -57,10 +58,17 @@ def preprocess(soup: Soup, *, eps: float | None = None, weld_tol: float = WELD_T
     flags = intersection_flags(soup.vertices, soup.faces, eps, faces_welded=faces_welded)
     degenerate = degenerate_faces(soup.vertices, soup.faces, tol=DEGENERATE_TOL) | (soup.areas <= 0)
     flagged = (flags["intersects"] | flags["coplanar"]) & ~degenerate
-    pairs = np.concatenate([flags["intersect_pairs"], flags["coplanar_pairs"], flags["close_pairs"]]).astype(np.int64)
+    pairs = np.concatenate([flags["intersect_pairs"], flags["coplanar_pairs"], flags["close_pairs"]]).astype(
+        np.int64
+    )
     clustering = cluster_sides(edges(faces_welded), ~flagged & ~degenerate, ~flags["too_close"])
     return Preprocessed(
-        intersects=flags["intersects"], coplanar=flags["coplanar"], too_close=flags["too_close"],
-        degenerate=degenerate, flagged=flagged, partner_pairs=pairs.reshape(-1, 2),
-        clustering=clustering, faces_welded=faces_welded,
+        intersects=flags["intersects"],
+        coplanar=flags["coplanar"],
+        too_close=flags["too_close"],
+        degenerate=degenerate,
+        flagged=flagged,
+        partner_pairs=pairs.reshape(-1, 2),
+        clustering=clustering,
+        faces_welded=faces_welded,
     )

@@ -4,6 +4,7 @@ The counts of one or more rounds are accumulated in a :class:`VisibilityCounts`:
 ``hits[i, j] = n_ij`` (sparse), ``cast[i] = n_i`` (rays that count: cast minus discarded),
 ``escaped[i]`` (misses, which link node *i* to the OUTSIDE terminal).
 """
+
 from __future__ import annotations
 
 import time

@@ -3,13 +3,13 @@
 Notation: node *i* has area ``A_i`` and ``n_i`` counted rays, ``n_ij`` of which landed on
 node *j*.  ``T_ij = A_i n_ij / n_i`` is the power-exchange estimate from *i*'s rays.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
 
 import numpy as np
 import scipy.sparse as sp
-
 
 #: escape share above which a side counts as open to the outside (see :func:`inside_prior`).
 #: Measured: the holes in the bottom of the Stanford bunny let 2.1% of its inner side's
@@ -43,7 +43,9 @@ class Weights:
     cap_in: np.ndarray
 
 
-def edge_weights(hits: sp.spmatrix, counted: np.ndarray, area: np.ndarray, is_point: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+def edge_weights(
+    hits: sp.spmatrix, counted: np.ndarray, area: np.ndarray, is_point: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Eq. 5: ``w(i,j) = ½ (A_i n_ij/n_i + A_j n_ji/n_j)``.
 
     When exactly one end is a point node (a hit snapped to a sample point of an
@@ -76,8 +78,13 @@ def outside_weights(escaped: np.ndarray, counted: np.ndarray, area: np.ndarray) 
     return np.where(counted > 0, area * escaped / np.maximum(counted, 1), 0.0)
 
 
-def inside_prior(w_out: np.ndarray, escaped: np.ndarray, counted: np.ndarray, opposite: np.ndarray,
-                 opening: float | None = DEFAULT_OPENING) -> np.ndarray:
+def inside_prior(
+    w_out: np.ndarray,
+    escaped: np.ndarray,
+    counted: np.ndarray,
+    opposite: np.ndarray,
+    opening: float | None = DEFAULT_OPENING,
+) -> np.ndarray:
     """Inside links without hints: ``w_in(opp(i)) = w_o(i)`` (appendix H §3.2.1), faded by
     the node's own escape share.
 
@@ -156,7 +163,11 @@ def graph_weights(
         np.maximum.at(w_max, i, w)
         np.maximum.at(w_max, j, w)
     return Weights(
-        i, j, w, w_out, w_in,
+        i,
+        j,
+        w,
+        w_out,
+        w_in,
         cap_ij=cosine_filter(w, w_max[i]),
         cap_ji=cosine_filter(w, w_max[j]),
         cap_out=cosine_filter(w_out, w_max),

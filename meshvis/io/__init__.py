@@ -10,6 +10,7 @@ declaring its ``READERS`` and ``WRITERS``; :mod:`~meshvis.io.reading` and
 :mod:`~meshvis.io.writing` collect them.  Every file is written through
 :func:`atomic_write`: an existing file is replaced only once its successor is complete.
 """
+
 from __future__ import annotations
 
 from meshvis.io._common import (
@@ -22,8 +23,8 @@ from meshvis.io._common import (
 )
 from meshvis.io.convert import as_soup
 from meshvis.io.reading import READ_FORMATS, load, sniff
-from meshvis.io.writing import WRITE_FORMATS, save
 from meshvis.io.scene import soup_from_scene
+from meshvis.io.writing import WRITE_FORMATS, save
 
 __all__ = [
     "READ_FORMATS",

@@ -4,6 +4,7 @@ corners into output vertices, unique names, float text.
 Format modules import from here and never from :mod:`meshvis.io.reading` or
 :mod:`meshvis.io.writing`, which import them: the dependency runs one way.
 """
+
 from __future__ import annotations
 
 import contextlib
@@ -11,7 +12,8 @@ import os
 import stat
 import struct
 import tempfile
-from typing import IO, Iterator
+from collections.abc import Iterator
+from typing import IO
 
 import numpy as np
 
@@ -179,13 +181,17 @@ def ensure_folder(out_dir: str) -> None:
     try:
         os.makedirs(out_dir, exist_ok=True)
     except OSError as exc:
-        raise OutputError(f"cannot create the output folder: {one_line(exc.strerror or exc)}", out_dir) from None
+        raise OutputError(
+            f"cannot create the output folder: {one_line(exc.strerror or exc)}", out_dir
+        ) from None
     try:  # os.access is not enough: root passes it, read-only mounts fail only on write
         fd, probe = tempfile.mkstemp(prefix=".meshvis-probe-", dir=out_dir)
         os.close(fd)
         os.unlink(probe)
     except OSError as exc:
-        raise OutputError(f"output folder is not writable ({one_line(exc.strerror or exc)})", out_dir) from None
+        raise OutputError(
+            f"output folder is not writable ({one_line(exc.strerror or exc)})", out_dir
+        ) from None
 
 
 def fmt_floats(values: np.ndarray) -> list[str]:

@@ -13,6 +13,7 @@ float32 relative to the node's translation (the centre of its bounding box, kept
 float64 in the JSON, which limits the precision lost to float32), UVs, RGBA vertex
 colours and PBR materials with their base colour texture embedded.
 """
+
 from __future__ import annotations
 
 import base64
@@ -42,11 +43,13 @@ def _read_json(path: str, label: str) -> dict:
             raise ModelFormatError("GLB file is truncated (no JSON chunk)", label)
         _, _, total = struct.unpack_from("<III", data, 0)
         if total > len(data):
-            raise ModelFormatError(f"GLB file is truncated: {total} bytes announced, {len(data)} found", label)
+            raise ModelFormatError(
+                f"GLB file is truncated: {total} bytes announced, {len(data)} found", label
+            )
         length, kind = struct.unpack_from("<II", data, 12)
         if kind != _JSON_CHUNK or 20 + length > len(data):
             raise ModelFormatError("GLB file has no valid JSON chunk", label)
-        raw = data[20: 20 + length]
+        raw = data[20 : 20 + length]
     elif path.lower().endswith(".glb"):
         raise ModelFormatError("not a GLB file (it does not start with 'glTF')", label)
     else:
@@ -69,11 +72,13 @@ def _local_matrix(node: dict) -> np.ndarray:
         m = np.diag(np.append(np.asarray(node["scale"], np.float64), 1.0)) @ m
     if "rotation" in node:
         x, y, z, w = np.asarray(node["rotation"], np.float64)
-        r = np.array([
-            [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
-            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
-            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
-        ])
+        r = np.array(
+            [
+                [1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+                [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+                [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)],
+            ]
+        )
         rot = np.eye(4)
         rot[:3, :3] = r
         m = rot @ m
@@ -112,7 +117,6 @@ def read_gltf(path: str, label: str | None = None) -> Soup:
     """Read a .glb / .gltf file into a flattened soup (see the module docstring)."""
     import trimesh
 
-
     label = label or path
     doc = _read_json(path, label)
     with open(path, "rb") as fh:
@@ -131,8 +135,11 @@ def read_gltf(path: str, label: str | None = None) -> Soup:
         Material(str(m.get("name") or f"material{i}"), None) for i, m in enumerate(json_mats)
     ]
     # a material that meshvis only wrote so that UVs survive stands for "no material"
-    placeholder = {i for i, m in enumerate(json_mats)
-                   if isinstance(m.get("extras"), dict) and m["extras"].get("meshvis_placeholder")}
+    placeholder = {
+        i
+        for i, m in enumerate(json_mats)
+        if isinstance(m.get("extras"), dict) and m["extras"].get("meshvis_placeholder")
+    }
     pieces: list[Soup] = []
     piece_part: list[int] = []
     names: list[str] = []
@@ -200,8 +207,15 @@ class _Buffer:
         self.views.append(v)
         return len(self.views) - 1
 
-    def accessor(self, array: np.ndarray, kind: str, component: int, target: int | None,
-                 normalized: bool = False, with_bounds: bool = False) -> int:
+    def accessor(
+        self,
+        array: np.ndarray,
+        kind: str,
+        component: int,
+        target: int | None,
+        normalized: bool = False,
+        with_bounds: bool = False,
+    ) -> int:
         view = self.view(np.ascontiguousarray(array).tobytes(), target)
         acc = {"bufferView": view, "componentType": component, "count": int(len(array)), "type": kind}
         if normalized:
@@ -218,7 +232,9 @@ class _Buffer:
         return blob + b"\x00" * ((-len(blob)) % 4)
 
 
-def write_gltf(soup: Soup, path: str, groups=None, group_names=None, face_values=None, *, binary: bool = True) -> None:
+def write_gltf(
+    soup: Soup, path: str, groups=None, group_names=None, face_values=None, *, binary: bool = True
+) -> None:
     """Write ``soup`` as GLB (``binary=True``) or as one self-contained .gltf (see the module docstring)."""
 
     buf = _Buffer()
@@ -228,8 +244,9 @@ def write_gltf(soup: Soup, path: str, groups=None, group_names=None, face_values
     else:
         node_of_face = soup.part_id
         node_names = list(soup.part_names)
-    node_names = unique_names(node_names + [f"node{i}" for i in range(len(node_names), int(node_of_face.max()) + 1)],
-                              "node")
+    node_names = unique_names(
+        node_names + [f"node{i}" for i in range(len(node_names), int(node_of_face.max()) + 1)], "node"
+    )
 
     mat_names = unique_names([m.name for m in soup.materials], "material")
     gl_materials, images, textures = [], [], []
@@ -257,8 +274,13 @@ def write_gltf(soup: Soup, path: str, groups=None, group_names=None, face_values
     placeholder = -1
     if soup.uv is not None and (soup.material_id < 0).any():
         placeholder = len(gl_materials)
-        gl_materials.append({"name": "meshvis_none", "extras": {"meshvis_placeholder": True},
-                             "pbrMetallicRoughness": {"metallicFactor": 0.0}})
+        gl_materials.append(
+            {
+                "name": "meshvis_none",
+                "extras": {"meshvis_placeholder": True},
+                "pbrMetallicRoughness": {"metallicFactor": 0.0},
+            }
+        )
 
     _, first = np.unique(node_of_face, return_index=True)
     node_order = node_of_face[np.sort(first)]
@@ -287,17 +309,20 @@ def write_gltf(soup: Soup, path: str, groups=None, group_names=None, face_values
             if piece.colors is not None:
                 col = piece.colors.reshape(-1, 4)[corner_src]
                 attrs["COLOR_0"] = buf.accessor(col, "VEC4", 5121, 34962, normalized=True)
-            prim = {"attributes": attrs,
-                    "indices": buf.accessor(faces.astype(np.uint32).reshape(-1), "SCALAR", 5125, 34963),
-                    "mode": 4}
+            prim = {
+                "attributes": attrs,
+                "indices": buf.accessor(faces.astype(np.uint32).reshape(-1), "SCALAR", 5125, 34963),
+                "mode": 4,
+            }
             if mt >= 0:
                 prim["material"] = mt
             elif placeholder >= 0:
                 prim["material"] = placeholder
             primitives.append(prim)
         meshes.append({"name": node_names[g], "primitives": primitives})
-        nodes.append({"name": node_names[g], "mesh": len(meshes) - 1,
-                      "translation": [float(c) for c in centre]})
+        nodes.append(
+            {"name": node_names[g], "mesh": len(meshes) - 1, "translation": [float(c) for c in centre]}
+        )
 
     doc: dict = {
         "asset": {"version": "2.0", "generator": "meshvis"},

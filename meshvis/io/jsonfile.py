@@ -1,5 +1,6 @@
 """Reports as standard JSON: numpy values converted, non-finite floats written as null,
 files written atomically."""
+
 from __future__ import annotations
 
 import json

@@ -10,6 +10,7 @@ The writers go through the two functions here, which translate any of those into
 their format holds: an MTL block with copied textures, or a glTF PBR description with the
 base colour texture as image bytes.
 """
+
 from __future__ import annotations
 
 import io

@@ -16,6 +16,7 @@ name share one part id.
 A face record with exactly two corners is an edge, not a polygon (some exporters write
 edges that way): it is skipped with a warning.  A record with fewer corners is an error.
 """
+
 from __future__ import annotations
 
 import os
@@ -31,6 +32,8 @@ from meshvis.io.triangulate import triangulate
 from meshvis.soup import Material, Soup
 
 _ROW = -1.7976931348623157e308  # marks line starts while parsing lines of varying length
+
+
 def _numbers(text: str, dtype, what: str, label: str) -> np.ndarray:
     """Parse whitespace-separated numbers with numpy; one-line error on junk."""
     try:
@@ -61,7 +64,9 @@ def _first_bad_face(f_lines: list[str]) -> int:
     return -1
 
 
-def _parse_rows(lines: list[str], keyword: str, width: int, what: str, label: str, line_numbers) -> tuple[np.ndarray, np.ndarray]:
+def _parse_rows(
+    lines: list[str], keyword: str, width: int, what: str, label: str, line_numbers
+) -> tuple[np.ndarray, np.ndarray]:
     """Parse ``keyword n1 n2 ...`` lines into a (k, maxwidth) float array and per-line counts.
 
     The fast path assumes every line has ``width`` numbers (the common case) and checks it
@@ -82,7 +87,9 @@ def _parse_rows(lines: list[str], keyword: str, width: int, what: str, label: st
     if len(values) == k * width:
         return values.reshape(k, width), np.full(k, width, np.int64)
     # lines of different lengths: parse again with a sentinel where each line starts
-    marked = _numbers(f" {_ROW!r} " + f" {_ROW!r} ".join([ln[skip:] for ln in lines]), np.float64, what, label)
+    marked = _numbers(
+        f" {_ROW!r} " + f" {_ROW!r} ".join([ln[skip:] for ln in lines]), np.float64, what, label
+    )
     starts = np.flatnonzero(marked == _ROW)
     if len(starts) != k:
         raise ModelFormatError(f"cannot read the numbers of the {what} lines", label)
@@ -135,7 +142,12 @@ def read_obj(path: str, label: str | None = None) -> Soup:
     usemtl: list[tuple[int, str]] = []
     mtllibs: list[str] = []
     v_append, vt_append, f_append, k_append, fw_append = (
-        v_lines.append, vt_lines.append, f_lines.append, kinds.append, f_where.append)
+        v_lines.append,
+        vt_lines.append,
+        f_lines.append,
+        kinds.append,
+        f_where.append,
+    )
 
     for no, line in enumerate(lines):
         if not line:
@@ -204,8 +216,9 @@ def read_obj(path: str, label: str | None = None) -> Soup:
     del vals
     uv_table = None
     if n_vt:
-        tvals, t_counts = _parse_rows(vt_lines, "vt", 2, "texture coordinate", label,
-                                      lambda i: _nth_line_number(path, "vt", i))
+        tvals, t_counts = _parse_rows(
+            vt_lines, "vt", 2, "texture coordinate", label, lambda i: _nth_line_number(path, "vt", i)
+        )
         if t_counts.min() < 1:
             raise ModelFormatError("a texture coordinate line has no numbers", label)
         uv_table = np.zeros((n_vt, 2))
@@ -219,7 +232,9 @@ def read_obj(path: str, label: str | None = None) -> Soup:
         bad = _first_bad_face(f_lines)
         if bad < 0:
             raise
-        raise ModelFormatError(f"line {f_where[bad] + 1}: cannot read the vertex indices of a face", label) from None
+        raise ModelFormatError(
+            f"line {f_where[bad] + 1}: cannot read the vertex indices of a face", label
+        ) from None
     del f_lines
 
     # relative (negative) indices count back from the vertices defined so far
@@ -239,7 +254,8 @@ def read_obj(path: str, label: str | None = None) -> Soup:
             rec = int(np.searchsorted(np.cumsum(counts), np.argmax(bad), side="right"))
             raise ModelFormatError(
                 f"line {f_where[rec] + 1}: relative index reaches before the first vertex or texture coordinate",
-                label)
+                label,
+            )
     del kinds
     if (v_idx == 0).any():
         rec = int(np.searchsorted(np.cumsum(counts), np.argmax(v_idx == 0), side="right"))
@@ -249,11 +265,14 @@ def read_obj(path: str, label: str | None = None) -> Soup:
         rec = int(np.searchsorted(np.cumsum(counts), np.argmax(over), side="right"))
         raise ModelFormatError(
             f"line {f_where[rec] + 1}: vertex index {int(v_idx[np.argmax(over)])} out of range "
-            f"(the file has {n_v} vertices)", label)
+            f"(the file has {n_v} vertices)",
+            label,
+        )
     if (vt_idx > n_vt).any():
         rec = int(np.searchsorted(np.cumsum(counts), np.argmax(vt_idx > n_vt), side="right"))
         raise ModelFormatError(
-            f"line {f_where[rec] + 1}: texture coordinate index out of range (the file has {n_vt})", label)
+            f"line {f_where[rec] + 1}: texture coordinate index out of range (the file has {n_vt})", label
+        )
     v_idx -= 1
 
     # ------------------------------------------------------------ short records
@@ -261,10 +280,13 @@ def read_obj(path: str, label: str | None = None) -> Soup:
         if counts.min() < 2:
             rec = int(np.argmax(counts < 2))
             raise ModelFormatError(
-                f"line {f_where[rec] + 1}: a face needs at least 3 vertices, got {int(counts[rec])}", label)
+                f"line {f_where[rec] + 1}: a face needs at least 3 vertices, got {int(counts[rec])}", label
+            )
         edges = counts == 2
-        warnings.warn(f"{label}: skipped {int(edges.sum())} face records with 2 vertices (edges, not faces)",
-                      stacklevel=4)
+        warnings.warn(
+            f"{label}: skipped {int(edges.sum())} face records with 2 vertices (edges, not faces)",
+            stacklevel=4,
+        )
         keep_rec = np.flatnonzero(~edges)
         if len(keep_rec) == 0:
             raise ModelError(f"the model has no faces (only {int(edges.sum())} two-vertex records)", label)
@@ -310,7 +332,7 @@ def read_obj(path: str, label: str | None = None) -> Soup:
 def _nth_line_number(path: str, keyword: str, n: int) -> int:
     """0-based line number of the n-th line starting with ``keyword`` (for error messages)."""
     seen = -1
-    with open(path, "r", encoding="latin-1") as fh:
+    with open(path, encoding="latin-1") as fh:
         for no, line in enumerate(fh):
             parts = line.split(None, 1)
             if parts and parts[0] == keyword:
@@ -474,8 +496,9 @@ def write_obj(
     uv_faces = None
     if soup.uv is not None:
         uv_flat = soup.uv.reshape(-1, 2)
-        _, uv_first, uv_inverse = np.unique(uv_flat[:, 0] + 1j * uv_flat[:, 1], return_index=True,
-                                            return_inverse=True)
+        _, uv_first, uv_inverse = np.unique(
+            uv_flat[:, 0] + 1j * uv_flat[:, 1], return_index=True, return_inverse=True
+        )
         uv_unique = uv_flat[uv_first]
         uv_faces = uv_inverse.reshape(-1, 3)
     stem = os.path.splitext(os.path.basename(path))[0]
@@ -535,7 +558,7 @@ def write_obj(
         if mt != cur_mat and (mt >= 0 or cur_mat is not None):
             out.append(f"usemtl {mat_names[mt] if mt >= 0 else 'none'}\n")
             cur_mat = mt
-        out.append((face_fmt * (b - a)) % tuple(fvals[a * per_face: b * per_face]))
+        out.append((face_fmt * (b - a)) % tuple(fvals[a * per_face : b * per_face]))
     text = "".join(out)
     del out
     if mtl_name:

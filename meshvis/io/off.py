@@ -8,6 +8,7 @@ face: ``k i_1 ... i_k`` optionally followed by a colour.  ``#`` starts a comment
 Vertex colours (``C``) and face colours (trailing numbers on face lines) are read as RGBA,
 floats in [0, 1] or integers in [0, 255]; texture coordinates (``ST``) become UVs.
 """
+
 from __future__ import annotations
 
 import os
@@ -59,17 +60,21 @@ def read_off(path: str, label: str | None = None) -> Soup:
     try:
         n_v, n_f = int(rest[0]), int(rest[1])
     except (IndexError, ValueError):
-        raise ModelFormatError("the vertex and face counts after the OFF keyword are missing", label) from None
+        raise ModelFormatError(
+            "the vertex and face counts after the OFF keyword are missing", label
+        ) from None
     if n_v < 0 or n_f < 0:
         raise ModelFormatError("negative vertex or face count", label)
     if len(lines) < body_start + n_v + n_f:
         raise ModelFormatError(
             f"the file is truncated: {n_v} vertices and {n_f} faces announced, "
-            f"{len(lines) - body_start} lines found", label)
+            f"{len(lines) - body_start} lines found",
+            label,
+        )
     if n_f == 0:
         raise ModelError("the model has no faces", label)
-    vlines = lines[body_start: body_start + n_v]
-    flines = lines[body_start + n_v: body_start + n_v + n_f]
+    vlines = lines[body_start : body_start + n_v]
+    flines = lines[body_start + n_v : body_start + n_v + n_f]
 
     widths = np.fromiter((len(t) for t in vlines), np.int64, n_v)
     if n_v and widths.min() < 3:
@@ -91,29 +96,35 @@ def read_off(path: str, label: str | None = None) -> Soup:
     vcolors = uv_table = None
     if has_c and width >= col + 3:
         n_col = 4 if width - col - (2 if has_st else 0) >= 4 else 3
-        vcolors = _to_rgba(vals[:, col: col + n_col])
+        vcolors = _to_rgba(vals[:, col : col + n_col])
         col += n_col
     if has_st and width >= col + 2:
-        uv_table = vals[:, col: col + 2]
+        uv_table = vals[:, col : col + 2]
 
     try:
         counts = np.fromiter((int(t[0]) for t in flines), np.int64, n_f)
-        corner_lists = [t[1: 1 + int(t[0])] for t in flines]
+        corner_lists = [t[1 : 1 + int(t[0])] for t in flines]
         corners = np.array([c for cl in corner_lists for c in cl], np.int64)
     except ValueError:
         raise ModelFormatError("cannot read the vertex indices of the faces", label) from None
     lengths = np.fromiter((len(cl) for cl in corner_lists), np.int64, n_f)
     if (lengths != counts).any():
         bad = int(np.argmax(lengths != counts))
-        raise ModelFormatError(f"face {bad} announces {int(counts[bad])} vertices but lists {int(lengths[bad])}", label)
+        raise ModelFormatError(
+            f"face {bad} announces {int(counts[bad])} vertices but lists {int(lengths[bad])}", label
+        )
     extras = np.fromiter((len(t) - 1 - int(t[0]) for t in flines), np.int64, n_f)
 
     if (counts < 3).any():
         if (counts < 2).any():
             bad = int(np.argmax(counts < 2))
-            raise ModelFormatError(f"face {bad} has {int(counts[bad])} vertices; a face needs at least 3", label)
-        warnings.warn(f"{label}: skipped {int((counts == 2).sum())} faces with 2 vertices (edges, not faces)",
-                      stacklevel=4)
+            raise ModelFormatError(
+                f"face {bad} has {int(counts[bad])} vertices; a face needs at least 3", label
+            )
+        warnings.warn(
+            f"{label}: skipped {int((counts == 2).sum())} faces with 2 vertices (edges, not faces)",
+            stacklevel=4,
+        )
     keep = counts >= 3
     if not keep.any():
         raise ModelError("the model has no faces (only two-vertex records)", label)
@@ -131,7 +142,7 @@ def read_off(path: str, label: str | None = None) -> Soup:
     if colors is None and extras.min() >= 3 and extras.min() == extras.max():
         k = int(min(extras[0], 4))
         try:
-            fvals = np.array([t[1 + int(t[0]): 1 + int(t[0]) + k] for t in flines], np.float64)
+            fvals = np.array([t[1 + int(t[0]) : 1 + int(t[0]) + k] for t in flines], np.float64)
             colors = np.repeat(_to_rgba(fvals)[src][:, None, :], 3, axis=1)
         except ValueError:
             colors = None  # not colours after all: ignore the extra numbers

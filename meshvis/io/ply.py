@@ -11,6 +11,7 @@ its first row (one ``np.frombuffer`` / reshape); when the list lengths turn out 
 row starts are found by a Python walk over the rows and every property is then gathered
 with numpy index arithmetic.
 """
+
 from __future__ import annotations
 
 import os
@@ -25,10 +26,22 @@ from meshvis.io.triangulate import triangulate
 from meshvis.soup import Material, Soup
 
 _TYPES = {
-    "char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1",
-    "short": "i2", "int16": "i2", "ushort": "u2", "uint16": "u2",
-    "int": "i4", "int32": "i4", "uint": "u4", "uint32": "u4",
-    "float": "f4", "float32": "f4", "double": "f8", "float64": "f8",
+    "char": "i1",
+    "int8": "i1",
+    "uchar": "u1",
+    "uint8": "u1",
+    "short": "i2",
+    "int16": "i2",
+    "ushort": "u2",
+    "uint16": "u2",
+    "int": "i4",
+    "int32": "i4",
+    "uint": "u4",
+    "uint32": "u4",
+    "float": "f4",
+    "float32": "f4",
+    "double": "f8",
+    "float64": "f8",
 }
 
 
@@ -61,7 +74,7 @@ def _parse_header(data: bytes, label: str):
                 raise ModelFormatError(f"unknown PLY format line {line.strip()!r}", label)
             fmt = tok[1]
         elif tok[0] in ("comment", "obj_info"):
-            comments.append(line.strip()[len(tok[0]):].strip())
+            comments.append(line.strip()[len(tok[0]) :].strip())
         elif tok[0] == "element":
             if len(tok) != 3 or not tok[2].isdigit():
                 raise ModelFormatError(f"bad PLY element line {line.strip()!r}", label)
@@ -81,7 +94,9 @@ def _parse_header(data: bytes, label: str):
     return fmt, elements, comments, body
 
 
-def _read_binary(buf: memoryview, offset: int, n: int, props: list[_Prop], endian: str, label: str, name: str):
+def _read_binary(
+    buf: memoryview, offset: int, n: int, props: list[_Prop], endian: str, label: str, name: str
+):
     """Read ``n`` rows of one element from ``buf`` at ``offset``; returns (columns, new offset)."""
     lists = [p for p in props if p.count_dtype]
     total = len(buf)
@@ -92,8 +107,10 @@ def _read_binary(buf: memoryview, offset: int, n: int, props: list[_Prop], endia
         arr = np.frombuffer(buf, dt, count=n, offset=offset)
         return {p.name: arr[f"p{i}"].astype(p.dtype) for i, p in enumerate(props)}, offset + n * dt.itemsize
     if n == 0:
-        return {p.name: (np.zeros(0, np.int64), np.zeros(0, p.dtype)) if p.count_dtype else np.zeros(0, p.dtype)
-                for p in props}, offset
+        return {
+            p.name: (np.zeros(0, np.int64), np.zeros(0, p.dtype)) if p.count_dtype else np.zeros(0, p.dtype)
+            for p in props
+        }, offset
     # fast path: every list as long as in the first row
     fields, pos, first_len = [], offset, {}
     for i, p in enumerate(props):
@@ -125,8 +142,14 @@ def _read_binary(buf: memoryview, offset: int, n: int, props: list[_Prop], endia
     layout = []  # per property: (is_list, struct format of count, count size, item size)
     for p in props:
         if p.count_dtype:
-            layout.append((True, endian + np.dtype(p.count_dtype).char, np.dtype(p.count_dtype).itemsize,
-                           np.dtype(p.dtype).itemsize))
+            layout.append(
+                (
+                    True,
+                    endian + np.dtype(p.count_dtype).char,
+                    np.dtype(p.count_dtype).itemsize,
+                    np.dtype(p.dtype).itemsize,
+                )
+            )
         else:
             layout.append((False, "", np.dtype(p.dtype).itemsize, 0))
     n_lists = len(lists)
@@ -158,7 +181,9 @@ def _read_binary(buf: memoryview, offset: int, n: int, props: list[_Prop], endia
         if is_list:
             k = counts[:, j]
             j += 1
-            item_start = np.repeat(cursor + csize, k) + isize * (np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k))
+            item_start = np.repeat(cursor + csize, k) + isize * (
+                np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
+            )
             idx = item_start[:, None] + np.arange(isize)
             vals = raw[idx.ravel()].view(endian + p.dtype).astype(p.dtype)
             out[p.name] = (k, vals)
@@ -178,11 +203,13 @@ def _read_ascii(values: np.ndarray, offset: int, n: int, props: list[_Prop], lab
         w = len(props)
         if offset + n * w > total:
             raise ModelFormatError(f"the file is truncated (in the '{name}' data)", label)
-        block = values[offset: offset + n * w].reshape(n, w)
+        block = values[offset : offset + n * w].reshape(n, w)
         return {p.name: block[:, i].astype(p.dtype) for i, p in enumerate(props)}, offset + n * w
     if n == 0:
-        return {p.name: (np.zeros(0, np.int64), np.zeros(0, p.dtype)) if p.count_dtype else np.zeros(0, p.dtype)
-                for p in props}, offset
+        return {
+            p.name: (np.zeros(0, np.int64), np.zeros(0, p.dtype)) if p.count_dtype else np.zeros(0, p.dtype)
+            for p in props
+        }, offset
     # fast path: lists as long as in the first row
     width, pos, first_len = 0, offset, {}
     for i, p in enumerate(props):
@@ -197,13 +224,16 @@ def _read_ascii(values: np.ndarray, offset: int, n: int, props: list[_Prop], lab
             width += 1
             pos += 1
     if offset + n * width <= total:
-        block = values[offset: offset + n * width].reshape(n, width)
+        block = values[offset : offset + n * width].reshape(n, width)
         if all((block[:, c] == k).all() for c, k in first_len.values()):
             out, col = {}, 0
             for i, p in enumerate(props):
                 if p.count_dtype:
                     k = first_len[i][1]
-                    out[p.name] = (np.full(n, k, np.int64), block[:, col + 1: col + 1 + k].reshape(-1).astype(p.dtype))
+                    out[p.name] = (
+                        np.full(n, k, np.int64),
+                        block[:, col + 1 : col + 1 + k].reshape(-1).astype(p.dtype),
+                    )
                     col += 1 + k
                 else:
                     out[p.name] = block[:, col].astype(p.dtype)
@@ -269,8 +299,11 @@ def read_elements(path: str, label: str):
 
 def _colors(columns: dict, n: int) -> np.ndarray | None:
     """(n, 4) uint8 RGBA from red/green/blue[/alpha] properties (float ones scaled from [0, 1])."""
-    for names in (("red", "green", "blue", "alpha"), ("r", "g", "b", "a"),
-                  ("diffuse_red", "diffuse_green", "diffuse_blue", "diffuse_alpha")):
+    for names in (
+        ("red", "green", "blue", "alpha"),
+        ("r", "g", "b", "a"),
+        ("diffuse_red", "diffuse_green", "diffuse_blue", "diffuse_alpha"),
+    ):
         if all(k in columns and not isinstance(columns[k], tuple) for k in names[:3]):
             out = np.full((n, 4), 255, np.uint8)
             for i, k in enumerate(names):
@@ -309,9 +342,12 @@ def read_ply(path: str, label: str | None = None) -> Soup:
         if (counts < 2).any():
             raise ModelFormatError(
                 f"face {int(np.argmax(counts < 2))} has {int(counts[np.argmax(counts < 2)])} vertices; "
-                "a face needs at least 3", label)
-        warnings.warn(f"{label}: skipped {int((~keep).sum())} faces with 2 vertices (edges, not faces)",
-                      stacklevel=4)
+                "a face needs at least 3",
+                label,
+            )
+        warnings.warn(
+            f"{label}: skipped {int((~keep).sum())} faces with 2 vertices (edges, not faces)", stacklevel=4
+        )
         if not keep.any():
             raise ModelError("the model has no faces (only two-vertex records)", label)
     keep_corner = np.repeat(keep, counts)
@@ -319,7 +355,9 @@ def read_ply(path: str, label: str | None = None) -> Soup:
     k_corners = corners[keep_corner]
     if len(k_corners) and (k_corners.min() < 0 or k_corners.max() >= len(vertices)):
         bad = int(k_corners.min()) if k_corners.min() < 0 else int(k_corners.max())
-        raise ModelError(f"vertex index {bad} is out of range (the model has {len(vertices)} vertices)", label)
+        raise ModelError(
+            f"vertex index {bad} is out of range (the model has {len(vertices)} vertices)", label
+        )
     tri, src_local = triangulate(vertices, counts[keep], k_corners)
     src = kept[src_local]
     faces = k_corners[tri]
@@ -360,8 +398,18 @@ def read_ply(path: str, label: str | None = None) -> Soup:
         material_id = np.asarray(face["material_id"], np.int64)[src]
         n_mat = int(material_id.max()) + 1 if len(material_id) else 0
         materials = [Material(names["material"].get(i, f"material{i}")) for i in range(n_mat)]
-    return Soup(vertices=vertices, faces=faces, part_id=part_id, part_names=part_names, source_face=src,
-                material_id=material_id, materials=materials, uv=uv, colors=colors, path=label)
+    return Soup(
+        vertices=vertices,
+        faces=faces,
+        part_id=part_id,
+        part_names=part_names,
+        source_face=src,
+        material_id=material_id,
+        materials=materials,
+        uv=uv,
+        colors=colors,
+        path=label,
+    )
 
 
 def _comment_names(comments: list[str]) -> dict[str, dict[int, str]]:
@@ -381,7 +429,7 @@ def _ply_type(values: np.ndarray) -> tuple[str, str]:
     if v.dtype == bool:
         return "uchar", "u1"
     if v.dtype.kind in "iu":
-        if len(v) == 0 or (v.min() >= -(2 ** 31) and v.max() < 2 ** 31):
+        if len(v) == 0 or (v.min() >= -(2**31) and v.max() < 2**31):
             return "int", "<i4"
         return "double", "<f8"
     if v.dtype == np.float32:
@@ -426,11 +474,14 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
     comments += [f"comment meshvis part {i} {one_line(nm, 1000)}" for i, nm in enumerate(soup.part_names)]
     if soup.materials or (soup.material_id >= 0).any():
         extra["material_id"] = soup.material_id
-        comments += [f"comment meshvis material {i} {one_line(mt.name, 1000)}"
-                     for i, mt in enumerate(soup.materials)]
+        comments += [
+            f"comment meshvis material {i} {one_line(mt.name, 1000)}" for i, mt in enumerate(soup.materials)
+        ]
     if groups is not None:
         extra["group"] = groups
-        comments += [f"comment meshvis group {i} {one_line(nm, 1000)}" for i, nm in enumerate(group_names or [])]
+        comments += [
+            f"comment meshvis group {i} {one_line(nm, 1000)}" for i, nm in enumerate(group_names or [])
+        ]
     for key, val in (face_values or {}).items():
         safe = "".join(ch if ch.isalnum() or ch == "_" else "_" for ch in key) or "value"
         while safe in extra or safe in ("n", "idx", "vertex_indices"):
@@ -448,9 +499,21 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
     fdata = np.empty(m, np.dtype(ffields))
     for (name, *_), col in zip(ffields, fcols):
         fdata[name] = col
-    header = "\n".join(
-        ["ply", "format binary_little_endian 1.0", *comments, f"element vertex {n}", *header_v,
-         f"element face {m}", *header_f, "end_header"]) + "\n"
+    header = (
+        "\n".join(
+            [
+                "ply",
+                "format binary_little_endian 1.0",
+                *comments,
+                f"element vertex {n}",
+                *header_v,
+                f"element face {m}",
+                *header_f,
+                "end_header",
+            ]
+        )
+        + "\n"
+    )
     with atomic_write(path, "wb") as fh:
         fh.write(header.encode("utf-8"))
         fh.write(vdata.tobytes())

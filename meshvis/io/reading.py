@@ -4,6 +4,7 @@ format's reader and turns every failure into a one-line :class:`~meshvis.errors.
 Each format module declares what it reads in a ``READERS`` mapping (format name ->
 ``reader(path, label) -> Soup``); this module collects them, so formats never import it.
 """
+
 from __future__ import annotations
 
 import os
@@ -90,7 +91,9 @@ def load(path: str | os.PathLike, *, name: str | None = None) -> Soup:
     except MemoryError:
         raise ModelFormatError("the file describes more data than fits in memory (corrupt?)", label) from None
     except Exception as exc:  # any parser failure becomes one clean line
-        raise ModelFormatError(f"cannot read as {_FORMAT_TITLES[fmt]}: {describe_exception(exc)}", label) from None
+        raise ModelFormatError(
+            f"cannot read as {_FORMAT_TITLES[fmt]}: {describe_exception(exc)}", label
+        ) from None
     soup.path = label
     validate(soup.vertices, soup.faces, label)
     return soup

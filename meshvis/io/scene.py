@@ -2,6 +2,7 @@
 visual (UVs, colours, material).  Used by the glTF and 3MF readers and by
 :func:`meshvis.io.as_soup`.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -71,8 +72,14 @@ def mesh_soup(geom, name: str, material_index: int) -> Soup:
             rgba = np.full((len(col), 4), 255, np.uint8)
             rgba[:, : col.shape[1]] = col.astype(np.uint8)
             colors = rgba[faces]
-    return Soup(np.asarray(geom.vertices, np.float64), faces, part_names=[name],
-                material_id=np.full(len(faces), material_index, np.int64), uv=uv, colors=colors)
+    return Soup(
+        np.asarray(geom.vertices, np.float64),
+        faces,
+        part_names=[name],
+        material_id=np.full(len(faces), material_index, np.int64),
+        uv=uv,
+        colors=colors,
+    )
 
 
 def soup_from_trimesh(geom, name: str, materials: list, index: dict) -> Soup:

@@ -9,6 +9,7 @@ ASCII STL: ``solid name`` ... ``facet normal`` / ``outer loop`` / three ``vertex
 
 STL has no shared vertices: every triangle gets its own three vertices, in file order.
 """
+
 from __future__ import annotations
 
 import os
@@ -40,7 +41,9 @@ def read_stl(path: str, label: str | None = None) -> Soup:
                 raise ModelError("the model has no faces", label)
             rec = np.frombuffer(data, _BINARY, count=n, offset=84)
             corners = rec["corners"].astype(np.float64).reshape(-1, 3)
-            return Soup(corners, np.arange(3 * n, dtype=np.int64).reshape(n, 3), part_names=[stem], path=label)
+            return Soup(
+                corners, np.arange(3 * n, dtype=np.int64).reshape(n, 3), part_names=[stem], path=label
+            )
     head = data[:1024].lstrip()
     if not head.startswith(b"solid") or b"\x00" in data[:4096]:
         if len(data) >= 84:
@@ -49,14 +52,19 @@ def read_stl(path: str, label: str | None = None) -> Soup:
             if expected > 4 * len(data) + 1000:
                 raise ModelFormatError(
                     "not an STL file: no 'solid' line, and the binary triangle count does not match the size",
-                    label)
+                    label,
+                )
             if expected > len(data):
                 raise ModelFormatError(
                     f"binary STL is truncated: the header announces {n} triangles ({expected} bytes), "
-                    f"the file has {len(data)} bytes", label)
+                    f"the file has {len(data)} bytes",
+                    label,
+                )
             raise ModelFormatError(
                 f"binary STL size does not match its triangle count ({n} triangles need {expected} bytes, "
-                f"the file has {len(data)})", label)
+                f"the file has {len(data)})",
+                label,
+            )
         raise ModelFormatError("too short for a binary STL and not an ASCII STL", label)
     return _read_ascii(data.decode("latin-1"), label, stem)
 
@@ -73,13 +81,16 @@ def _read_ascii(text: str, label: str, stem: str) -> Soup:
             continue
         if len(found) % 3:
             raise ModelFormatError(
-                f"solid {name or k!r} has {len(found)} vertices, not a multiple of 3 (truncated?)", label)
+                f"solid {name or k!r} has {len(found)} vertices, not a multiple of 3 (truncated?)", label
+            )
         try:
             with warnings.catch_warnings():
                 warnings.simplefilter("error")
                 xyz = np.array(found, dtype=np.float64)
         except (ValueError, DeprecationWarning):
-            raise ModelFormatError(f"cannot read the vertex coordinates of solid {name or k!r}", label) from None
+            raise ModelFormatError(
+                f"cannot read the vertex coordinates of solid {name or k!r}", label
+            ) from None
         chunks.append(xyz)
         part_ids.append(np.full(len(found) // 3, len(names), np.int64))
         names.append(name or (stem if len(starts) == 1 else f"{stem}{k}"))
@@ -88,8 +99,13 @@ def _read_ascii(text: str, label: str, stem: str) -> Soup:
     vertices = np.concatenate(chunks)
     m = len(vertices) // 3
 
-    return Soup(vertices, np.arange(3 * m, dtype=np.int64).reshape(m, 3), part_id=np.concatenate(part_ids),
-                part_names=unique_names(names, "solid"), path=label)
+    return Soup(
+        vertices,
+        np.arange(3 * m, dtype=np.int64).reshape(m, 3),
+        part_id=np.concatenate(part_ids),
+        part_names=unique_names(names, "solid"),
+        path=label,
+    )
 
 
 def write_stl(soup: Soup, path: str, groups=None, group_names=None, face_values=None) -> None:

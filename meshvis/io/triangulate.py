@@ -14,12 +14,15 @@ Strategy, vectorised per polygon size:
 
 All triangles keep the winding of their polygon, so their normals agree with it.
 """
+
 from __future__ import annotations
 
 import numpy as np
 
 
-def triangulate(vertices: np.ndarray, counts: np.ndarray, corners: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def triangulate(
+    vertices: np.ndarray, counts: np.ndarray, corners: np.ndarray
+) -> tuple[np.ndarray, np.ndarray]:
     """Split polygons into triangles.
 
     Parameters
@@ -76,7 +79,9 @@ def triangulate(vertices: np.ndarray, counts: np.ndarray, corners: np.ndarray) -
             a = np.take_along_axis(fan_pos, f0, 1)
             b = np.take_along_axis(fan_pos, (f0 + i) % k, 1)
             c = np.take_along_axis(fan_pos, (f0 + i + 1) % k, 1)
-            triangles[rows[fan].ravel()] = np.stack([np.broadcast_to(a, b.shape), b, c], axis=-1).reshape(-1, 3)
+            triangles[rows[fan].ravel()] = np.stack([np.broadcast_to(a, b.shape), b, c], axis=-1).reshape(
+                -1, 3
+            )
         for g in np.flatnonzero(~fan):
             local = ear_clip(pts[g])
             triangles[rows[g]] = pos[g][local]

@@ -4,11 +4,12 @@ the soup to the format's writer.
 Each format module declares what it writes in a ``WRITERS`` mapping (format name ->
 ``writer(soup, path, groups, group_names, face_values)``); this module collects them.
 """
+
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import replace
-from typing import Mapping
 
 import numpy as np
 

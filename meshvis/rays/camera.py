@@ -3,6 +3,7 @@
 Pixel convention: x grows to the right, y grows downwards, pixel (0, 0) is the top-left
 pixel and its centre is at (0.5, 0.5).  The vertical field of view ``fov`` is in degrees.
 """
+
 from __future__ import annotations
 
 import os
@@ -97,7 +98,9 @@ class Camera:
         row, col = np.divmod(np.arange(width * height), width)
         return self.pixel_rays(col, row, width, height)
 
-    def pixel_rays(self, col: np.ndarray, row: np.ndarray, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
+    def pixel_rays(
+        self, col: np.ndarray, row: np.ndarray, width: int, height: int
+    ) -> tuple[np.ndarray, np.ndarray]:
         """Primary rays through the centres of the given pixels of a ``width`` x ``height`` image.
 
         Returns
@@ -146,7 +149,7 @@ class Camera:
         orthographic: bool = False,
         margin: float = 1.0,
         up: Any = (0.0, 1.0, 0.0),
-    ) -> "Camera":
+    ) -> Camera:
         """A camera framing the model's bounding sphere.
 
         ``azimuth`` turns around the up axis, ``elevation`` lifts the camera above the
@@ -170,9 +173,14 @@ class Camera:
         return cls(position, center, up, fov, orthographic, 2 * margin * radius if orthographic else None)
 
     @classmethod
-    def orbit(cls, model: Any, n_frames: int, elevation: float = 20.0, start: float = 30.0, **kw: Any) -> list["Camera"]:
+    def orbit(
+        cls, model: Any, n_frames: int, elevation: float = 20.0, start: float = 30.0, **kw: Any
+    ) -> list[Camera]:
         """``n_frames`` cameras turning once around the model."""
-        return [cls.fit(model, azimuth=start + 360.0 * k / n_frames, elevation=elevation, **kw) for k in range(n_frames)]
+        return [
+            cls.fit(model, azimuth=start + 360.0 * k / n_frames, elevation=elevation, **kw)
+            for k in range(n_frames)
+        ]
 
     def to_json(self) -> dict:
         d = asdict(self)
@@ -181,7 +189,7 @@ class Camera:
         return d
 
     @classmethod
-    def from_json(cls, d: dict) -> "Camera":
+    def from_json(cls, d: dict) -> Camera:
         known = {"position", "target", "up", "fov", "orthographic", "ortho_height"}
         unknown = set(d) - known
         if unknown:

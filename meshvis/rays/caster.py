@@ -15,6 +15,7 @@ trace a large batch 1.5–1.8 times as fast as one on a 2-core machine (docs/per
 processes would have to rebuild the scene and copy the rays and results, and measure
 slower.  ``meshvis bench rays`` measures all three side by side.
 """
+
 from __future__ import annotations
 
 import os
@@ -127,15 +128,24 @@ class RayCaster:
         n = len(o32)
         if n == 0:
             if query == "INTERSECT":
-                return {"primID": np.zeros(0, np.int32), "tfar": np.zeros(0, np.float32), "Ng": np.zeros((0, 3), np.float32),
-                        "u": np.zeros(0, np.float32), "v": np.zeros(0, np.float32)}
+                return {
+                    "primID": np.zeros(0, np.int32),
+                    "tfar": np.zeros(0, np.float32),
+                    "Ng": np.zeros((0, 3), np.float32),
+                    "u": np.zeros(0, np.float32),
+                    "v": np.zeros(0, np.float32),
+                }
             return np.zeros(0, np.int32)
 
         def call(sl: slice) -> Any:
             kw = {} if dists is None else {"dists": np.ascontiguousarray(dists[sl])}
             if query == "INTERSECT":
-                return self._scene.run(np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), output=1, **kw)
-            return self._scene.run(np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), query=query, **kw)
+                return self._scene.run(
+                    np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), output=1, **kw
+                )
+            return self._scene.run(
+                np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), query=query, **kw
+            )
 
         if self.threads == 1 or n < 2 * CHUNK:
             return call(slice(0, n))
@@ -155,8 +165,14 @@ class RayCaster:
         return np.concatenate(parts)
 
     # ------------------------------------------------------------------ public queries
-    def intersect(self, origins: np.ndarray, directions: np.ndarray, max_distance: np.ndarray | float | None = None,
-                  *, exact_distance: bool = False) -> Hits:
+    def intersect(
+        self,
+        origins: np.ndarray,
+        directions: np.ndarray,
+        max_distance: np.ndarray | float | None = None,
+        *,
+        exact_distance: bool = False,
+    ) -> Hits:
         """First hit of every ray ``origins + t * directions``, ``0 <= t <= max_distance``.
 
         Parameters
@@ -175,7 +191,9 @@ class RayCaster:
         d = self._unit_dirs(np.asarray(directions).reshape(-1, 3))
         dists = None
         if max_distance is not None:
-            dists = np.broadcast_to(np.asarray(max_distance, np.float64) * self.scale, (len(origins),)).astype(np.float32)
+            dists = np.broadcast_to(
+                np.asarray(max_distance, np.float64) * self.scale, (len(origins),)
+            ).astype(np.float32)
         r = self._run(self.to_unit(origins), d.astype(np.float32), "INTERSECT", dists)
         face = r["primID"].astype(np.int64)
         hit = face >= 0
@@ -218,7 +236,9 @@ class RayCaster:
         sign = np.where(np.asarray(side) == 0, 1.0, -1.0)
         return points + self.normals[face] * (sign * self.offset * self.diagonal)[:, None]
 
-    def intersect_from_surface(self, points: np.ndarray, face: np.ndarray, side: np.ndarray, directions: np.ndarray) -> Hits:
+    def intersect_from_surface(
+        self, points: np.ndarray, face: np.ndarray, side: np.ndarray, directions: np.ndarray
+    ) -> Hits:
         """Like :meth:`intersect` for rays that start on ``face`` and leave it on ``side``."""
         return self.intersect(self.push_off(points, face, side), directions)
 
@@ -232,4 +252,3 @@ class RayCaster:
 
     def __repr__(self) -> str:
         return f"<RayCaster {self.soup.n_faces} faces, {self.threads} threads>"
-

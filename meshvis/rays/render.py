@@ -4,6 +4,7 @@ No GPU and no display: one ray per pixel through :class:`~meshvis.rays.caster.Ra
 Lambert shading with a head light.  Front sides and back sides get clearly different
 colours (blue and orange), so a face that points the wrong way shows at a glance.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -11,9 +12,9 @@ from typing import Any
 
 import numpy as np
 
+from meshvis.io import as_soup
 from meshvis.rays.camera import Camera
 from meshvis.rays.caster import RayCaster
-from meshvis.io import as_soup
 
 FRONT = np.array([96, 140, 220], np.float64)
 BACK = np.array([235, 120, 60], np.float64)

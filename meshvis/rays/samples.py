@@ -3,6 +3,7 @@
 All functions take an explicit ``numpy.random.Generator`` so that results depend only on
 the caller's seed.
 """
+
 from __future__ import annotations
 
 import numpy as np
@@ -27,8 +28,9 @@ def uniform_in_triangles(triangles: np.ndarray, rng: np.random.Generator) -> np.
     return w0[:, None] * triangles[:, 0] + w1[:, None] * triangles[:, 1] + w2[:, None] * triangles[:, 2]
 
 
-def cosine_hemisphere(normals: np.ndarray, rng: np.random.Generator,
-                      frames: tuple[np.ndarray, np.ndarray] | None = None) -> np.ndarray:
+def cosine_hemisphere(
+    normals: np.ndarray, rng: np.random.Generator, frames: tuple[np.ndarray, np.ndarray] | None = None
+) -> np.ndarray:
     """Cosine-distributed unit directions around each unit normal.
 
     ``θ = arccos √ξ₁``, ``φ = 2π ξ₂`` (DESIGN.md §4): the density is ``cos θ / π``, so the
@@ -78,7 +80,9 @@ def uniform_sphere(n: int, rng: np.random.Generator) -> np.ndarray:
     return d / np.linalg.norm(d, axis=1, keepdims=True)
 
 
-def sample_scheme_barycentric(n_samples: int, scheme: int = 2, rng: np.random.Generator | None = None) -> np.ndarray:
+def sample_scheme_barycentric(
+    n_samples: int, scheme: int = 2, rng: np.random.Generator | None = None
+) -> np.ndarray:
     """Barycentric coordinates of the sample points placed on each flagged triangle.
 
     Appendix H §3.1 lists three schemes; the first two are implemented:
@@ -103,8 +107,11 @@ def sample_scheme_barycentric(n_samples: int, scheme: int = 2, rng: np.random.Ge
     if scheme == 2 and n_samples >= 4:
         # edge samples, slightly inside so that they belong to this triangle only
         e = 0.05
-        pts += [np.array([0.5 - e / 2, 0.5 - e / 2, e]), np.array([e, 0.5 - e / 2, 0.5 - e / 2]),
-                np.array([0.5 - e / 2, e, 0.5 - e / 2])]
+        pts += [
+            np.array([0.5 - e / 2, 0.5 - e / 2, e]),
+            np.array([e, 0.5 - e / 2, 0.5 - e / 2]),
+            np.array([0.5 - e / 2, e, 0.5 - e / 2]),
+        ]
         inner = n_samples - 3
     # interior: a low-discrepancy (Kronecker) sequence warped to the triangle
     k = np.arange(inner) + 0.5

@@ -7,26 +7,37 @@ of them flipped.  The parts of each solid inside the other are hidden; intersect
 triangles need sample-point nodes.  Every result is checked against the generator's
 ground truth.
 """
+
 from __future__ import annotations
 
 import os
 import time
-from typing import Callable
+from collections.abc import Callable
 
 import numpy as np
 
-from meshvis.rays.camera import Camera
-from meshvis.graphcut.classify import classify
 from meshvis.eval.generators import overlapping_solids, soupify
+from meshvis.graphcut.classify import classify
 from meshvis.io import save
 from meshvis.io.jsonfile import write_json
+from meshvis.rays.camera import Camera
+from meshvis.rays.render import render, render_layers, save_png
 from meshvis.repair.layers import layers
 from meshvis.repair.orient import orient
 from meshvis.repair.remove import remove_interior
-from meshvis.rays.render import render, render_layers, save_png
 
-DEMO_FILES = ("input.obj", "input.png", "oriented.obj", "oriented.png", "exterior.obj", "interior.obj",
-              "exterior.png", "layers.ply", "layers.png", "report.json")
+DEMO_FILES = (
+    "input.obj",
+    "input.png",
+    "oriented.obj",
+    "oriented.png",
+    "exterior.obj",
+    "interior.obj",
+    "exterior.png",
+    "layers.ply",
+    "layers.png",
+    "report.json",
+)
 
 
 def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str], None] = print) -> dict:
@@ -40,8 +51,10 @@ def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str]
     soup = truth.soup
     soup.path = os.path.join(folder, "input.obj")
     save(soup, soup.path)
-    say(f"bundled model: box and sphere passing through each other, as a soup of {soup.n_faces} faces, "
-        f"30% flipped -> {soup.path}")
+    say(
+        f"bundled model: box and sphere passing through each other, as a soup of {soup.n_faces} faces, "
+        f"30% flipped -> {soup.path}"
+    )
     camera = Camera.fit(soup, azimuth=35, elevation=25, up=(0.0, 0.0, 1.0))
     shot = lambda s, name: save_png(render(s, camera, size=(size, size)).image, os.path.join(folder, name))  # noqa: E731
     shot(soup, "input.png")
@@ -64,19 +77,24 @@ def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str]
     shot(r.kept, "exterior.png")
     hidden = ~truth.outside.any(axis=1)
     removed_ok = float(((~r.keep) == hidden)[ok].mean())
-    say(f"remove-interior: kept {int(r.keep.sum())}, removed {int((~r.keep).sum())}; "
-        f"agrees with the truth on {100 * removed_ok:.2f}% of the faces")
+    say(
+        f"remove-interior: kept {int(r.keep.sum())}, removed {int((~r.keep).sum())}; "
+        f"agrees with the truth on {100 * removed_ok:.2f}% of the faces"
+    )
 
     lay = layers(soup, classification=c)
     save(soup, os.path.join(folder, "layers.ply"), face_values={"layer": lay.layer})
     save_png(render_layers(soup, lay.layer, camera, size=(size, size)), os.path.join(folder, "layers.png"))
     layer_acc = float((area * (lay.layer == truth.layer) * ok).sum() / (area * ok).sum())
-    say(f"layers: {lay.n_layers} layers, faces per layer {lay.report(False)['faces_per_layer']}; "
-        f"correct on {100 * layer_acc:.2f}% of the area")
+    say(
+        f"layers: {lay.n_layers} layers, faces per layer {lay.report(False)['faces_per_layer']}; "
+        f"correct on {100 * layer_acc:.2f}% of the area"
+    )
 
     summary = {
         "model": "overlapping box and sphere (meshvis.eval.generators.overlapping_solids, soupify flip=0.3)",
-        "faces": soup.n_faces, "seed": seed,
+        "faces": soup.n_faces,
+        "seed": seed,
         "orientation_correct_area": orient_acc,
         "removal_agreement_faces": removed_ok,
         "layer_correct_area": layer_acc,

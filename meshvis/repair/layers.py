@@ -5,6 +5,7 @@ layer-1 faces (in particular their inside nodes) are tied to the source and the 
 cut again: what becomes outside now is layer 2 — what one sees once layer 1 is gone.
 Repeat until every face has a layer or ``max_layers`` is reached.
 """
+
 from __future__ import annotations
 
 import time
@@ -58,7 +59,12 @@ def _face_outside_any(c: Classification, node_outside: np.ndarray) -> tuple[np.n
     out = frac > 0
     side = np.where(out[:, 0] & out[:, 1], 2, np.where(out[:, 0], 0, np.where(out[:, 1], 1, -1)))
     # for partly outside faces (sample points), the side with more outside area wins
-    partial = out[:, 0] & out[:, 1] & (np.abs(frac[:, 0] - frac[:, 1]) > 0) & ~((frac[:, 0] == 1) & (frac[:, 1] == 1))
+    partial = (
+        out[:, 0]
+        & out[:, 1]
+        & (np.abs(frac[:, 0] - frac[:, 1]) > 0)
+        & ~((frac[:, 0] == 1) & (frac[:, 1] == 1))
+    )
     side[partial] = np.where(frac[partial, 0] >= frac[partial, 1], 0, 1)
     return out.any(axis=1), side.astype(np.int8)
 
@@ -78,8 +84,14 @@ def face_nodes_mask(c: Classification, faces: np.ndarray) -> np.ndarray:
     return mask
 
 
-def layers(model: Any, *, max_layers: int | None = None, classification: Classification | None = None,
-           progress=None, **classify_kw: Any) -> LayerResult:
+def layers(
+    model: Any,
+    *,
+    max_layers: int | None = None,
+    classification: Classification | None = None,
+    progress=None,
+    **classify_kw: Any,
+) -> LayerResult:
     """Peel the model into nested layers.
 
     Parameters

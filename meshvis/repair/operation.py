@@ -5,9 +5,11 @@ Options are a plain mapping (an ``argparse.Namespace`` works too) whose keys and
 defaults are :func:`default_options`; the command line takes its defaults from here, so a
 batch file is processed exactly as the single-file command would process it.
 """
+
 from __future__ import annotations
 
-from typing import Any, Callable, Mapping
+from collections.abc import Callable, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -18,8 +20,16 @@ OPERATIONS = ("classify", "orient", "remove-interior", "layers")
 
 #: options of the classification, shared by every operation
 CLASSIFY_DEFAULTS: dict[str, Any] = {
-    "seed": 0, "rays_per_node": 32, "samples_per_face": 4, "no_filter": False, "no_progressive": False,
-    "solver": "pymaxflow", "inside_point": [], "outside_point": [], "inside_box": [], "outside_box": [],
+    "seed": 0,
+    "rays_per_node": 32,
+    "samples_per_face": 4,
+    "no_filter": False,
+    "no_progressive": False,
+    "solver": "pymaxflow",
+    "inside_point": [],
+    "outside_point": [],
+    "inside_box": [],
+    "outside_box": [],
 }
 #: options of each operation on top of the classification
 OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
@@ -50,17 +60,30 @@ def classify_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
     o = {**CLASSIFY_DEFAULTS, **_options(options)}
     hints = None
     if o["inside_point"] or o["outside_point"] or o["inside_box"] or o["outside_box"]:
-        hints = Hints(inside_points=np.array(o["inside_point"], np.float64).reshape(-1, 3),
-                      outside_points=np.array(o["outside_point"], np.float64).reshape(-1, 3),
-                      inside_boxes=np.array(o["inside_box"], np.float64).reshape(-1, 2, 3),
-                      outside_boxes=np.array(o["outside_box"], np.float64).reshape(-1, 2, 3))
-    return dict(rays_per_node=int(o["rays_per_node"]), seed=int(o["seed"]),
-                samples_per_face=int(o["samples_per_face"]), use_filter=not o["no_filter"],
-                progressive=not o["no_progressive"], solver=o["solver"], hints=hints)
+        hints = Hints(
+            inside_points=np.array(o["inside_point"], np.float64).reshape(-1, 3),
+            outside_points=np.array(o["outside_point"], np.float64).reshape(-1, 3),
+            inside_boxes=np.array(o["inside_box"], np.float64).reshape(-1, 2, 3),
+            outside_boxes=np.array(o["outside_box"], np.float64).reshape(-1, 2, 3),
+        )
+    return dict(
+        rays_per_node=int(o["rays_per_node"]),
+        seed=int(o["seed"]),
+        samples_per_face=int(o["samples_per_face"]),
+        use_filter=not o["no_filter"],
+        progressive=not o["no_progressive"],
+        solver=o["solver"],
+        hints=hints,
+    )
 
 
-def run_operation(op: str, soup, options: Mapping[str, Any] | Any, progress: Callable | None = None,
-                  say: Callable[[str], None] | None = None) -> dict:
+def run_operation(
+    op: str,
+    soup,
+    options: Mapping[str, Any] | Any,
+    progress: Callable | None = None,
+    say: Callable[[str], None] | None = None,
+) -> dict:
     """Classify ``soup``, apply ``op``, write the outputs named in ``options``, return the report.
 
     Parameters
@@ -78,12 +101,12 @@ def run_operation(op: str, soup, options: Mapping[str, Any] | Any, progress: Cal
     """
     from meshvis.graphcut.classify import classify
     from meshvis.io import atomic_write, save
+    from meshvis.rays.render import render, render_layers, save_png
     from meshvis.repair.layers import layers
     from meshvis.repair.orient import orient
     from meshvis.repair.remove import remove_interior
-    from meshvis.rays.render import render, render_layers, save_png
 
-    o = {**default_options(op), **{k: None for k in OUTPUT_KEYS}, **_options(options)}
+    o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
     tell = say or (lambda text: None)
     c = classify(soup, progress=progress, **classify_kwargs(o))
     tell(c.summary())
@@ -97,12 +120,20 @@ def run_operation(op: str, soup, options: Mapping[str, Any] | Any, progress: Cal
         if o["preview"]:
             save_png(render(soup, color_by="side").image, o["preview"])
     elif op == "orient":
-        r = orient(soup, classification=c, front=o["front"], two_sided=o["two_sided"],
-                   semantics=o["semantics"], conflicts=o["conflicts"])
+        r = orient(
+            soup,
+            classification=c,
+            front=o["front"],
+            two_sided=o["two_sided"],
+            semantics=o["semantics"],
+            conflicts=o["conflicts"],
+        )
         save(r.soup, o["output"])
         report = r.report()
-        tell(f"flipped {report['flipped']} of {report['input_faces']} faces; "
-             f"{report['status_counts']}; wrote {o['output']} ({r.soup.n_faces} faces)")
+        tell(
+            f"flipped {report['flipped']} of {report['input_faces']} faces; "
+            f"{report['status_counts']}; wrote {o['output']} ({r.soup.n_faces} faces)"
+        )
         if o["preview"]:
             save_png(render(r.soup, color_by="side").image, o["preview"])
     elif op == "remove-interior":
@@ -111,8 +142,10 @@ def run_operation(op: str, soup, options: Mapping[str, Any] | Any, progress: Cal
         if o["removed"]:
             save(r.removed, o["removed"])
         report = r.report()
-        tell(f"kept {report['kept_faces']}, removed {report['removed_faces']} of {report['input_faces']} faces; "
-             f"wrote {o['output']}" + (f" and {o['removed']}" if o["removed"] else ""))
+        tell(
+            f"kept {report['kept_faces']}, removed {report['removed_faces']} of {report['input_faces']} faces; "
+            f"wrote {o['output']}" + (f" and {o['removed']}" if o["removed"] else "")
+        )
         if o["preview"]:
             save_png(render(r.kept, color_by="side").image, o["preview"])
     else:  # layers

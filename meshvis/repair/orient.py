@@ -18,6 +18,7 @@ turned so that its front faces the outside.  The other cases are decided by opti
 * flagged faces whose sample points disagree: by area ``majority`` (default) or
   ``duplicate``.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -25,8 +26,8 @@ from typing import Any
 
 import numpy as np
 
-from meshvis.graphcut.classify import Classification, classify
 from meshvis.errors import ParameterError
+from meshvis.graphcut.classify import Classification, classify
 from meshvis.repair.layers import LayerResult, layers
 from meshvis.soup import Soup
 
@@ -72,11 +73,17 @@ class OrientResult:
             d["layers"] = self.layers.report(per_face=False)
         else:
             d["layers"] = "skipped: no hidden faces"
-        d["parity_faces"] = self.parity_faces if self.parity_faces else "skipped: every hidden face had a vote"
+        d["parity_faces"] = (
+            self.parity_faces if self.parity_faces else "skipped: every hidden face had a vote"
+        )
         if per_face:
-            d["per_face"] = {"flipped": self.flipped, "duplicated": self.duplicated, "status": self.status,
-                             "outside_front": self.classification.outside[:, 0],
-                             "outside_back": self.classification.outside[:, 1]}
+            d["per_face"] = {
+                "flipped": self.flipped,
+                "duplicated": self.duplicated,
+                "status": self.status,
+                "outside_front": self.classification.outside[:, 0],
+                "outside_back": self.classification.outside[:, 1],
+            }
         return d
 
 
@@ -121,8 +128,9 @@ def surface_vote(c: Classification, outer: np.ndarray, decided: np.ndarray) -> t
     return side, decisive
 
 
-def parity_side(c: Classification, faces: np.ndarray, seed: int = 0, rays: int = 9,
-                max_crossings: int = 64) -> np.ndarray:
+def parity_side(
+    c: Classification, faces: np.ndarray, seed: int = 0, rays: int = 9, max_crossings: int = 64
+) -> np.ndarray:
     """Outer side of ``faces`` by ray parity against their own body.
 
     From each face's centroid, ``rays`` cosine-distributed rays leave its front side, and

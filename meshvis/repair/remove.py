@@ -4,6 +4,7 @@ One classification; every face with an outside side — or, for faces classified
 sample points, at least one outside sample point — is kept, the rest is removed.
 Every input face ends up in exactly one of the two outputs.
 """
+
 from __future__ import annotations
 
 from dataclasses import dataclass
@@ -36,17 +37,23 @@ class RemovalResult:
             "kept_faces": int(self.keep.sum()),
             "removed_faces": int((~self.keep).sum()),
             "removed_area_fraction": float(
-                (self.classification.soup.areas * ~self.keep).sum() / max(self.classification.soup.total_area, 1e-300)
+                (self.classification.soup.areas * ~self.keep).sum()
+                / max(self.classification.soup.total_area, 1e-300)
             ),
             "classification": self.classification.report(per_face=False),
         }
         if per_face:
-            d["per_face"] = {"keep": self.keep, "outside_front": self.classification.outside[:, 0],
-                             "outside_back": self.classification.outside[:, 1]}
+            d["per_face"] = {
+                "keep": self.keep,
+                "outside_front": self.classification.outside[:, 0],
+                "outside_back": self.classification.outside[:, 1],
+            }
         return d
 
 
-def remove_interior(model: Any, *, classification: Classification | None = None, **classify_kw: Any) -> RemovalResult:
+def remove_interior(
+    model: Any, *, classification: Classification | None = None, **classify_kw: Any
+) -> RemovalResult:
     """Remove the faces that cannot be seen from outside.
 
     Parameters

@@ -19,6 +19,7 @@ against time, both logarithmic, one panel per input and one curve per method; ex
 answers, error 0, are drawn on the floor line), and ``accuracy.md`` (the machine, a
 table per task, and a check of where meshvis' curve is not at or below a baseline's).
 """
+
 from __future__ import annotations
 
 import argparse
@@ -27,20 +28,24 @@ import io
 import os
 import sys
 import time
-from typing import Iterable
+from collections.abc import Iterable
 
 import numpy as np
 
-from meshvis.eval.baselines import BASELINES
 from meshvis.errors import OutputError
+from meshvis.eval.baselines import BASELINES
 from meshvis.eval.bench import cases as C
 
 #: meshvis sweeps (rays per node)
 RAYS_FULL = (1, 2, 4, 8, 16, 32, 64)
 RAYS_QUICK = (1, 4, 16)
 #: baseline sweeps in ``--quick`` runs (full runs use each baseline's own ``sweep``)
-QUICK_SWEEPS = {"libigl_reorient": (1, 10), "pymeshlab_reorient": (4, 16), "pymeshlab_ao": (4, 16),
-                "pymeshlab_ao_2sided": (4, 16)}
+QUICK_SWEEPS = {
+    "libigl_reorient": (1, 10),
+    "pymeshlab_reorient": (4, 16),
+    "pymeshlab_ao": (4, 16),
+    "pymeshlab_ao_2sided": (4, 16),
+}
 TASKS = ("orient", "remove", "layers")
 #: errors below this are drawn on the floor of the log axis
 FLOOR = 1e-5
@@ -48,8 +53,9 @@ OUTPUTS = ("accuracy.csv", "accuracy.md") + tuple(f"accuracy_{t}.png" for t in T
 
 
 # ====================================================================== the sweep
-def sweep(cases: Iterable[C.Case], *, quick: bool = False, seed: int = 0, peel_timeout: float = 300.0,
-          log=print) -> tuple[list[C.Point], list[str]]:
+def sweep(
+    cases: Iterable[C.Case], *, quick: bool = False, seed: int = 0, peel_timeout: float = 300.0, log=print
+) -> tuple[list[C.Point], list[str]]:
     """Measure every method at every budget on every case.
 
     Returns
@@ -61,20 +67,37 @@ def sweep(cases: Iterable[C.Case], *, quick: bool = False, seed: int = 0, peel_t
     skipped: list[str] = []
     C.warm_up()
     for case, truth in C.built_cases(cases, skipped, log):
-        settings = [(r, dict(rays_per_node=r, progressive=False), False) for r in (RAYS_QUICK if quick else RAYS_FULL)]
+        settings = [
+            (r, dict(rays_per_node=r, progressive=False), False) for r in (RAYS_QUICK if quick else RAYS_FULL)
+        ]
         settings.append((32, {}, True))  # the defaults: progressive, up to 32 rays per node
         for r, kw, default in settings:
             res = C.meshvis_run(truth, TASKS, seed=seed, **kw)
             for task, (sec, values, info) in res.items():
-                p = C.Point(case.name, truth.n_faces, task, "meshvis_default" if default else "meshvis",
-                            "meshvis default (progressive)" if default else "meshvis", "rays_per_node", r, sec,
-                            load1=C.load1(), default=default, extra=info, **C.score(truth, task, values))
+                p = C.Point(
+                    case.name,
+                    truth.n_faces,
+                    task,
+                    "meshvis_default" if default else "meshvis",
+                    "meshvis default (progressive)" if default else "meshvis",
+                    "rays_per_node",
+                    r,
+                    sec,
+                    load1=C.load1(),
+                    default=default,
+                    extra=info,
+                    **C.score(truth, task, values),
+                )
                 points.append(p)
-            log(f"  meshvis {'default' if default else f'rays_per_node={r}'}: "
-                + ", ".join(f"{t} {res[t][0]:.3f} s err {points[-3 + i].error:.2e}" for i, t in enumerate(TASKS)))
+            log(
+                f"  meshvis {'default' if default else f'rays_per_node={r}'}: "
+                + ", ".join(
+                    f"{t} {res[t][0]:.3f} s err {points[-3 + i].error:.2e}" for i, t in enumerate(TASKS)
+                )
+            )
         for name, b in BASELINES.items():
             values = QUICK_SWEEPS.get(name, b.sweep) if quick else b.sweep
-            for v in (values or (None,)):
+            for v in values or (None,):
                 p = C.baseline_point(truth, case.name, name, v, timeout=peel_timeout)
                 points.append(p)
                 state = f"err {p.error:.2e}" if p.ok else f"FAILED: {p.message}"
@@ -104,8 +127,15 @@ def read_csv(path: str) -> list[C.Point]:
             kw = {}
             for k, v in row.items():
                 t = kinds.get(k)
-                kw[k] = (v == "True") if t in ("bool", bool) else int(v) if t in ("int", int) else \
-                    float(v) if t in ("float", float) else v
+                kw[k] = (
+                    (v == "True")
+                    if t in ("bool", bool)
+                    else int(v)
+                    if t in ("int", int)
+                    else float(v)
+                    if t in ("float", float)
+                    else v
+                )
             points.append(C.Point(**kw))
     return points
 
@@ -118,11 +148,16 @@ def _methods(points: list[C.Point]) -> list[str]:
     return seen
 
 
-STYLE = {"meshvis": dict(color="C3", marker="o", lw=2.2, zorder=5),
-         "meshvis_default": dict(color="C3", marker="*", ms=14, lw=0, zorder=6),
-         "libigl_reorient": dict(color="C0", marker="s"), "trimesh_fix_normals": dict(color="C2", marker="D"),
-         "pymeshlab_reorient": dict(color="C1", marker="^"), "pymeshlab_ao": dict(color="C1", marker="v"),
-         "pymeshlab_ao_2sided": dict(color="C4", marker="<"), "libigl_peel": dict(color="C0", marker="P")}
+STYLE = {
+    "meshvis": dict(color="C3", marker="o", lw=2.2, zorder=5),
+    "meshvis_default": dict(color="C3", marker="*", ms=14, lw=0, zorder=6),
+    "libigl_reorient": dict(color="C0", marker="s"),
+    "trimesh_fix_normals": dict(color="C2", marker="D"),
+    "pymeshlab_reorient": dict(color="C1", marker="^"),
+    "pymeshlab_ao": dict(color="C1", marker="v"),
+    "pymeshlab_ao_2sided": dict(color="C4", marker="<"),
+    "libigl_peel": dict(color="C0", marker="P"),
+}
 
 
 def plot_task(path: str, task: str, points: list[C.Point]) -> None:
@@ -169,7 +204,7 @@ def plot_task(path: str, task: str, points: list[C.Point]) -> None:
         ax.set_xlabel("wall time (s)")
         ax.set_ylabel("error (area fraction)")
         ax.grid(True, which="both", alpha=0.25)
-    for ax in axes.ravel()[len(case_names):]:
+    for ax in axes.ravel()[len(case_names) :]:
         ax.axis("off")
     handles, names = [], []
     for ax in axes.ravel():
@@ -178,7 +213,9 @@ def plot_task(path: str, task: str, points: list[C.Point]) -> None:
                 handles.append(h)
                 names.append(lab)
     fig.legend(handles, names, loc="lower center", ncol=min(4, max(len(names), 1)), fontsize=9, frameon=False)
-    fig.suptitle(f"{C.TASK_TITLES[task]}: error against time (error 0 drawn at {FLOOR:g}, dotted line)", fontsize=11)
+    fig.suptitle(
+        f"{C.TASK_TITLES[task]}: error against time (error 0 drawn at {FLOOR:g}, dotted line)", fontsize=11
+    )
     height = 4.0 * rows + legend_in
     fig.tight_layout(rect=(0, legend_in / height, 1, 1 - 0.35 / height))
     buf = io.BytesIO()
@@ -212,8 +249,10 @@ def dominance(points: list[C.Point], task: str, case: str) -> tuple[list[str], l
         by_then = [m.error for m in mv if m.seconds <= b.seconds]
         if not by_then:
             if first.error > b.error:
-                beaten.append(f"{where}: faster than meshvis' fastest point ({C.fmt_time(first.seconds)} s, "
-                              f"error {C.fmt_err(first.error)}) and more accurate")
+                beaten.append(
+                    f"{where}: faster than meshvis' fastest point ({C.fmt_time(first.seconds)} s, "
+                    f"error {C.fmt_err(first.error)}) and more accurate"
+                )
             else:
                 earlier.append(where)
         elif min(by_then) > b.error:
@@ -223,18 +262,23 @@ def dominance(points: list[C.Point], task: str, case: str) -> tuple[list[str], l
 
 def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: str, seconds: float) -> str:
     """The report: machine, command, one table per task, and the curve check."""
-    lines = [f"# meshvis bench accuracy", "", f"Command: `{command}` — {seconds:.0f} s in all.", ""]
+    lines = ["# meshvis bench accuracy", "", f"Command: `{command}` — {seconds:.0f} s in all.", ""]
     lines += C.machine_lines(machine) + [
-        f"- load average at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}", ""]
+        f"- load average at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}",
+        "",
+    ]
     if skipped:
         lines += ["Skipped cases:", ""] + [f"- {s}" for s in skipped] + [""]
     for task in TASKS:
         pts = [p for p in points if p.task == task]
         if not pts:
             continue
-        lines += [f"## {C.TASK_TITLES[task]}", "",
-                  "| case | method | points | fastest: s / error | default: s / error | best error (s) |",
-                  "|---|---|---:|---|---|---|"]
+        lines += [
+            f"## {C.TASK_TITLES[task]}",
+            "",
+            "| case | method | points | fastest: s / error | default: s / error | best error (s) |",
+            "|---|---|---:|---|---|---|",
+        ]
         for case in dict.fromkeys(p.case for p in pts):
             for method in _methods([p for p in pts if p.case == case]):
                 mp = [p for p in pts if p.case == case and p.method == method]
@@ -247,16 +291,21 @@ def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: 
                 dflt = [p for p in ok if p.default]
                 d_txt = f"{C.fmt_time(dflt[0].seconds)} / {C.fmt_err(dflt[0].error)}" if dflt else "–"
                 n_txt = f"{len(ok)}" if len(ok) == len(mp) else f"{len(ok)} ({len(mp) - len(ok)} failed)"
-                lines.append(f"| {case} | {mp[0].label} | {n_txt} | "
-                             f"{C.fmt_time(fast.seconds)} / {C.fmt_err(fast.error)} | {d_txt} | "
-                             f"{C.fmt_err(best.error)} ({C.fmt_time(best.seconds)}) |")
+                lines.append(
+                    f"| {case} | {mp[0].label} | {n_txt} | "
+                    f"{C.fmt_time(fast.seconds)} / {C.fmt_err(fast.error)} | {d_txt} | "
+                    f"{C.fmt_err(best.error)} ({C.fmt_time(best.seconds)}) |"
+                )
         lines += [""]
-    lines += ["## Where meshvis' curve is not at or below a baseline's", "",
-              "A baseline point is *above* meshvis' curve when some point of meshvis' sweep is at most as "
-              "slow and at most as wrong.  Listed: points where meshvis' curve is above the baseline "
-              "(**beaten**), and points faster than meshvis' fastest run where that run is nevertheless "
-              "at least as accurate (**earlier**: the baseline finishes first, with an equal or larger error).",
-              ""]
+    lines += [
+        "## Where meshvis' curve is not at or below a baseline's",
+        "",
+        "A baseline point is *above* meshvis' curve when some point of meshvis' sweep is at most as "
+        "slow and at most as wrong.  Listed: points where meshvis' curve is above the baseline "
+        "(**beaten**), and points faster than meshvis' fastest run where that run is nevertheless "
+        "at least as accurate (**earlier**: the baseline finishes first, with an equal or larger error).",
+        "",
+    ]
     for task in TASKS:
         for case in dict.fromkeys(p.case for p in points if p.task == task):
             beaten, earlier = dominance(points, task, case)
@@ -265,21 +314,35 @@ def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: 
             if not beaten and not earlier:
                 lines.append(head + "at or below every baseline point")
                 continue
-            lines.append(head + (f"**beaten** by {len(beaten)} point(s)" if beaten else "never beaten")
-                         + (f"; earlier: {'; '.join(earlier)}" if earlier else ""))
+            lines.append(
+                head
+                + (f"**beaten** by {len(beaten)} point(s)" if beaten else "never beaten")
+                + (f"; earlier: {'; '.join(earlier)}" if earlier else "")
+            )
             lines += [f"  - beaten: {b}" for b in beaten]
     return "\n".join(lines) + "\n"
 
 
 # ====================================================================== command
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--out", required=True, metavar="DIR", help="folder for the CSV, charts and table (created)")
+    p.add_argument(
+        "--out", required=True, metavar="DIR", help="folder for the CSV, charts and table (created)"
+    )
     p.add_argument("--quick", action="store_true", help="small inputs and short sweeps (under two minutes)")
-    p.add_argument("--cases", metavar="A,B,...", help=f"inputs to run (default: all, or {','.join(C.QUICK)} "
-                   f"with --quick); choose from {','.join(C.CASES)}")
+    p.add_argument(
+        "--cases",
+        metavar="A,B,...",
+        help=f"inputs to run (default: all, or {','.join(C.QUICK)} "
+        f"with --quick); choose from {','.join(C.CASES)}",
+    )
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--peel-timeout", type=float, default=300.0, metavar="S",
-                   help="time limit of one CGAL peel (it runs in a worker process)")
+    p.add_argument(
+        "--peel-timeout",
+        type=float,
+        default=300.0,
+        metavar="S",
+        help="time limit of one CGAL peel (it runs in a worker process)",
+    )
     p.add_argument("--force", action="store_true", help="overwrite earlier results in DIR")
     p.add_argument("--quiet", action="store_true")
 
@@ -300,15 +363,27 @@ def main(args: argparse.Namespace) -> int:
     log = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
     m = C.machine()
     t0 = time.perf_counter()
-    points, skipped = sweep(chosen, quick=args.quick, seed=args.seed,
-                            peel_timeout=min(args.peel_timeout, 60.0) if args.quick else args.peel_timeout, log=log)
+    points, skipped = sweep(
+        chosen,
+        quick=args.quick,
+        seed=args.seed,
+        peel_timeout=min(args.peel_timeout, 60.0) if args.quick else args.peel_timeout,
+        log=log,
+    )
     total = time.perf_counter() - t0
     write_csv(os.path.join(args.out, "accuracy.csv"), points)
     for task in TASKS:
         plot_task(os.path.join(args.out, f"accuracy_{task}.png"), task, points)
     command = "meshvis bench accuracy " + " ".join(
-        x for x in ["--quick" if args.quick else "", f"--cases {args.cases}" if args.cases else "",
-                    f"--seed {args.seed}" if args.seed else "", f"--out {args.out}"] if x)
+        x
+        for x in [
+            "--quick" if args.quick else "",
+            f"--cases {args.cases}" if args.cases else "",
+            f"--seed {args.seed}" if args.seed else "",
+            f"--out {args.out}",
+        ]
+        if x
+    )
     text = markdown(points, skipped, m, command, total)
     from meshvis.io import atomic_write
 

@@ -9,14 +9,15 @@ A *point* is one run of one method at one budget on one case and one task, score
 against the truth (:mod:`meshvis.eval.metrics`) and stamped with the machine's load average,
 because the machine these numbers come from is shared.
 """
+
 from __future__ import annotations
 
 import os
 import platform
 import sys
 import time
+from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
-from typing import Callable
 
 import numpy as np
 
@@ -26,9 +27,22 @@ from meshvis.eval.generators import GroundTruth
 from meshvis.eval.metrics import layer_error, orientation_error, removal_scores
 
 __all__ = [
-    "Case", "Point", "CASES", "QUICK", "HIDDEN_SHELL_CASES", "select_cases", "load_case",
-    "meshvis_run", "baseline_point", "score", "machine", "machine_lines", "load1", "warm_up",
-    "fmt_err", "fmt_time",
+    "Case",
+    "Point",
+    "CASES",
+    "QUICK",
+    "HIDDEN_SHELL_CASES",
+    "select_cases",
+    "load_case",
+    "meshvis_run",
+    "baseline_point",
+    "score",
+    "machine",
+    "machine_lines",
+    "load1",
+    "warm_up",
+    "fmt_err",
+    "fmt_time",
 ]
 
 TASK_TITLES = {"orient": "normal orientation", "remove": "inside removal", "layers": "layers"}
@@ -53,23 +67,36 @@ def _real(file: str) -> Callable[[], GroundTruth]:
 
 
 #: every case, in report order
-CASES: dict[str, Case] = {c.name: c for c in [
-    Case("sphere_pair", _soup(gen.sphere_pair),
-         "outer sphere with a 6-face crack around a hidden inner sphere"),
-    Case("nested_shells", _soup(gen.nested_shells), "three concentric closed spheres"),
-    Case("cracked_box", _soup(gen.cracked_box), "single-sheet box with hairline cracks, small box inside"),
-    Case("box_with_opening", _soup(gen.box_with_opening), "cave: a large opening, two-sided interior"),
-    Case("cup", _soup(gen.cup), "open cup modelled as one sheet (every face two-sided)"),
-    Case("terrain", _soup(gen.terrain), "open heightfield; meshvis gets the generator's side hints, "
-         "the baselines cannot take any"),
-    Case("house", _soup(gen.house), "rooms with shared coplanar walls and furniture inside"),
-    Case("overlapping_solids", _soup(gen.overlapping_solids), "a sphere and a box that interpenetrate"),
-    Case("assembly", _soup(gen.assembly), "engine-like assembly of 36 parts, pistons hidden"),
-    Case("skin_ribcage", _soup(gen.skin_and_ribcage), "dm_control dog skin with the rib cage inside", True),
-    Case("cow", _soup(_real("cow.obj")), "cow.obj, closed", True),
-    Case("spot", _soup(_real("spot.obj")), "spot.obj, closed", True),
-    Case("dog_skin", _soup(_real("dm_control__SKINbody.stl")), "dm_control skin alone, closed", True),
-]}
+CASES: dict[str, Case] = {
+    c.name: c
+    for c in [
+        Case(
+            "sphere_pair",
+            _soup(gen.sphere_pair),
+            "outer sphere with a 6-face crack around a hidden inner sphere",
+        ),
+        Case("nested_shells", _soup(gen.nested_shells), "three concentric closed spheres"),
+        Case(
+            "cracked_box", _soup(gen.cracked_box), "single-sheet box with hairline cracks, small box inside"
+        ),
+        Case("box_with_opening", _soup(gen.box_with_opening), "cave: a large opening, two-sided interior"),
+        Case("cup", _soup(gen.cup), "open cup modelled as one sheet (every face two-sided)"),
+        Case(
+            "terrain",
+            _soup(gen.terrain),
+            "open heightfield; meshvis gets the generator's side hints, the baselines cannot take any",
+        ),
+        Case("house", _soup(gen.house), "rooms with shared coplanar walls and furniture inside"),
+        Case("overlapping_solids", _soup(gen.overlapping_solids), "a sphere and a box that interpenetrate"),
+        Case("assembly", _soup(gen.assembly), "engine-like assembly of 36 parts, pistons hidden"),
+        Case(
+            "skin_ribcage", _soup(gen.skin_and_ribcage), "dm_control dog skin with the rib cage inside", True
+        ),
+        Case("cow", _soup(_real("cow.obj")), "cow.obj, closed", True),
+        Case("spot", _soup(_real("spot.obj")), "spot.obj, closed", True),
+        Case("dog_skin", _soup(_real("dm_control__SKINbody.stl")), "dm_control skin alone, closed", True),
+    ]
+}
 
 #: the cases of ``--quick`` runs (small, crack and hidden shells, one real model)
 QUICK = ("sphere_pair", "nested_shells", "cracked_box", "cow")
@@ -163,8 +190,10 @@ def score(truth: GroundTruth, task: str, values: np.ndarray | None) -> dict:
         return {"error": nan}
     if task == "orient":
         hidden = truth.layer >= 2
-        return {"error": orientation_error(truth, values),
-                "error_hidden": orientation_error(truth, values, where=hidden) if hidden.any() else nan}
+        return {
+            "error": orientation_error(truth, values),
+            "error_hidden": orientation_error(truth, values, where=hidden) if hidden.any() else nan,
+        }
     if task == "remove":
         s = removal_scores(truth, values)
         return {"error": s.error, "precision": s.precision, "recall": s.recall}
@@ -173,8 +202,9 @@ def score(truth: GroundTruth, task: str, values: np.ndarray | None) -> dict:
     raise ValueError(task)
 
 
-def meshvis_run(truth: GroundTruth, tasks: tuple[str, ...], *, seed: int = 0, share: bool = True,
-                **classify_kw) -> dict[str, tuple[float, np.ndarray, dict]]:
+def meshvis_run(
+    truth: GroundTruth, tasks: tuple[str, ...], *, seed: int = 0, share: bool = True, **classify_kw
+) -> dict[str, tuple[float, np.ndarray, dict]]:
     """Run meshvis' applications on a case; per task ``(seconds, values, info)``.
 
     With ``share`` the classification is computed once and its time is added to every
@@ -214,8 +244,9 @@ def meshvis_run(truth: GroundTruth, tasks: tuple[str, ...], *, seed: int = 0, sh
     return out
 
 
-def baseline_point(truth: GroundTruth, case: str, name: str, value: float | None, *,
-                   timeout: float = 300.0) -> Point:
+def baseline_point(
+    truth: GroundTruth, case: str, name: str, value: float | None, *, timeout: float = 300.0
+) -> Point:
     """Run baseline ``name`` with its knob at sweep ``value`` (None: library default) and score it."""
     b: Baseline = BASELINES[name]
     kw = dict(b.fixed)
@@ -226,10 +257,21 @@ def baseline_point(truth: GroundTruth, case: str, name: str, value: float | None
     r: BaselineResult = b.run(truth.soup, **kw)
     s = score(truth, b.task, r.values if r.ok else None)
     shown = b.default if value is None else value
-    return Point(case, truth.n_faces, b.task, name, b.label,
-                 (b.knob + (" per face" if b.per_face else "")) if b.knob else "",
-                 float("nan") if shown is None else float(shown), r.seconds, ok=r.ok, message=r.message,
-                 load1=load1(), default=value is None or value == b.default, **s)
+    return Point(
+        case,
+        truth.n_faces,
+        b.task,
+        name,
+        b.label,
+        (b.knob + (" per face" if b.per_face else "")) if b.knob else "",
+        float("nan") if shown is None else float(shown),
+        r.seconds,
+        ok=r.ok,
+        message=r.message,
+        load1=load1(),
+        default=value is None or value == b.default,
+        **s,
+    )
 
 
 def warm_up() -> None:
@@ -268,8 +310,15 @@ def machine() -> dict:
             versions[mod] = "missing"
     from meshvis import __version__
 
-    return {"cpu": cpu, "cores": os.cpu_count(), "os": platform.platform(), "python": sys.version.split()[0],
-            "meshvis": __version__, "versions": versions, "load_average": [round(x, 2) for x in os.getloadavg()]}
+    return {
+        "cpu": cpu,
+        "cores": os.cpu_count(),
+        "os": platform.platform(),
+        "python": sys.version.split()[0],
+        "meshvis": __version__,
+        "versions": versions,
+        "load_average": [round(x, 2) for x in os.getloadavg()],
+    }
 
 
 def _dist_version(mod: str) -> str:
@@ -286,10 +335,12 @@ def _dist_version(mod: str) -> str:
 def machine_lines(m: dict) -> list[str]:
     """Markdown bullet lines describing :func:`machine`'s result."""
     v = ", ".join(f"{k} {x}" for k, x in m["versions"].items())
-    return [f"- CPU: {m['cpu']}, {m['cores']} logical cores; {m['os']}",
-            f"- Python {m['python']}, meshvis {m['meshvis']}; {v}",
-            f"- load average at the start (1, 5, 15 min): {', '.join(str(x) for x in m['load_average'])} "
-            "(the machine is shared with other jobs; every row also records the 1-minute load)"]
+    return [
+        f"- CPU: {m['cpu']}, {m['cores']} logical cores; {m['os']}",
+        f"- Python {m['python']}, meshvis {m['meshvis']}; {v}",
+        f"- load average at the start (1, 5, 15 min): {', '.join(str(x) for x in m['load_average'])} "
+        "(the machine is shared with other jobs; every row also records the 1-minute load)",
+    ]
 
 
 def fmt_err(x: float) -> str:

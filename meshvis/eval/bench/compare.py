@@ -16,6 +16,7 @@ of each method divided by meshvis' time on the same task and input, and the targ
 issue 4 checked on the numbers: meshvis at least as accurate as the best baseline,
 ≥ 99.5 % of the hidden shell correct, ≥ 3× faster than libigl's default orientation.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -49,15 +50,29 @@ def _best_of(repeat: int, run):
     return best
 
 
-def compare_case(truth, case: str, *, seed: int = 0, repeat: int = 1, peel_timeout: float = 300.0,
-                 log=print) -> list[C.Point]:
+def compare_case(
+    truth, case: str, *, seed: int = 0, repeat: int = 1, peel_timeout: float = 300.0, log=print
+) -> list[C.Point]:
     """All methods at default settings on one case; one :class:`Point` per (method, task)."""
     points: list[C.Point] = []
     for task in TASKS:
+
         def run_meshvis(task=task):
             sec, values, info = C.meshvis_run(truth, (task,), seed=seed, share=False)[task]
-            return C.Point(case, truth.n_faces, task, "meshvis", "meshvis (defaults)", "rays_per_node", 32, sec,
-                           load1=C.load1(), default=True, extra=info, **C.score(truth, task, values))
+            return C.Point(
+                case,
+                truth.n_faces,
+                task,
+                "meshvis",
+                "meshvis (defaults)",
+                "rays_per_node",
+                32,
+                sec,
+                load1=C.load1(),
+                default=True,
+                extra=info,
+                **C.score(truth, task, values),
+            )
 
         p = _best_of(repeat, run_meshvis)
         points.append(p)
@@ -72,8 +87,16 @@ def compare_case(truth, case: str, *, seed: int = 0, repeat: int = 1, peel_timeo
 def checks(points: list[C.Point], case: str) -> list[str]:
     """The targets of issue 4 on one case, each as 'yes'/'NO' with its numbers."""
     out = []
-    get = lambda task, method: next((p for p in points if p.case == case and p.task == task  # noqa: E731
-                                     and p.method == method), None)
+    get = lambda task, method: next(
+        (
+            p
+            for p in points
+            if p.case == case
+            and p.task == task  # noqa: E731
+            and p.method == method
+        ),
+        None,
+    )
     for task in TASKS:
         mv = get(task, "meshvis")
         base = [p for p in points if p.case == case and p.task == task and p.method != "meshvis" and p.ok]
@@ -81,30 +104,40 @@ def checks(points: list[C.Point], case: str) -> list[str]:
             continue
         best = min(base, key=lambda p: p.error)
         ok = mv.error <= best.error
-        out.append(f"{C.TASK_TITLES[task]}: meshvis error {C.fmt_err(mv.error)} vs best baseline "
-                   f"{best.method} {C.fmt_err(best.error)} — at least as accurate: {'yes' if ok else 'NO'}")
+        out.append(
+            f"{C.TASK_TITLES[task]}: meshvis error {C.fmt_err(mv.error)} vs best baseline "
+            f"{best.method} {C.fmt_err(best.error)} — at least as accurate: {'yes' if ok else 'NO'}"
+        )
     mv, ig = get("orient", "meshvis"), get("orient", "libigl_reorient")
     if mv is not None and not np.isnan(mv.error_hidden):
         acc = 1 - mv.error_hidden
         ig_txt = f"; libigl {100 * (1 - ig.error_hidden):.2f} %" if ig is not None and ig.ok else ""
-        out.append(f"hidden shell correctly oriented: meshvis {100 * acc:.2f} % "
-                   f"(target ≥ {100 * HIDDEN_TARGET:g} %: {'yes' if acc >= HIDDEN_TARGET else 'NO'}){ig_txt}")
+        out.append(
+            f"hidden shell correctly oriented: meshvis {100 * acc:.2f} % "
+            f"(target ≥ {100 * HIDDEN_TARGET:g} %: {'yes' if acc >= HIDDEN_TARGET else 'NO'}){ig_txt}"
+        )
     if mv is not None and ig is not None and ig.ok:
         r = ig.seconds / mv.seconds
-        out.append(f"speed: time(libigl default) / time(meshvis orient) = {ig.seconds:.3f} s / {mv.seconds:.3f} s "
-                   f"= {r:.1f}× (target ≥ {SPEED_TARGET:g}×: {'yes' if r >= SPEED_TARGET else 'NO'})")
+        out.append(
+            f"speed: time(libigl default) / time(meshvis orient) = {ig.seconds:.3f} s / {mv.seconds:.3f} s "
+            f"= {r:.1f}× (target ≥ {SPEED_TARGET:g}×: {'yes' if r >= SPEED_TARGET else 'NO'})"
+        )
     return out
 
 
 def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: str, seconds: float) -> str:
     lines = ["# meshvis bench compare", "", f"Command: `{command}` — {seconds:.0f} s in all.", ""]
     lines += C.machine_lines(machine) + [
-        f"- load average at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}", ""]
+        f"- load average at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}",
+        "",
+    ]
     if skipped:
         lines += ["Skipped cases:", ""] + [f"- {s}" for s in skipped] + [""]
-    lines += ["| case | faces | task | method | error | hidden-shell error | precision | recall | time (s) "
-              "| time / meshvis | load |",
-              "|---|---:|---|---|---:|---:|---:|---:|---:|---:|---:|"]
+    lines += [
+        "| case | faces | task | method | error | hidden-shell error | precision | recall | time (s) "
+        "| time / meshvis | load |",
+        "|---|---:|---|---|---:|---:|---:|---:|---:|---:|---:|",
+    ]
     for case in dict.fromkeys(p.case for p in points):
         for task in TASKS:
             tp = [p for p in points if p.case == case and p.task == task]
@@ -112,9 +145,11 @@ def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: 
             for p in tp:
                 ratio = p.seconds / mv.seconds if mv is not None and mv.seconds > 0 else float("nan")
                 err = C.fmt_err(p.error) if p.ok else f"failed: {p.message}"
-                lines.append(f"| {case} | {p.faces} | {task} | {p.label} | {err} | {C.fmt_err(p.error_hidden)} | "
-                             f"{C.fmt_err(p.precision)} | {C.fmt_err(p.recall)} | {C.fmt_time(p.seconds)} | "
-                             f"{ratio:.2f} | {p.load1:.1f} |")
+                lines.append(
+                    f"| {case} | {p.faces} | {task} | {p.label} | {err} | {C.fmt_err(p.error_hidden)} | "
+                    f"{C.fmt_err(p.precision)} | {C.fmt_err(p.recall)} | {C.fmt_time(p.seconds)} | "
+                    f"{ratio:.2f} | {p.load1:.1f} |"
+                )
     lines += ["", "## Targets (issue 4)", ""]
     for case in dict.fromkeys(p.case for p in points):
         lines.append(f"- **{case}**")
@@ -131,8 +166,11 @@ def write_csv(path: str, points: list[C.Point]) -> None:
 # ====================================================================== command
 def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--quick", action="store_true", help=f"only {', '.join(QUICK)}")
-    p.add_argument("--cases", metavar="A,B,...", help=f"inputs (default {','.join(FULL)}); "
-                   f"choose from {','.join(C.CASES)}")
+    p.add_argument(
+        "--cases",
+        metavar="A,B,...",
+        help=f"inputs (default {','.join(FULL)}); choose from {','.join(C.CASES)}",
+    )
     p.add_argument("--out", metavar="DIR", help="also write compare.md and compare.csv into DIR")
     p.add_argument("--repeat", type=int, default=1, metavar="N", help="keep the fastest of N runs per method")
     p.add_argument("--seed", type=int, default=0)
@@ -152,12 +190,20 @@ def main(args: argparse.Namespace) -> int:
     points: list[C.Point] = []
     skipped: list[str] = []
     for case, truth in C.built_cases(chosen, skipped, log):
-        points += compare_case(truth, case.name, seed=args.seed, repeat=args.repeat,
-                               peel_timeout=args.peel_timeout, log=log)
+        points += compare_case(
+            truth, case.name, seed=args.seed, repeat=args.repeat, peel_timeout=args.peel_timeout, log=log
+        )
     command = "meshvis bench compare " + " ".join(
-        x for x in ["--quick" if args.quick else "", f"--cases {args.cases}" if args.cases else "",
-                    f"--repeat {args.repeat}" if args.repeat != 1 else "", f"--seed {args.seed}" if args.seed else "",
-                    f"--out {args.out}" if args.out else ""] if x)
+        x
+        for x in [
+            "--quick" if args.quick else "",
+            f"--cases {args.cases}" if args.cases else "",
+            f"--repeat {args.repeat}" if args.repeat != 1 else "",
+            f"--seed {args.seed}" if args.seed else "",
+            f"--out {args.out}" if args.out else "",
+        ]
+        if x
+    )
     text = markdown(points, skipped, m, command.strip(), time.perf_counter() - t0)
     if args.out:
         from meshvis.io import atomic_write

@@ -8,6 +8,7 @@ Three ways to use the cores are measured in one run on the same batch:
 * processes: a pool of worker processes, each building its own scene and tracing a share
   of the rays (scene build and transfer of rays and results included).
 """
+
 from __future__ import annotations
 
 import multiprocessing as mp
@@ -17,9 +18,9 @@ from typing import Any
 import numpy as np
 
 from meshvis.graphcut.nodes import side_normals
+from meshvis.io import as_soup
 from meshvis.rays.caster import RayCaster, default_threads
 from meshvis.rays.samples import cosine_hemisphere, uniform_in_triangles
-from meshvis.io import as_soup
 from meshvis.soup import Soup
 
 

@@ -32,6 +32,7 @@ graph weights (before and after the cosine filter) is NaN or infinite.
 ``--quick`` runs fewer scales and widths on smaller models (well under a minute).  The
 explanation of the crack threshold is in ``docs/stability.md``.
 """
+
 from __future__ import annotations
 
 import argparse
@@ -39,16 +40,17 @@ import math
 import os
 import tempfile
 import time
+from collections.abc import Callable, Iterable
 from dataclasses import asdict, dataclass, field
-from typing import Any, Callable, Iterable
+from typing import Any
 
 import numpy as np
 
-from meshvis.graphcut.weights import DEFAULT_OPENING
+from meshvis.errors import ModelError
 from meshvis.eval import generators
 from meshvis.graphcut.classify import Classification, classify
-from meshvis.errors import ModelError
 from meshvis.graphcut.mincut import Cut, rounding_bound
+from meshvis.graphcut.weights import DEFAULT_OPENING
 from meshvis.rays.caster import DEFAULT_OFFSET
 from meshvis.soup import Soup
 
@@ -166,10 +168,14 @@ def aspect_ratios(soup: Soup) -> np.ndarray:
 def _with(soup: Soup, vertices: np.ndarray, faces: np.ndarray, parent: np.ndarray) -> Soup:
     """A soup of new geometry whose faces inherit the attributes of their ``parent`` faces."""
     return Soup(
-        vertices, faces,
-        part_id=soup.part_id[parent], part_names=list(soup.part_names),
-        source_face=soup.source_face[parent], material_id=soup.material_id[parent],
-        materials=list(soup.materials), path=soup.path,
+        vertices,
+        faces,
+        part_id=soup.part_id[parent],
+        part_names=list(soup.part_names),
+        source_face=soup.source_face[parent],
+        material_id=soup.material_id[parent],
+        materials=list(soup.materials),
+        path=soup.path,
     )
 
 
@@ -199,8 +205,9 @@ def similarity(soup: Soup, kind: str, amount: float = 1.0, seed: int = 0) -> Sou
     return soup.transformed(m)
 
 
-def split_into_slivers(soup: Soup, fraction: float = 0.25, t_min: float = 1e-6, t_max: float = 1e-2,
-                       seed: int = 0) -> tuple[Soup, np.ndarray]:
+def split_into_slivers(
+    soup: Soup, fraction: float = 0.25, t_min: float = 1e-6, t_max: float = 1e-2, seed: int = 0
+) -> tuple[Soup, np.ndarray]:
     """Split a ``fraction`` of the faces in two at a point very close to a corner.
 
     Face (a, b, c) becomes (a, p, c) and (p, b, c) with ``p = a + t (b − a)``, ``t``
@@ -244,7 +251,9 @@ def add_zero_area(soup: Soup, fraction: float = 0.1, seed: int = 0) -> Soup:
     line = np.stack([f[half:, 0], mid, f[half:, 1]], 1)
     mids = 0.5 * (soup.vertices[f[half:, 0]] + soup.vertices[f[half:, 1]])
     parent = np.concatenate([np.arange(soup.n_faces), src])
-    return _with(soup, np.concatenate([soup.vertices, mids]), np.concatenate([soup.faces, point, line]), parent)
+    return _with(
+        soup, np.concatenate([soup.vertices, mids]), np.concatenate([soup.faces, point, line]), parent
+    )
 
 
 def add_duplicates(soup: Soup, fraction: float = 0.1, seed: int = 0) -> Soup:
@@ -264,8 +273,12 @@ def add_near_coplanar(soup: Soup, offset: float = 1e-7, fraction: float = 0.1, s
     src = rng.choice(soup.n_faces, k, replace=False)
     moved = soup.triangles[src] + (offset * soup.diagonal) * soup.normals[src][:, None, :]
     faces = np.concatenate([soup.faces, soup.n_vertices + np.arange(3 * k).reshape(k, 3)])
-    return _with(soup, np.concatenate([soup.vertices, moved.reshape(-1, 3)]), faces,
-                 np.concatenate([np.arange(soup.n_faces), src]))
+    return _with(
+        soup,
+        np.concatenate([soup.vertices, moved.reshape(-1, 3)]),
+        faces,
+        np.concatenate([np.arange(soup.n_faces), src]),
+    )
 
 
 def perturb_corners(soup: Soup, amount: float = 1e-9, seed: int = 0) -> Soup:
@@ -320,7 +333,9 @@ def tiny_beside_huge(sizes: Iterable[float] = TINY_SIZES, subdivisions: int = 2,
     of = np.asarray(outer.faces)[1:] if hole else np.asarray(outer.faces)
     inner = trimesh.creation.icosphere(subdivisions, radius=0.5)
     pieces: list[tuple[np.ndarray, np.ndarray, str]] = [
-        (np.asarray(outer.vertices), of, "outer"), (np.asarray(inner.vertices), np.asarray(inner.faces), "inner")]
+        (np.asarray(outer.vertices), of, "outer"),
+        (np.asarray(inner.vertices), np.asarray(inner.faces), "inner"),
+    ]
     D = 2.0 * np.sqrt(3.0)
     for k, s in enumerate(sizes):
         ang = 2 * np.pi * k / len(sizes)
@@ -336,7 +351,9 @@ def tiny_beside_huge(sizes: Iterable[float] = TINY_SIZES, subdivisions: int = 2,
         f.append(pf + off)
         pid.append(np.full(len(pf), i))
         off += len(pv)
-    return Soup(np.concatenate(v), np.concatenate(f), part_id=np.concatenate(pid), part_names=[p[2] for p in pieces])
+    return Soup(
+        np.concatenate(v), np.concatenate(f), part_id=np.concatenate(pid), part_names=[p[2] for p in pieces]
+    )
 
 
 # ============================================================================ cases
@@ -351,24 +368,40 @@ def _finite_note(bad: list[str]) -> str:
     return "" if not bad else f"; NON-FINITE: {', '.join(bad[:3])}" + (" …" if len(bad) > 3 else "")
 
 
-def similarity_cases(models: dict[str, Soup], scales: Iterable[float], rays_per_node: int, seed: int) -> list[CaseResult]:
+def similarity_cases(
+    models: dict[str, Soup], scales: Iterable[float], rays_per_node: int, seed: int
+) -> list[CaseResult]:
     """Group 1: classification under uniform scale, far translation, rotation, and a rerun."""
     out = []
     for name, soup in models.items():
         ref = classify(soup, rays_per_node=rays_per_node, seed=seed)
-        variants: list[tuple[str, Callable[[], Soup], float]] = [("rerun (same input, same seed)", lambda: soup, 1.0)]
+        variants: list[tuple[str, Callable[[], Soup], float]] = [
+            ("rerun (same input, same seed)", lambda: soup, 1.0)
+        ]
         variants += [(f"scale {s:g}", lambda s=s: similarity(soup, "scale", s), AGREEMENT) for s in scales]
-        variants += [(f"translate {TRANSLATION:g} x size", lambda: similarity(soup, "translate", TRANSLATION), AGREEMENT),
-                     ("rotate (random)", lambda: similarity(soup, "rotate", seed=seed), AGREEMENT)]
+        variants += [
+            (
+                f"translate {TRANSLATION:g} x size",
+                lambda: similarity(soup, "translate", TRANSLATION),
+                AGREEMENT,
+            ),
+            ("rotate (random)", lambda: similarity(soup, "rotate", seed=seed), AGREEMENT),
+        ]
         for label, make, need in variants:
+
             def case(label=label, make=make, need=need) -> CaseResult:
                 c = classify(make(), rays_per_node=rays_per_node, seed=seed)
                 agree = area_agreement(ref.side_outside, c.side_outside, soup.areas)
                 bad = nonfinite(c) + nonfinite(ref)
                 ok = agree >= need and not bad
-                return CaseResult("similarity", f"{name}: {label}", ok,
-                                  f"agreement {100 * agree:.4f}% of area (need >= {100 * need:g}%)" + _finite_note(bad),
-                                  {"agreement": agree, "required": need, "nonfinite": bad, "faces": soup.n_faces})
+                return CaseResult(
+                    "similarity",
+                    f"{name}: {label}",
+                    ok,
+                    f"agreement {100 * agree:.4f}% of area (need >= {100 * need:g}%)" + _finite_note(bad),
+                    {"agreement": agree, "required": need, "nonfinite": bad, "faces": soup.n_faces},
+                )
+
             out.append(_timed(case))
     return out
 
@@ -391,45 +424,83 @@ def degenerate_cases(models: dict[str, Soup], rays_per_node: int, seed: int) -> 
             n_flip = int(np.sum(np.any(ref.side_outside[parent] != c.side_outside, axis=1) & sliver))
             ar = float(aspect_ratios(s).max())
             bad = nonfinite(c)
-            return CaseResult("degenerate", f"{name}: slivers (aspect ratio up to {ar:.1e})",
-                              agree >= AGREEMENT and not bad,
-                              f"agreement {100 * agree:.4f}% of area; {n_flip} of {int(sliver.sum())} slivers "
-                              f"differ from their face" + _finite_note(bad),
-                              {"agreement": agree, "max_aspect_ratio": ar, "slivers": int(sliver.sum()),
-                               "slivers_differing": n_flip, "nonfinite": bad})
+            return CaseResult(
+                "degenerate",
+                f"{name}: slivers (aspect ratio up to {ar:.1e})",
+                agree >= AGREEMENT and not bad,
+                f"agreement {100 * agree:.4f}% of area; {n_flip} of {int(sliver.sum())} slivers "
+                f"differ from their face" + _finite_note(bad),
+                {
+                    "agreement": agree,
+                    "max_aspect_ratio": ar,
+                    "slivers": int(sliver.sum()),
+                    "slivers_differing": n_flip,
+                    "nonfinite": bad,
+                },
+            )
 
-        def appended_case(label: str, make: Callable[[], Soup], extra: Callable[[Classification], dict]) -> CaseResult:
+        def appended_case(
+            label: str, make: Callable[[], Soup], extra: Callable[[Classification], dict]
+        ) -> CaseResult:
             s = make()
             c = classify(s, rays_per_node=rays_per_node, seed=seed)
             agree = area_agreement(ref.side_outside, c.side_outside[:m], soup.areas)
             bad = nonfinite(c)
             info = extra(c)
             tail = "; ".join(f"{k.replace('_', ' ')} {v}" for k, v in info.items())
-            return CaseResult("degenerate", f"{name}: {label}", agree >= AGREEMENT and not bad,
-                              f"original faces agree on {100 * agree:.4f}% of area; {tail}" + _finite_note(bad),
-                              {"agreement": agree, "added_faces": s.n_faces - m, **info, "nonfinite": bad})
+            return CaseResult(
+                "degenerate",
+                f"{name}: {label}",
+                agree >= AGREEMENT and not bad,
+                f"original faces agree on {100 * agree:.4f}% of area; {tail}" + _finite_note(bad),
+                {"agreement": agree, "added_faces": s.n_faces - m, **info, "nonfinite": bad},
+            )
 
         out.append(_timed(sliver_case))
-        out.append(_timed(lambda: appended_case(
-            "zero-area faces (+10%)", lambda: add_zero_area(soup, seed=seed),
-            lambda c: {"degenerate_faces": int(c.degenerate.sum()),
-                       "added_classified_outside": int(c.side_outside[m:].any(axis=1).sum())})))
-        out.append(_timed(lambda: appended_case(
-            "duplicate faces (+10% same, +10% reversed)", lambda: add_duplicates(soup, seed=seed),
-            lambda c: {"flagged_faces": int(c.flagged.sum())})))
-        out.append(_timed(lambda: appended_case(
-            "near-coplanar copies 1e-7 x size away (+10%)", lambda: add_near_coplanar(soup, 1e-7, seed=seed),
-            lambda c: {"flagged_faces": int(c.flagged.sum())})))
+        out.append(
+            _timed(
+                lambda: appended_case(
+                    "zero-area faces (+10%)",
+                    lambda: add_zero_area(soup, seed=seed),
+                    lambda c: {
+                        "degenerate_faces": int(c.degenerate.sum()),
+                        "added_classified_outside": int(c.side_outside[m:].any(axis=1).sum()),
+                    },
+                )
+            )
+        )
+        out.append(
+            _timed(
+                lambda: appended_case(
+                    "duplicate faces (+10% same, +10% reversed)",
+                    lambda: add_duplicates(soup, seed=seed),
+                    lambda c: {"flagged_faces": int(c.flagged.sum())},
+                )
+            )
+        )
+        out.append(
+            _timed(
+                lambda: appended_case(
+                    "near-coplanar copies 1e-7 x size away (+10%)",
+                    lambda: add_near_coplanar(soup, 1e-7, seed=seed),
+                    lambda c: {"flagged_faces": int(c.flagged.sum())},
+                )
+            )
+        )
 
         def perturbed_case() -> CaseResult:
             s = perturb_corners(soup, 1e-9, seed=seed)
             c = classify(s, rays_per_node=rays_per_node, seed=seed)
             agree = area_agreement(ref.side_outside, c.side_outside, soup.areas)
             bad = nonfinite(c)
-            return CaseResult("degenerate", f"{name}: corners unwelded and moved by 1e-9 x size",
-                              agree >= AGREEMENT and not bad,
-                              f"agreement {100 * agree:.4f}% of area; {int(c.flagged.sum())} faces flagged"
-                              + _finite_note(bad), {"agreement": agree, "nonfinite": bad})
+            return CaseResult(
+                "degenerate",
+                f"{name}: corners unwelded and moved by 1e-9 x size",
+                agree >= AGREEMENT and not bad,
+                f"agreement {100 * agree:.4f}% of area; {int(c.flagged.sum())} faces flagged"
+                + _finite_note(bad),
+                {"agreement": agree, "nonfinite": bad},
+            )
 
         out.append(_timed(perturbed_case))
     return out
@@ -446,8 +517,9 @@ def _side_nodes(c: Classification, faces: np.ndarray, side: int) -> np.ndarray:
     return np.unique(np.concatenate([cl, nodes.point_node(pts, np.full(len(pts), side))]))
 
 
-def escape_share(c: Classification, faces: np.ndarray, side: int, n_rays: int, seed: int = 0,
-                 per_node: bool = False) -> float | tuple[float, np.ndarray, np.ndarray]:
+def escape_share(
+    c: Classification, faces: np.ndarray, side: int, n_rays: int, seed: int = 0, per_node: bool = False
+) -> float | tuple[float, np.ndarray, np.ndarray]:
     """Measured share of the cosine rays from one side of ``faces`` that escape the model.
 
     Casts about ``n_rays`` rays with the classifier's own sampling
@@ -477,8 +549,14 @@ def escape_share(c: Classification, faces: np.ndarray, side: int, n_rays: int, s
     return share, nodes, counts.escaped[nodes] / np.maximum(counted, 1)
 
 
-def crack_sweep(widths: Iterable[float], cell: float, rays_per_node: int, seed: int, share_rays: int,
-                opening: float = DEFAULT_OPENING) -> list[dict]:
+def crack_sweep(
+    widths: Iterable[float],
+    cell: float,
+    rays_per_node: int,
+    seed: int,
+    share_rays: int,
+    opening: float = DEFAULT_OPENING,
+) -> list[dict]:
     """Classify :func:`meshvis.eval.generators.cracked_box` for every crack width.
 
     Returns
@@ -507,26 +585,34 @@ def crack_sweep(widths: Iterable[float], cell: float, rays_per_node: int, seed: 
         paper = classify(s, rays_per_node=rays_per_node, seed=seed, opening=None)
         measured, measured_nodes, node_share = escape_share(c, box, 1, share_rays, seed, per_node=True)
         big = c.nodes.area[measured_nodes] >= 0.01 * c.nodes.area[measured_nodes].sum()
-        rows.append({
-            "width": w,
-            "inner_outside": float((c.side_outside[inner].any(axis=1) * A[inner]).sum() / A[inner].sum()),
-            "box_inner_side_outside": float((c.side_outside[box, 1] * A[box]).sum() / A[box].sum()),
-            "share_classifier": float(c.counts.escaped[nodes].sum() / max(counted.sum(), 1)),
-            "share_measured": measured,
-            # spread over the walls (nodes of at least 1 % of the inner-side area)
-            "share_measured_min": float(node_share[big].min()), "share_measured_max": float(node_share[big].max()),
-            "w_out": float(wt.w_out[nodes].sum()), "w_in": float(wt.w_in[nodes].sum()),
-            "cap_out": float(wt.cap_out[nodes].sum()), "cap_in": float(wt.cap_in[nodes].sum()),
-            "paper_inner_outside": float((paper.side_outside[inner].any(axis=1) * A[inner]).sum() / A[inner].sum()),
-            "flagged": int(c.flagged.sum()),
-            "rays": c.n_rays,
-            "nonfinite": nonfinite(c) + nonfinite(paper),
-        })
+        rows.append(
+            {
+                "width": w,
+                "inner_outside": float((c.side_outside[inner].any(axis=1) * A[inner]).sum() / A[inner].sum()),
+                "box_inner_side_outside": float((c.side_outside[box, 1] * A[box]).sum() / A[box].sum()),
+                "share_classifier": float(c.counts.escaped[nodes].sum() / max(counted.sum(), 1)),
+                "share_measured": measured,
+                # spread over the walls (nodes of at least 1 % of the inner-side area)
+                "share_measured_min": float(node_share[big].min()),
+                "share_measured_max": float(node_share[big].max()),
+                "w_out": float(wt.w_out[nodes].sum()),
+                "w_in": float(wt.w_in[nodes].sum()),
+                "cap_out": float(wt.cap_out[nodes].sum()),
+                "cap_in": float(wt.cap_in[nodes].sum()),
+                "paper_inner_outside": float(
+                    (paper.side_outside[inner].any(axis=1) * A[inner]).sum() / A[inner].sum()
+                ),
+                "flagged": int(c.flagged.sum()),
+                "rays": c.n_rays,
+                "nonfinite": nonfinite(c) + nonfinite(paper),
+            }
+        )
     return rows
 
 
-def slit_transmission(widths: Iterable[float], positions: Iterable[float] = (0.9, 0.3), n_rays: int = 20_000,
-                      seed: int = 0) -> list[dict]:
+def slit_transmission(
+    widths: Iterable[float], positions: Iterable[float] = (0.9, 0.3), n_rays: int = 20_000, seed: int = 0
+) -> list[dict]:
     """Share of straight rays that pass through a slit of width ``w`` × diagonal, as Embree sees it.
 
     The model: two coplanar rectangles in z = 0 spanning x ∈ [−1, 1], y ∈ [−0.2, 0.2]
@@ -548,21 +634,45 @@ def slit_transmission(widths: Iterable[float], positions: Iterable[float] = (0.9
     for x0 in positions:
         for w in widths:
             h = 0.5 * w * D
-            V = np.array([[-1, -.2, 0], [x0 - h, -.2, 0], [x0 - h, .2, 0], [-1, .2, 0],
-                          [x0 + h, -.2, 0], [1, -.2, 0], [1, .2, 0], [x0 + h, .2, 0]], float)
+            V = np.array(
+                [
+                    [-1, -0.2, 0],
+                    [x0 - h, -0.2, 0],
+                    [x0 - h, 0.2, 0],
+                    [-1, 0.2, 0],
+                    [x0 + h, -0.2, 0],
+                    [1, -0.2, 0],
+                    [1, 0.2, 0],
+                    [x0 + h, 0.2, 0],
+                ],
+                float,
+            )
             rc = RayCaster((V, np.array([[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]])))
             rng = np.random.default_rng(seed)
-            o = np.stack([x0 + rng.uniform(-0.5, 0.5, n_rays) * w * D, rng.uniform(-0.15, 0.15, n_rays),
-                          np.full(n_rays, 0.1)], axis=1)
+            o = np.stack(
+                [
+                    x0 + rng.uniform(-0.5, 0.5, n_rays) * w * D,
+                    rng.uniform(-0.15, 0.15, n_rays),
+                    np.full(n_rays, 0.1),
+                ],
+                axis=1,
+            )
             hit = rc.intersect(o, np.broadcast_to([0.0, 0.0, -1.0], o.shape)).face >= 0
             u = np.float32((x0 - rc.center[0]) * rc.scale)
-            rows.append({"width": w, "position": x0, "spacing": float(np.spacing(u)),
-                         "transmitted": float(1.0 - hit.mean())})
+            rows.append(
+                {
+                    "width": w,
+                    "position": x0,
+                    "spacing": float(np.spacing(u)),
+                    "transmitted": float(1.0 - hit.mean()),
+                }
+            )
     return rows
 
 
-def offset_probe(widths: Iterable[float], offsets: Iterable[float], n_rays: int, cell: float = 0.1,
-                 seed: int = 0) -> list[dict]:
+def offset_probe(
+    widths: Iterable[float], offsets: Iterable[float], n_rays: int, cell: float = 0.1, seed: int = 0
+) -> list[dict]:
     """Escape share of the cracked box's inner sides for narrow cracks, with two ray offsets.
 
     For every ray ``offset`` (fraction of the diagonal) and crack ``width``, the share is
@@ -582,14 +692,28 @@ def offset_probe(widths: Iterable[float], offsets: Iterable[float], n_rays: int,
             box = np.flatnonzero(s.part_id == s.part_names.index("box"))
             c = classify(s, rays_per_node=4, seed=seed, offset=off, progressive=False)
             e = escape_share(c, box, 1, n_rays, seed + 1)
-            rows.append({"width": w, "offset": off, "share": e, "share_per_width": e / w,
-                         "escaped": int(round(e * n_rays))})
+            rows.append(
+                {
+                    "width": w,
+                    "offset": off,
+                    "share": e,
+                    "share_per_width": e / w,
+                    "escaped": int(round(e * n_rays)),
+                }
+            )
     return rows
 
 
-def crack_case(widths: Iterable[float], cell: float, rays_per_node: int, seed: int, share_rays: int,
-               slit_widths: Iterable[float] = (), offset_widths: Iterable[float] = (),
-               offset_rays: int = 0) -> CaseResult:
+def crack_case(
+    widths: Iterable[float],
+    cell: float,
+    rays_per_node: int,
+    seed: int,
+    share_rays: int,
+    slit_widths: Iterable[float] = (),
+    offset_widths: Iterable[float] = (),
+    offset_rays: int = 0,
+) -> CaseResult:
     """Group 3: from which crack width the interior leaks; passes when leaking is monotone in the width.
 
     The figures behind the explanation come with it: the escape shares, the terminal
@@ -600,8 +724,13 @@ def crack_case(widths: Iterable[float], cell: float, rays_per_node: int, seed: i
     widths = sorted(widths, reverse=True)
     rows = crack_sweep(widths, cell, rays_per_node, seed, share_rays)
     slits = slit_transmission(sorted(slit_widths, reverse=True), seed=seed) if slit_widths else []
-    offsets = offset_probe(sorted(offset_widths, reverse=True), (DEFAULT_OFFSET, DEFAULT_OFFSET / 10), offset_rays,
-                           seed=seed) if offset_widths and offset_rays else []
+    offsets = (
+        offset_probe(
+            sorted(offset_widths, reverse=True), (DEFAULT_OFFSET, DEFAULT_OFFSET / 10), offset_rays, seed=seed
+        )
+        if offset_widths and offset_rays
+        else []
+    )
     leak = np.array([r["inner_outside"] for r in rows])
     # narrower cracks may not leak more than wider ones (1e-3 of the area for rounding)
     monotone = bool(np.all(np.diff(leak) <= 1e-3))
@@ -615,12 +744,23 @@ def crack_case(widths: Iterable[float], cell: float, rays_per_node: int, seed: i
     else:
         fig = f"interior holds at every width tried (up to {max(holding):g})"
     fig += "; monotone" if monotone else "; NOT MONOTONE"
-    return CaseResult("cracks", "cracked box with an inner box, crack width sweep", monotone and not bad,
-                      fig + _finite_note(bad),
-                      {"leak_from": min(leaking) if leaking else None, "holds_to": max(holding) if holding else None,
-                       "monotone": monotone, "nonfinite": bad, "cell": cell, "share_rays": share_rays,
-                       "slit_transmission": slits, "offset_probe": offsets},
-                      table=rows)
+    return CaseResult(
+        "cracks",
+        "cracked box with an inner box, crack width sweep",
+        monotone and not bad,
+        fig + _finite_note(bad),
+        {
+            "leak_from": min(leaking) if leaking else None,
+            "holds_to": max(holding) if holding else None,
+            "monotone": monotone,
+            "nonfinite": bad,
+            "cell": cell,
+            "share_rays": share_rays,
+            "slit_transmission": slits,
+            "offset_probe": offsets,
+        },
+        table=rows,
+    )
 
 
 def _cut_edges(outside: np.ndarray, w) -> int:
@@ -658,11 +798,16 @@ def compare_solvers(c: Classification) -> dict:
     differ = np.any(fp != fs, axis=1)
     A = c.soup.areas
     return {
-        "value_pymaxflow": pm.value, "value_scipy": sc.value, "difference": abs(sc.value - pm.value),
-        "bound": bound, "cut_edges": k, "scale": sc.scale,
+        "value_pymaxflow": pm.value,
+        "value_scipy": sc.value,
+        "difference": abs(sc.value - pm.value),
+        "bound": bound,
+        "cut_edges": k,
+        "scale": sc.scale,
         "edge_weight_orders": float(np.log10(ew.max() / ew.min())) if len(ew) else 0.0,
         "capacity_orders": float(np.log10(pos.max() / pos.min())) if len(pos) else 0.0,
-        "capacities_rounded_to_zero": int(len(lost)), "capacities": int(len(pos)),
+        "capacities_rounded_to_zero": int(len(lost)),
+        "capacities": int(len(pos)),
         "lost_share_of_cut": float(lost.sum() / pm.value) if pm.value > 0 else 0.0,
         "nodes_differing": int(np.sum(pm.outside != sc.outside)),
         "faces_differing": int(differ.sum()),
@@ -671,10 +816,13 @@ def compare_solvers(c: Classification) -> dict:
     }
 
 
-def weight_cases(models: dict[str, Soup], rays_per_node: int, seed: int, require_span: set[str]) -> list[CaseResult]:
+def weight_cases(
+    models: dict[str, Soup], rays_per_node: int, seed: int, require_span: set[str]
+) -> list[CaseResult]:
     """Group 4: both max-flow solvers on the same graph (weights spanning 12+ orders for the tiny-cube model)."""
     out = []
     for name, soup in models.items():
+
         def case(name=name, soup=soup) -> CaseResult:
             c = classify(soup, rays_per_node=rays_per_node, seed=seed)
             r = compare_solvers(c)
@@ -683,12 +831,14 @@ def weight_cases(models: dict[str, Soup], rays_per_node: int, seed: int, require
             ok_value = r["difference"] <= r["bound"] + slack
             ok_span = name not in require_span or r["edge_weight_orders"] >= WEIGHT_ORDERS
             ok = ok_value and ok_span and r["agreement"] >= AGREEMENT and not bad
-            fig = (f"edge weights span {r['edge_weight_orders']:.1f} orders; cut {r['value_pymaxflow']:.6g} vs "
-                   f"{r['value_scipy']:.6g}, |diff| {r['difference']:.2e} <= bound {r['bound']:.2e}: "
-                   f"{'yes' if ok_value else 'NO'}; labels agree on {100 * r['agreement']:.4f}% of area; "
-                   f"rounding lost {r['capacities_rounded_to_zero']} of {r['capacities']} capacities "
-                   f"({r['lost_share_of_cut']:.1e} of the cut), {r['faces_differing']} faces "
-                   f"({r['area_differing']:.1e} of area) labelled differently")
+            fig = (
+                f"edge weights span {r['edge_weight_orders']:.1f} orders; cut {r['value_pymaxflow']:.6g} vs "
+                f"{r['value_scipy']:.6g}, |diff| {r['difference']:.2e} <= bound {r['bound']:.2e}: "
+                f"{'yes' if ok_value else 'NO'}; labels agree on {100 * r['agreement']:.4f}% of area; "
+                f"rounding lost {r['capacities_rounded_to_zero']} of {r['capacities']} capacities "
+                f"({r['lost_share_of_cut']:.1e} of the cut), {r['faces_differing']} faces "
+                f"({r['area_differing']:.1e} of area) labelled differently"
+            )
             if not ok_span:
                 fig += f"; SPAN BELOW {WEIGHT_ORDERS} ORDERS"
             table = []
@@ -696,11 +846,23 @@ def weight_cases(models: dict[str, Soup], rays_per_node: int, seed: int, require
                 # how each tiny cube came out (pymaxflow): its outer and inner sides
                 for p, pname in enumerate(soup.part_names):
                     sel = soup.part_id == p
-                    table.append({"part": pname, "faces": int(sel.sum()),
-                                  "front_outside": float(c.side_outside[sel, 0].mean()),
-                                  "back_outside": float(c.side_outside[sel, 1].mean())})
-            return CaseResult("weights", f"{name}: pymaxflow vs scipy (integer) on one graph", ok,
-                              fig + _finite_note(bad), {**r, "nonfinite": bad}, table=table)
+                    table.append(
+                        {
+                            "part": pname,
+                            "faces": int(sel.sum()),
+                            "front_outside": float(c.side_outside[sel, 0].mean()),
+                            "back_outside": float(c.side_outside[sel, 1].mean()),
+                        }
+                    )
+            return CaseResult(
+                "weights",
+                f"{name}: pymaxflow vs scipy (integer) on one graph",
+                ok,
+                fig + _finite_note(bad),
+                {**r, "nonfinite": bad},
+                table=table,
+            )
+
         out.append(_timed(case))
     return out
 
@@ -727,6 +889,7 @@ def tiny_cases(rays_per_node: int, seed: int, folder: str | None = None) -> list
     out = []
     with tempfile.TemporaryDirectory(dir=folder) as tmp:
         for label, text in _OBJ.items():
+
             def case(label=label, text=text) -> CaseResult:
                 path = os.path.join(tmp, label.split(" (")[0].replace(" ", "_") + ".obj")
                 with open(path, "w") as fh:
@@ -734,13 +897,22 @@ def tiny_cases(rays_per_node: int, seed: int, folder: str | None = None) -> list
                 c = classify(path, rays_per_node=rays_per_node, seed=seed)
                 bad = nonfinite(c)
                 ok = bool(c.side_outside.all())
-                fig = f"{c.soup.n_faces} face(s), {int(c.side_outside.sum())} of {2 * c.soup.n_faces} sides " \
-                      f"outside (expected all: a lone sheet is seen from both sides)"
-                return CaseResult("tiny", label, ok and not bad, fig + _finite_note(bad),
-                                  {"faces": c.soup.n_faces, "sides_outside": int(c.side_outside.sum()), "nonfinite": bad})
+                fig = (
+                    f"{c.soup.n_faces} face(s), {int(c.side_outside.sum())} of {2 * c.soup.n_faces} sides "
+                    f"outside (expected all: a lone sheet is seen from both sides)"
+                )
+                return CaseResult(
+                    "tiny",
+                    label,
+                    ok and not bad,
+                    fig + _finite_note(bad),
+                    {"faces": c.soup.n_faces, "sides_outside": int(c.side_outside.sum()), "nonfinite": bad},
+                )
+
             out.append(_timed(case))
 
         for label, text in _BAD_OBJ.items():
+
             def error_case(label=label, text=text) -> CaseResult:
                 path = os.path.join(tmp, label.replace(" ", "_") + ".obj")
                 with open(path, "w") as fh:
@@ -750,19 +922,34 @@ def tiny_cases(rays_per_node: int, seed: int, folder: str | None = None) -> list
                 except ModelError as exc:
                     msg = str(exc)
                     ok = path in msg and "\n" not in msg
-                    return CaseResult("tiny", label, ok, f"ModelError: {msg.replace(tmp, '<tmp>')}",
-                                      {"error": type(exc).__name__, "names_file": path in msg})
+                    return CaseResult(
+                        "tiny",
+                        label,
+                        ok,
+                        f"ModelError: {msg.replace(tmp, '<tmp>')}",
+                        {"error": type(exc).__name__, "names_file": path in msg},
+                    )
                 except Exception as exc:  # anything else is a bug
-                    return CaseResult("tiny", label, False, f"{type(exc).__name__} instead of ModelError: {exc}",
-                                      {"error": type(exc).__name__})
+                    return CaseResult(
+                        "tiny",
+                        label,
+                        False,
+                        f"{type(exc).__name__} instead of ModelError: {exc}",
+                        {"error": type(exc).__name__},
+                    )
                 return CaseResult("tiny", label, False, "no error raised", {"error": None})
+
             out.append(_timed(error_case))
     return out
 
 
 # ============================================================================ the run
-def run(quick: bool = False, seed: int = 0, rays_per_node: int = 32,
-        progress: Callable[[CaseResult], None] | None = None) -> dict:
+def run(
+    quick: bool = False,
+    seed: int = 0,
+    rays_per_node: int = 32,
+    progress: Callable[[CaseResult], None] | None = None,
+) -> dict:
     """Run every stability case.
 
     Parameters
@@ -792,12 +979,29 @@ def run(quick: bool = False, seed: int = 0, rays_per_node: int = 32,
     if not quick:
         base["house"] = generators.house(seed=seed).soup
     emit(similarity_cases(base, SCALES_QUICK if quick else SCALES_FULL, rays_per_node, seed))
-    emit(degenerate_cases({"nested spheres": shells} if quick else {"nested spheres": shells, "house": base["house"]},
-                          rays_per_node, seed))
-    emit([_timed(lambda: crack_case(CRACK_WIDTHS_QUICK if quick else CRACK_WIDTHS_FULL, 0.1 if quick else 0.05,
-                                    rays_per_node, seed, SHARE_RAYS_QUICK if quick else SHARE_RAYS_FULL,
-                                    SLIT_WIDTHS_QUICK if quick else SLIT_WIDTHS_FULL,
-                                    () if quick else OFFSET_WIDTHS, OFFSET_RAYS))])
+    emit(
+        degenerate_cases(
+            {"nested spheres": shells} if quick else {"nested spheres": shells, "house": base["house"]},
+            rays_per_node,
+            seed,
+        )
+    )
+    emit(
+        [
+            _timed(
+                lambda: crack_case(
+                    CRACK_WIDTHS_QUICK if quick else CRACK_WIDTHS_FULL,
+                    0.1 if quick else 0.05,
+                    rays_per_node,
+                    seed,
+                    SHARE_RAYS_QUICK if quick else SHARE_RAYS_FULL,
+                    SLIT_WIDTHS_QUICK if quick else SLIT_WIDTHS_FULL,
+                    () if quick else OFFSET_WIDTHS,
+                    OFFSET_RAYS,
+                )
+            )
+        ]
+    )
     wmodels = {TINY_NAME: tiny_beside_huge(), "cracked box": cracked}
     if not quick:
         wmodels["house"] = base["house"]
@@ -807,11 +1011,18 @@ def run(quick: bool = False, seed: int = 0, rays_per_node: int = 32,
 
     cases = [asdict(r) for r in results]
     return {
-        "quick": quick, "seed": seed, "rays_per_node": rays_per_node,
-        "passed": sum(r.passed for r in results), "failed": sum(not r.passed for r in results),
+        "quick": quick,
+        "seed": seed,
+        "rays_per_node": rays_per_node,
+        "passed": sum(r.passed for r in results),
+        "failed": sum(not r.passed for r in results),
         "seconds": time.perf_counter() - t0,
-        "machine": {"python": platform.python_version(), "platform": platform.platform(),
-                    "processor": platform.processor() or platform.machine(), "cpus": os.cpu_count()},
+        "machine": {
+            "python": platform.python_version(),
+            "platform": platform.platform(),
+            "processor": platform.processor() or platform.machine(),
+            "cpus": os.cpu_count(),
+        },
         "cases": cases,
     }
 
@@ -822,28 +1033,36 @@ def format_case(r: CaseResult | dict) -> str:
     line = f"{'PASS' if d['passed'] else 'FAIL'}  [{d['group']}] {d['name']}: {d['figure']}  ({d['seconds']:.2f} s)"
     rows = d.get("table") or []
     if rows and "width" in rows[0]:
-        line += ("\n      width     inner box out  inner sides out  escape share: classifier  measured (walls min..max)"
-                 "  w_out -> filtered   w_in -> filtered   paper prior: inner out  flagged")
+        line += (
+            "\n      width     inner box out  inner sides out  escape share: classifier  measured (walls min..max)"
+            "  w_out -> filtered   w_in -> filtered   paper prior: inner out  flagged"
+        )
         for t in rows:
-            line += (f"\n      {t['width']:<9.2g} {100 * t['inner_outside']:>11.1f}%  {100 * t['box_inner_side_outside']:>14.1f}%"
-                     f"  {t['share_classifier']:>18.5f}  {t['share_measured']:.2e} ({t['share_measured_min']:.2e}"
-                     f"..{t['share_measured_max']:.2e})"
-                     f"  {t['w_out']:8.3g} -> {t['cap_out']:<8.3g} {t['w_in']:8.3g} -> {t['cap_in']:<8.3g}"
-                     f" {100 * t['paper_inner_outside']:>18.1f}%  {t['flagged']:>7d}")
+            line += (
+                f"\n      {t['width']:<9.2g} {100 * t['inner_outside']:>11.1f}%  {100 * t['box_inner_side_outside']:>14.1f}%"
+                f"  {t['share_classifier']:>18.5f}  {t['share_measured']:.2e} ({t['share_measured_min']:.2e}"
+                f"..{t['share_measured_max']:.2e})"
+                f"  {t['w_out']:8.3g} -> {t['cap_out']:<8.3g} {t['w_in']:8.3g} -> {t['cap_in']:<8.3g}"
+                f" {100 * t['paper_inner_outside']:>18.1f}%  {t['flagged']:>7d}"
+            )
         slits = d.get("values", {}).get("slit_transmission") or []
         if slits:
-            line += "\n      float32 probe: straight rays across a slit, share transmitted (slit at two places)"
+            line += (
+                "\n      float32 probe: straight rays across a slit, share transmitted (slit at two places)"
+            )
             for x0 in sorted({t["position"] for t in slits}, reverse=True):
                 sel = [t for t in slits if t["position"] == x0]
-                line += (f"\n      float32 spacing {sel[0]['spacing']:.2e} x D: "
-                         + ", ".join(f"{t['width']:g}: {100 * t['transmitted']:.0f}%" for t in sel))
+                line += f"\n      float32 spacing {sel[0]['spacing']:.2e} x D: " + ", ".join(
+                    f"{t['width']:g}: {100 * t['transmitted']:.0f}%" for t in sel
+                )
         probe = d.get("values", {}).get("offset_probe") or []
         if probe:
             line += "\n      ray-offset probe: escape share / width of the inner sides (escaped rays)"
             for off in sorted({t["offset"] for t in probe}, reverse=True):
                 sel = [t for t in probe if t["offset"] == off]
-                line += (f"\n      offset {off:g} x D: "
-                         + ", ".join(f"{t['width']:g}: {t['share_per_width']:.2f} ({t['escaped']})" for t in sel))
+                line += f"\n      offset {off:g} x D: " + ", ".join(
+                    f"{t['width']:g}: {t['share_per_width']:.2f} ({t['escaped']})" for t in sel
+                )
     elif rows and "part" in rows[0]:
         line += "\n      part            faces  front outside  back outside"
         for t in rows:
@@ -855,15 +1074,19 @@ def format(result: dict) -> str:
     """The printed report: one line per case, then the count."""
     lines = [format_case(c) for c in result["cases"]]
     total = result["passed"] + result["failed"]
-    lines.append(f"stability{' (quick)' if result['quick'] else ''}: {result['passed']} of {total} cases passed, "
-                 f"{result['failed']} failed ({result['seconds']:.1f} s)")
+    lines.append(
+        f"stability{' (quick)' if result['quick'] else ''}: {result['passed']} of {total} cases passed, "
+        f"{result['failed']} failed ({result['seconds']:.1f} s)"
+    )
     return "\n".join(lines)
 
 
 # ============================================================================ command line
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     """Arguments of ``meshvis bench stability``."""
-    parser.add_argument("--quick", action="store_true", help="reduced set (fewer scales and widths, smaller models)")
+    parser.add_argument(
+        "--quick", action="store_true", help="reduced set (fewer scales and widths, smaller models)"
+    )
     parser.add_argument("--seed", type=int, default=0, help="seed of every classification (default 0)")
     parser.add_argument("--rays-per-node", type=int, default=32, help="ray budget per node (default 32)")
     parser.add_argument("--json", metavar="FILE", help="also write every number as JSON")
@@ -873,12 +1096,17 @@ def main(args: argparse.Namespace) -> int:
     """Run the cases, print one line each as they finish and the count; 1 if any case failed."""
     from meshvis.io.jsonfile import write_json
 
-    result = run(quick=bool(getattr(args, "quick", False)), seed=int(getattr(args, "seed", 0)),
-                 rays_per_node=int(getattr(args, "rays_per_node", 32)),
-                 progress=lambda r: print(format_case(r), flush=True))
+    result = run(
+        quick=bool(getattr(args, "quick", False)),
+        seed=int(getattr(args, "seed", 0)),
+        rays_per_node=int(getattr(args, "rays_per_node", 32)),
+        progress=lambda r: print(format_case(r), flush=True),
+    )
     total = result["passed"] + result["failed"]
-    print(f"stability{' (quick)' if result['quick'] else ''}: {result['passed']} of {total} cases passed, "
-          f"{result['failed']} failed ({result['seconds']:.1f} s)")
+    print(
+        f"stability{' (quick)' if result['quick'] else ''}: {result['passed']} of {total} cases passed, "
+        f"{result['failed']} failed ({result['seconds']:.1f} s)"
+    )
     if getattr(args, "json", None):
         write_json(args.json, result)
     return 1 if result["failed"] else 0
