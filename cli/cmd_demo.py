@@ -21,7 +21,7 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from meshvis.repair.demo import DEMO_FILES, run_demo
+    from meshvis.eval.demo import DEMO_FILES, run_demo
 
     if os.path.exists(args.out) and not os.path.isdir(args.out):
         raise OutputError("exists and is not a folder", args.out)

@@ -29,7 +29,7 @@ COMMANDS = {
 
 
 def build_parser() -> argparse.ArgumentParser:
-    from meshvis import __version__
+    from meshvis._version import __version__
 
     parser = argparse.ArgumentParser(
         prog="meshvis",

@@ -26,8 +26,7 @@ from __future__ import annotations
 import importlib
 from typing import Any
 
-__version__ = "0.1.0"
-
+from meshvis._version import __version__  # noqa: E402
 from meshvis.errors import (  # noqa: E402
     MeshvisError,
     ModelError,

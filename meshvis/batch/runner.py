@@ -956,7 +956,7 @@ def write_summary(result: BatchResult, out_dir: str, meta: dict | None = None) -
     rows under ``"files"``, plus ``meta`` (operation, options, ...), the counts per status,
     the wall time and whether the batch was interrupted.
     """
-    from meshvis import __version__
+    from meshvis._version import __version__
 
     csv_path = os.path.join(out_dir, "summary.csv")
     json_path = os.path.join(out_dir, "summary.json")

@@ -1,4 +1,4 @@
 """Evaluation: generated models with known answers (:mod:`~meshvis.eval.generators`), error
 measures (:mod:`~meshvis.eval.metrics`), the baselines a user would pick instead
-(:mod:`~meshvis.eval.baselines`) and the ``meshvis bench`` commands
-(:mod:`meshvis.eval.bench`)."""
+(:mod:`~meshvis.eval.baselines`), the ``meshvis bench`` commands (:mod:`meshvis.eval.bench`)
+and the demo on the bundled model (:mod:`~meshvis.eval.demo`)."""

@@ -26,7 +26,7 @@ from typing import Any
 
 import numpy as np
 
-from meshvis import __version__
+from meshvis._version import __version__
 from meshvis.errors import ModelError, ParameterError
 from meshvis.graphcut.hints import Hints, hint_weights
 from meshvis.graphcut.mincut import SOLVERS, Cut, VisibilityGraph

@@ -308,7 +308,7 @@ def machine() -> dict:
             versions[mod] = str(getattr(m, "__version__", "") or _dist_version(mod))
         except Exception:
             versions[mod] = "missing"
-    from meshvis import __version__
+    from meshvis._version import __version__
 
     return {
         "cpu": cpu,

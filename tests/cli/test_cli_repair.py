@@ -3,6 +3,7 @@ with known answers and on a real textured model."""
 
 import json
 import os
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,7 +12,7 @@ from meshvis.cli.main import main
 from meshvis.eval import generators as G
 from meshvis.io import load, save
 
-REAL = G.real_models_dir()
+REAL = Path(__file__).resolve().parents[3] / "shared" / "models" / "real"
 
 
 def area_fraction(mask, areas):
@@ -128,7 +129,7 @@ def test_orient_cli_options_two_sided_duplicate(tmp_path):
 
 
 def test_demo_writes_everything(tmp_path):
-    from meshvis.repair.demo import DEMO_FILES
+    from meshvis.eval.demo import DEMO_FILES
 
     folder = tmp_path / "demo"
     assert main(["demo", "--out", str(folder), "--size", "96", "-q"]) == 0

@@ -26,7 +26,7 @@ from meshvis.labeling.pipeline import fit_camera, solve
 from meshvis.rays.camera import Camera
 from meshvis.soup import Soup
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 REAL = os.path.join(ROOT, "..", "shared", "models", "real")
 SIZE = (256, 256)
 

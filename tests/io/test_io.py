@@ -18,7 +18,7 @@ from meshvis.io.ply import read_elements
 from meshvis.io.triangulate import ear_clip, triangulate
 from meshvis.soup import Material, Soup
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 REAL = os.path.normpath(os.path.join(ROOT, "..", "shared", "models", "real"))
 README = os.path.normpath(os.path.join(ROOT, "..", "shared", "models", "README.md"))
 

@@ -22,7 +22,7 @@ from meshvis.eval.generators import GroundTruth
 from meshvis.geometry.adjacency import weld
 from meshvis.soup import Soup, validate
 
-ROOT = Path(__file__).resolve().parents[1]
+ROOT = Path(__file__).resolve().parents[2]
 MODELS = ROOT / "models"
 
 # small settings for the slow-ish generators; defaults are exercised by test_defaults
@@ -406,7 +406,7 @@ def _exact_sides_winding(V, F, faces, eps):
 
 
 def test_from_closed_real_model():
-    path = g.real_models_dir() / "cow.obj"
+    path = ROOT.parent / "shared" / "models" / "real" / "cow.obj"
     if not path.exists():
         pytest.skip("real models not available")
     t = g.from_closed_mesh(path)

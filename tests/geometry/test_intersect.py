@@ -246,7 +246,7 @@ def test_real_model_agrees_with_meshlab():
     import os
 
     pymeshlab = pytest.importorskip("pymeshlab")
-    path = os.path.join(os.path.dirname(__file__), "..", "..", "shared", "models", "real", "cow.obj")
+    path = os.path.join(os.path.dirname(__file__), "..", "..", "..", "shared", "models", "real", "cow.obj")
     if not os.path.exists(path):
         pytest.skip("real models not available")
     import trimesh

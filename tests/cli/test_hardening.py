@@ -22,7 +22,7 @@ import pytest
 import meshvis.io as mio
 from meshvis.cli.main import build_parser, main
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 FORMATS = ("obj", "ply", "stl", "off", "glb", "gltf", "3mf")
 IS_ROOT = hasattr(os, "geteuid") and os.geteuid() == 0
 

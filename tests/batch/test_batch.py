@@ -22,7 +22,7 @@ import meshvis.io as mio
 from meshvis.cli.main import main
 from meshvis.errors import ParameterError
 
-ROOT = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
 
 
 # ---------------------------------------------------------------- models

@@ -1,6 +1,8 @@
 """Classification against the ground-truth generators and soupified real models
 (issue: area-weighted correct classification >= 99.5% at default settings)."""
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -9,7 +11,7 @@ from meshvis.eval import generators as G
 from meshvis.graphcut.hints import Hints
 from meshvis.io import load
 
-REAL = G.real_models_dir()
+REAL = Path(__file__).resolve().parents[3] / "shared" / "models" / "real"
 
 CASES = {
     "nested_shells": lambda: G.nested_shells(),
