@@ -41,6 +41,32 @@ class Material:
 
 
 @dataclass(eq=False)
+class SourceRecord:
+    """What a reader keeps of its file so that the writer of the same format can edit it.
+
+    A repair changes which faces exist and which way they wind; with this record a writer
+    rewrites only the face data and copies everything else of the file (DESIGN §5: files
+    come back as rich as they went in).
+
+    Parameters
+    ----------
+    format : str
+        The reader's format name (``"glb"``, ``"obj"``, ``"ply"``, ...).
+    vertices : (n, 3) float64
+        The soup's vertex array as read: a soup whose vertices moved is written anew.
+    faces : (m0, 3) int64
+        The faces as read, indexed by :attr:`Soup.origin`.
+    data : object
+        What the format's writer needs (the glTF document, the OBJ lines, the PLY elements).
+    """
+
+    format: str
+    vertices: np.ndarray
+    faces: np.ndarray
+    data: Any = None
+
+
+@dataclass(eq=False)
 class Soup:
     """A triangle soup with per-face attributes.
 
@@ -56,6 +82,9 @@ class Soup:
     uv : (m, 3, 2) float64 or None, per-corner texture coordinates
     colors : (m, 3, 4) uint8 or None, per-corner RGBA vertex colours
     path : str or None, the file the soup was read from (for messages)
+    origin : (m,) int64, index of each face in the soup as it was read (follows subsets and flips)
+    source : :class:`SourceRecord` or None, what the reader kept of the file so that a writer
+        of the same format can edit the file instead of rebuilding it
 
     Examples
     --------
@@ -75,6 +104,8 @@ class Soup:
     uv: np.ndarray | None = None
     colors: np.ndarray | None = None
     path: str | None = None
+    origin: np.ndarray | None = None
+    source: SourceRecord | None = None
 
     def __post_init__(self) -> None:
         self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
@@ -92,6 +123,9 @@ class Soup:
         if self.material_id is None:
             self.material_id = np.full(m, -1, np.int64)
         self.material_id = np.asarray(self.material_id, np.int64).reshape(m)
+        if self.origin is None:
+            self.origin = np.arange(m, dtype=np.int64)
+        self.origin = np.asarray(self.origin, np.int64).reshape(m)
         if self.uv is not None:
             self.uv = np.asarray(self.uv, np.float64).reshape(m, 3, 2)
         if self.colors is not None:
@@ -167,6 +201,7 @@ class Soup:
             faces=self.faces[index],
             part_id=self.part_id[index],
             source_face=self.source_face[index],
+            origin=self.origin[index],
             material_id=self.material_id[index],
             uv=None if self.uv is None else self.uv[index],
             colors=None if self.colors is None else self.colors[index],
@@ -184,6 +219,7 @@ class Soup:
             colors=None if self.colors is None else self.colors[rows, order],
             part_id=self.part_id.copy(),
             source_face=self.source_face.copy(),
+            origin=self.origin.copy(),
             material_id=self.material_id.copy(),
         )
 
@@ -207,6 +243,7 @@ class Soup:
             faces=self.faces.copy(),
             part_id=self.part_id.copy(),
             source_face=self.source_face.copy(),
+            origin=self.origin.copy(),
             material_id=self.material_id.copy(),
             uv=None if self.uv is None else self.uv.copy(),
             colors=None if self.colors is None else self.colors.copy(),

@@ -18,51 +18,33 @@ from __future__ import annotations
 
 import base64
 import json
+import os
 import struct
 
 import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
 from meshvis.io._common import atomic_write, unique_names, weld_corners
+from meshvis.io.edits import face_edits
+from meshvis.io.gltf_edit import (
+    BIN_CHUNK,
+    GLB_MAGIC,
+    JSON_CHUNK,
+    GltfSource,
+    can_edit,
+    read_container,
+    write_edited,
+)
 from meshvis.io.mtl import describe_pbr
 from meshvis.io.scene import mesh_soup, soup_from_scene
-from meshvis.soup import Material, Soup
+from meshvis.soup import Material, Soup, SourceRecord
 
-_GLB_MAGIC = b"glTF"
-_JSON_CHUNK = 0x4E4F534A
-_BIN_CHUNK = 0x004E4942
+_GLB_MAGIC = GLB_MAGIC
+_JSON_CHUNK = JSON_CHUNK
+_BIN_CHUNK = BIN_CHUNK
 
 
 # ---------------------------------------------------------------------------- reading
-def _read_json(path: str, label: str) -> dict:
-    """The glTF JSON document of a .gltf or .glb file."""
-    with open(path, "rb") as fh:
-        data = fh.read()
-    if data[:4] == _GLB_MAGIC:
-        if len(data) < 20:
-            raise ModelFormatError("GLB file is truncated (no JSON chunk)", label)
-        _, _, total = struct.unpack_from("<III", data, 0)
-        if total > len(data):
-            raise ModelFormatError(
-                f"GLB file is truncated: {total} bytes announced, {len(data)} found", label
-            )
-        length, kind = struct.unpack_from("<II", data, 12)
-        if kind != _JSON_CHUNK or 20 + length > len(data):
-            raise ModelFormatError("GLB file has no valid JSON chunk", label)
-        raw = data[20 : 20 + length]
-    elif path.lower().endswith(".glb"):
-        raise ModelFormatError("not a GLB file (it does not start with 'glTF')", label)
-    else:
-        raw = data
-    try:
-        doc = json.loads(raw.decode("utf-8"))
-    except (UnicodeDecodeError, ValueError) as exc:
-        raise ModelFormatError(f"glTF JSON does not parse: {str(exc).splitlines()[0]}", label) from None
-    if not isinstance(doc, dict) or "asset" not in doc:
-        raise ModelFormatError("not a glTF document (no 'asset')", label)
-    return doc
-
-
 def _local_matrix(node: dict) -> np.ndarray:
     """4x4 transform of a glTF node: ``matrix``, or T * R * S."""
     if "matrix" in node:
@@ -118,7 +100,7 @@ def read_gltf(path: str, label: str | None = None) -> Soup:
     import trimesh
 
     label = label or path
-    doc = _read_json(path, label)
+    doc, buffers, glb_bin = read_container(path, label)
     with open(path, "rb") as fh:
         ftype = "glb" if fh.read(4) == _GLB_MAGIC else "gltf"
     scene = trimesh.load(path, file_type=ftype, force="scene", process=False, maintain_order=True)
@@ -141,6 +123,7 @@ def read_gltf(path: str, label: str | None = None) -> Soup:
         if isinstance(m.get("extras"), dict) and m["extras"].get("meshvis_placeholder")
     }
     pieces: list[Soup] = []
+    piece_rows: list[tuple[int, ...]] = []  # node, mesh, primitive, mirrored (see GltfSource)
     piece_part: list[int] = []
     names: list[str] = []
     nodes = doc.get("nodes", [])
@@ -164,6 +147,7 @@ def read_gltf(path: str, label: str | None = None) -> Soup:
             if not np.allclose(world, np.eye(4)):
                 piece = piece.transformed(world)
             pieces.append(piece)
+            piece_rows.append((node_index, mi, k, int(np.linalg.det(world[:3, :3]) < 0)))
             piece_part.append(len(names))
             added = True
         if added:
@@ -181,7 +165,21 @@ def read_gltf(path: str, label: str | None = None) -> Soup:
         materials = [materials[i] for i in keep]
     soup.materials = materials
     soup.path = label
+    soup.source = _source_record(soup, pieces, piece_rows, doc, buffers, glb_bin, path)
     return soup
+
+
+def _source_record(soup, pieces, rows, doc, buffers, glb_bin, path) -> SourceRecord:
+    """The record that lets :func:`write_gltf` edit this document (see :class:`GltfSource`)."""
+    n_v = np.array([p.n_vertices for p in pieces], np.int64)
+    n_f = np.array([p.n_faces for p in pieces], np.int64)
+    v0 = np.concatenate([[0], np.cumsum(n_v)[:-1]])
+    f0 = np.concatenate([[0], np.cumsum(n_f)[:-1]])
+    r = np.array(rows, np.int64).reshape(-1, 4)
+    table = np.column_stack([r[:, :3], v0, n_v, f0, r[:, 3]])
+    data = GltfSource(doc, buffers, glb_bin, os.path.dirname(os.path.abspath(path)), table)
+    fmt = "glb" if glb_bin >= 0 or path.lower().endswith(".glb") else "gltf"
+    return SourceRecord(fmt, soup.vertices, soup.faces.copy(), data)
 
 
 # ---------------------------------------------------------------------------- writing
@@ -235,7 +233,17 @@ class _Buffer:
 def write_gltf(
     soup: Soup, path: str, groups=None, group_names=None, face_values=None, *, binary: bool = True
 ) -> None:
-    """Write ``soup`` as GLB (``binary=True``) or as one self-contained .gltf (see the module docstring)."""
+    """Write ``soup`` as GLB (``binary=True``) or as one self-contained .gltf (see the module docstring).
+
+    A soup read from a glTF file whose faces are input faces (some removed, turned over,
+    reordered or repeated) on the vertices as read is written by editing the input
+    document (:mod:`meshvis.io.gltf_edit`); any other soup, or one with ``groups``, is
+    written from scratch.
+    """
+    edits = face_edits(soup, ("glb", "gltf")) if groups is None else None
+    if edits is not None and can_edit(edits.record.data, path):
+        write_edited(edits, soup.faces, path, binary)
+        return
 
     buf = _Buffer()
     if groups is not None:
