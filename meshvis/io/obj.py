@@ -22,14 +22,16 @@ from __future__ import annotations
 import os
 import re
 import warnings
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
 from meshvis.io._common import atomic_write, fmt_floats, unique_names, weld_corners
+from meshvis.io.edits import FaceEdits, face_edits
 from meshvis.io.mtl import MtlSource, write_mtl
 from meshvis.io.triangulate import triangulate
-from meshvis.soup import Material, Soup
+from meshvis.soup import Material, Soup, SourceRecord
 
 _ROW = -1.7976931348623157e308  # marks line starts while parsing lines of varying length
 
@@ -103,6 +105,49 @@ def _parse_rows(
 
 
 # ---------------------------------------------------------------------------- reader
+@dataclass(eq=False)
+class ObjSource:
+    """What the OBJ writer needs to edit the file instead of rebuilding it.
+
+    Parameters
+    ----------
+    lines : list of str
+        The file's lines (continuations joined).
+    record_line : (p,) int64
+        Line number of every face record.
+    record : (m0,) int64
+        Face record of every triangle as read.
+    corners : (m0, 3) int64
+        Corner numbers (0-based, within its record) of the three corners of every triangle.
+    mtllibs : list of str
+        The ``mtllib`` references, as written.
+    default_part : str or None
+        Name of the part of the faces before any ``o``/``g`` (the input's stem), None when
+        there are none.
+    """
+
+    lines: list[str]
+    record_line: np.ndarray
+    record: np.ndarray
+    corners: np.ndarray
+    mtllibs: list[str]
+    default_part: str | None = None
+
+
+@dataclass(eq=False)
+class _Statements:
+    """The lines of an OBJ file sorted by keyword (one cheap pass, see :func:`_sort_lines`)."""
+
+    v: list[str] = field(default_factory=list)
+    vt: list[str] = field(default_factory=list)
+    f: list[str] = field(default_factory=list)
+    f_where: list[int] = field(default_factory=list)  # line number (0-based) of every face record
+    kinds: list[int] = field(default_factory=list)  # 0 = v, 1 = vt, 2 = f, in file order
+    groups: list[tuple[int, str, str]] = field(default_factory=list)  # (face index, "o" | "g", name)
+    usemtl: list[tuple[int, str]] = field(default_factory=list)
+    mtllibs: list[str] = field(default_factory=list)
+
+
 def read_obj(path: str, label: str | None = None) -> Soup:
     """Read an OBJ file (see the module docstring for the rules).
 
@@ -116,9 +161,60 @@ def read_obj(path: str, label: str | None = None) -> Soup:
     -------
     Soup
         Vertices as in the file (unused ones kept), triangles in file order, ``source_face``
-        = index of the ``f`` record in the file (0-based, counting skipped edge records).
+        = index of the ``f`` record in the file (0-based, counting skipped edge records),
+        and a :class:`~meshvis.soup.SourceRecord` with the file's lines.
     """
     label = label or path
+    lines = _read_lines(path, label)
+    st = _sort_lines(lines)
+    n_rec = len(st.f)
+    if n_rec == 0:
+        raise ModelError("the model has no faces" + ("" if st.v else " (no OBJ statements found)"), label)
+    vertices, colors_v = _vertex_table(st, path, label)
+    uv_table = _uv_table(st, path, label)
+    counts, v_idx, vt_idx = _face_corners(st, len(vertices), 0 if uv_table is None else len(uv_table), label)
+    keep_rec, kept_counts, v_idx, vt_idx = _drop_edges(counts, v_idx, vt_idx, st.f_where, label)
+
+    tri, src = triangulate(vertices, kept_counts, v_idx)
+    corner_start = np.concatenate([[0], np.cumsum(kept_counts)[:-1]])
+    local = tri - corner_start[src][:, None]
+    if keep_rec is not None:
+        src = keep_rec[src]
+    faces = v_idx[tri]
+
+    uv = None
+    if uv_table is not None and (vt_idx > 0).any():
+        uv_flat = np.zeros((len(vt_idx), 2))
+        has = vt_idx > 0
+        uv_flat[has] = uv_table[vt_idx[has] - 1]
+        uv = uv_flat[tri]
+    colors = colors_v[faces] if colors_v is not None else None
+
+    stem = os.path.splitext(os.path.basename(label))[0]
+    part_id, part_names = _assign_parts(st.groups, n_rec, src, stem)
+    material_id, materials = _assign_materials(st.usemtl, n_rec, src, st.mtllibs, path)
+    soup = Soup(
+        vertices=vertices,
+        faces=faces,
+        part_id=part_id,
+        part_names=part_names,
+        source_face=src,
+        material_id=material_id,
+        materials=materials,
+        uv=uv,
+        colors=colors,
+        path=label,
+    )
+    before_any = not st.groups or st.groups[0][0] > 0
+    data = ObjSource(
+        lines, np.asarray(st.f_where, np.int64), src.copy(), local, st.mtllibs, stem if before_any else None
+    )
+    soup.source = SourceRecord("obj", soup.vertices, soup.faces.copy(), data)
+    return soup
+
+
+def _read_lines(path: str, label: str) -> list[str]:
+    """The file's text lines (UTF-8 or Latin-1, ``\\`` continuations joined)."""
     with open(path, "rb") as fh:
         data = fh.read()
     if b"\x00" in data[:65536]:
@@ -130,25 +226,19 @@ def read_obj(path: str, label: str | None = None) -> Soup:
     del data
     if "\\\n" in text or "\\\r\n" in text:
         text = re.sub(r"\\\r?\n", " ", text)
-    lines = text.splitlines()
-    del text
+    return text.splitlines()
 
-    v_lines: list[str] = []
-    vt_lines: list[str] = []
-    f_lines: list[str] = []
-    f_where: list[int] = []  # line number (0-based) of every face record
-    kinds: list[int] = []  # 0 = v, 1 = vt, 2 = f, in file order (for relative indices)
-    groups: list[tuple[int, str, str]] = []  # (face index, "o" | "g", name)
-    usemtl: list[tuple[int, str]] = []
-    mtllibs: list[str] = []
+
+def _sort_lines(lines: list[str]) -> _Statements:
+    """One pass over the lines: the statements meshvis reads, by keyword (comments cut)."""
+    st = _Statements()
     v_append, vt_append, f_append, k_append, fw_append = (
-        v_lines.append,
-        vt_lines.append,
-        f_lines.append,
-        kinds.append,
-        f_where.append,
+        st.v.append,
+        st.vt.append,
+        st.f.append,
+        st.kinds.append,
+        st.f_where.append,
     )
-
     for no, line in enumerate(lines):
         if not line:
             continue
@@ -181,22 +271,22 @@ def read_obj(path: str, label: str | None = None) -> Soup:
         elif c == "o" or c == "g":
             word, _, rest = line.partition(" ") if " " in line else line.partition("\t")
             if word in ("o", "g"):
-                groups.append((len(f_lines), word, " ".join(rest.split())))
+                st.groups.append((len(st.f), word, " ".join(rest.split())))
         elif c == "u" and line.startswith("usemtl"):
-            usemtl.append((len(f_lines), line[6:].strip()))
+            st.usemtl.append((len(st.f), line[6:].strip()))
         elif c == "m" and line.startswith("mtllib"):
-            mtllibs.append(line[6:].strip())
-    del lines
-    n_v, n_vt, n_rec = len(v_lines), len(vt_lines), len(f_lines)
-    if n_rec == 0:
-        raise ModelError("the model has no faces" + ("" if n_v else " (no OBJ statements found)"), label)
+            st.mtllibs.append(line[6:].strip())
+    return st
 
-    # ------------------------------------------------------------ vertices and UVs
+
+def _vertex_table(st: _Statements, path: str, label: str) -> tuple[np.ndarray, np.ndarray | None]:
+    """(n, 3) vertex positions and (n, 4) uint8 colours (or None) of the ``v`` lines."""
+
     def vline(i: int) -> int:
         return _nth_line_number(path, "v", i)
 
-    vals, v_counts = _parse_rows(v_lines, "v", 3, "vertex", label, vline)
-    del v_lines
+    n_v = len(st.v)
+    vals, v_counts = _parse_rows(st.v, "v", 3, "vertex", label, vline)
     if len(v_counts) and v_counts.min() < 3:
         bad = int(np.argmax(v_counts < 3))
         raise ModelFormatError(f"line {vline(bad) + 1}: a vertex needs 3 coordinates", label)
@@ -213,120 +303,98 @@ def read_obj(path: str, label: str | None = None) -> Soup:
             rgba[has, :3] /= 255.0
             rgba[has_a, 3] /= 255.0
         colors_v = np.clip(np.round(np.nan_to_num(rgba) * 255.0), 0, 255).astype(np.uint8)
-    del vals
-    uv_table = None
-    if n_vt:
-        tvals, t_counts = _parse_rows(
-            vt_lines, "vt", 2, "texture coordinate", label, lambda i: _nth_line_number(path, "vt", i)
-        )
-        if t_counts.min() < 1:
-            raise ModelFormatError("a texture coordinate line has no numbers", label)
-        uv_table = np.zeros((n_vt, 2))
-        uv_table[:, : min(2, tvals.shape[1])] = tvals[:, :2]
-    del vt_lines
+    return vertices, colors_v
 
-    # ------------------------------------------------------------ face records
+
+def _uv_table(st: _Statements, path: str, label: str) -> np.ndarray | None:
+    """(k, 2) texture coordinates of the ``vt`` lines, or None without any."""
+    if not st.vt:
+        return None
+    tvals, t_counts = _parse_rows(
+        st.vt, "vt", 2, "texture coordinate", label, lambda i: _nth_line_number(path, "vt", i)
+    )
+    if t_counts.min() < 1:
+        raise ModelFormatError("a texture coordinate line has no numbers", label)
+    uv_table = np.zeros((len(st.vt), 2))
+    uv_table[:, : min(2, tvals.shape[1])] = tvals[:, :2]
+    return uv_table
+
+
+def _face_corners(st: _Statements, n_v: int, n_vt: int, label: str):
+    """Corner counts and 0-based vertex / 1-based UV index per corner, relative indices resolved."""
+    f_where = st.f_where
     try:
-        counts, v_idx, vt_idx = _parse_faces(f_lines, label)
+        counts, v_idx, vt_idx = _parse_faces(st.f, label)
     except ModelFormatError:
-        bad = _first_bad_face(f_lines)
+        bad = _first_bad_face(st.f)
         if bad < 0:
             raise
         raise ModelFormatError(
             f"line {f_where[bad] + 1}: cannot read the vertex indices of a face", label
         ) from None
-    del f_lines
+
+    def record_of(corner: int) -> int:
+        return int(np.searchsorted(np.cumsum(counts), corner, side="right"))
 
     # relative (negative) indices count back from the vertices defined so far
     if (v_idx < 0).any() or (vt_idx < 0).any():
-        kinds_a = np.frombuffer(bytes(kinds), np.uint8)
+        kinds_a = np.frombuffer(bytes(st.kinds), np.uint8)
         vt_relative = vt_idx < 0
         is_face = kinds_a == 2
-        nv_before = np.cumsum(kinds_a == 0)[is_face]
-        nvt_before = np.cumsum(kinds_a == 1)[is_face]
-        nv_c = np.repeat(nv_before, counts)
-        nvt_c = np.repeat(nvt_before, counts)
+        nv_c = np.repeat(np.cumsum(kinds_a == 0)[is_face], counts)
+        nvt_c = np.repeat(np.cumsum(kinds_a == 1)[is_face], counts)
         v_idx = np.where(v_idx < 0, v_idx + nv_c + 1, v_idx)
         vt_idx = np.where(vt_idx < 0, vt_idx + nvt_c + 1, vt_idx)
         # a relative index that reaches past the first vertex lands on <= 0
         bad = (v_idx <= 0) | (vt_relative & (vt_idx <= 0))
         if bad.any():
-            rec = int(np.searchsorted(np.cumsum(counts), np.argmax(bad), side="right"))
             raise ModelFormatError(
-                f"line {f_where[rec] + 1}: relative index reaches before the first vertex or texture coordinate",
+                f"line {f_where[record_of(np.argmax(bad))] + 1}: relative index reaches before the first "
+                "vertex or texture coordinate",
                 label,
             )
-    del kinds
     if (v_idx == 0).any():
-        rec = int(np.searchsorted(np.cumsum(counts), np.argmax(v_idx == 0), side="right"))
+        rec = record_of(np.argmax(v_idx == 0))
         raise ModelFormatError(f"line {f_where[rec] + 1}: vertex index 0 (OBJ indices start at 1)", label)
     over = v_idx > n_v
     if over.any():
-        rec = int(np.searchsorted(np.cumsum(counts), np.argmax(over), side="right"))
         raise ModelFormatError(
-            f"line {f_where[rec] + 1}: vertex index {int(v_idx[np.argmax(over)])} out of range "
-            f"(the file has {n_v} vertices)",
+            f"line {f_where[record_of(np.argmax(over))] + 1}: vertex index {int(v_idx[np.argmax(over)])} "
+            f"out of range (the file has {n_v} vertices)",
             label,
         )
     if (vt_idx > n_vt).any():
-        rec = int(np.searchsorted(np.cumsum(counts), np.argmax(vt_idx > n_vt), side="right"))
         raise ModelFormatError(
-            f"line {f_where[rec] + 1}: texture coordinate index out of range (the file has {n_vt})", label
+            f"line {f_where[record_of(np.argmax(vt_idx > n_vt))] + 1}: texture coordinate index out of "
+            f"range (the file has {n_vt})",
+            label,
         )
-    v_idx -= 1
+    return counts, v_idx - 1, vt_idx
 
-    # ------------------------------------------------------------ short records
-    if counts.min() < 3:
-        if counts.min() < 2:
-            rec = int(np.argmax(counts < 2))
-            raise ModelFormatError(
-                f"line {f_where[rec] + 1}: a face needs at least 3 vertices, got {int(counts[rec])}", label
-            )
-        edges = counts == 2
-        warnings.warn(
-            f"{label}: skipped {int(edges.sum())} face records with 2 vertices (edges, not faces)",
-            stacklevel=4,
+
+def _drop_edges(counts, v_idx, vt_idx, f_where, label):
+    """Skip two-corner records (edges) with a warning; refuse shorter ones.
+
+    Returns the kept record numbers (None when all are kept), their corner counts and
+    their corners' vertex and UV indices.
+    """
+    if counts.min() >= 3:
+        return None, counts, v_idx, vt_idx
+    if counts.min() < 2:
+        rec = int(np.argmax(counts < 2))
+        raise ModelFormatError(
+            f"line {f_where[rec] + 1}: a face needs at least 3 vertices, got {int(counts[rec])}", label
         )
-        keep_rec = np.flatnonzero(~edges)
-        if len(keep_rec) == 0:
-            raise ModelError(f"the model has no faces (only {int(edges.sum())} two-vertex records)", label)
-        keep_corner = np.repeat(~edges, counts)
-        v_idx, vt_idx = v_idx[keep_corner], vt_idx[keep_corner]
-        kept_counts = counts[keep_rec]
-    else:
-        keep_rec = None
-        kept_counts = counts
-
-    tri, src = triangulate(vertices, kept_counts, v_idx)
-    if keep_rec is not None:
-        src = keep_rec[src]
-    faces = v_idx[tri]
-
-    uv = None
-    if uv_table is not None and (vt_idx > 0).any():
-        uv_flat = np.zeros((len(vt_idx), 2))
-        has = vt_idx > 0
-        uv_flat[has] = uv_table[vt_idx[has] - 1]
-        uv = uv_flat[tri]
-    colors = colors_v[faces] if colors_v is not None else None
-
-    # ------------------------------------------------------------ parts and materials
-    stem = os.path.splitext(os.path.basename(label))[0]
-    part_id, part_names = _assign_parts(groups, n_rec, src, stem)
-    material_id, materials = _assign_materials(usemtl, n_rec, src, mtllibs, path)
-
-    return Soup(
-        vertices=vertices,
-        faces=faces,
-        part_id=part_id,
-        part_names=part_names,
-        source_face=src,
-        material_id=material_id,
-        materials=materials,
-        uv=uv,
-        colors=colors,
-        path=label,
+    edges = counts == 2
+    warnings.warn(
+        f"{label}: skipped {int(edges.sum())} face records with 2 vertices (edges, not faces)",
+        stacklevel=5,
     )
+    keep_rec = np.flatnonzero(~edges)
+    if len(keep_rec) == 0:
+        raise ModelError(f"the model has no faces (only {int(edges.sum())} two-vertex records)", label)
+    keep_corner = np.repeat(~edges, counts)
+    return keep_rec, counts[keep_rec], v_idx[keep_corner], vt_idx[keep_corner]
 
 
 def _nth_line_number(path: str, keyword: str, n: int) -> int:
@@ -482,37 +550,109 @@ def write_obj(
 ) -> None:
     """Write ``soup`` as OBJ, plus an MTL file and textures when it has materials.
 
-    Parts become ``o`` statements, ``groups`` become ``g`` statements inside them,
-    materials ``usemtl``; faces keep their order (a statement is repeated when the
-    part, group or material changes).  Vertices are written once per (vertex, colour)
-    pair, UVs once per distinct pair.  Everything is written with
-    :func:`meshvis.io.atomic_write`.
-    """
+    A soup read from an OBJ file whose faces are input faces (some removed, turned over or
+    repeated) on the vertices as read is written by editing the input's lines
+    (:func:`_edited_lines`): ``v``, ``vt``, ``vn``, ``s``, ``o``/``g``, ``usemtl`` and
+    comment lines stay as they were, a polygon whose triangles are all kept and wound alike
+    stays one polygon (its corners reversed when turned over), the kept triangles of any
+    other polygon take its place.
 
+    Any other soup, or one with ``groups``, is written from scratch: parts become ``o``
+    statements, ``groups`` become ``g`` statements inside them, materials ``usemtl``;
+    faces keep their order (a statement is repeated when the part, group or material
+    changes).  Vertices are written once per (vertex, colour) pair, UVs once per distinct
+    pair.  Everything is written with :func:`meshvis.io.atomic_write`.
+    """
+    stem = os.path.splitext(os.path.basename(path))[0]
+    folder = os.path.dirname(os.path.abspath(path))
+    used_mats = soup.material_id >= 0
+    mtl_name = stem + ".mtl" if used_mats.any() else None
+    mat_names: list[str] = []
+    edits = face_edits(soup, ("obj",)) if groups is None else None
+    if edits is not None:
+        mat_names = [m.name for m in soup.materials]
+        text = _edited_lines(edits, mtl_name, stem)
+    else:
+        if mtl_name:
+            mat_names = unique_names([m.name for m in soup.materials], "material")
+        text = _rebuilt_text(soup, groups, group_names, mtl_name, mat_names)
+    if mtl_name:
+        write_mtl(soup.materials, mat_names, os.path.join(folder, mtl_name), folder, stem)
+    with atomic_write(path, "w") as fh:
+        fh.write(text)
+
+
+def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:
+    """The input's text with its face records replaced by the soup's faces (see :func:`write_obj`)."""
+    src: ObjSource = edits.record.data
+    lines = list(src.lines)
+    n_tri = len(edits.record.faces)
+    src_face = src.record
+    count = edits.kept_count()
+    flips = np.bincount(edits.origin, weights=edits.flipped, minlength=n_tri)
+    # per record: all its triangles once, all turned over or none -> the record stays a polygon
+    rec_tris = np.bincount(src_face, minlength=len(src.record_line))
+    once = np.bincount(src_face, weights=count == 1, minlength=len(src.record_line)) == rec_tris
+    n_flip = np.bincount(src_face, weights=flips, minlength=len(src.record_line))
+    whole = once & ((n_flip == 0) | (n_flip == rec_tris))
+    turned = whole & (n_flip > 0)
+    for r in np.flatnonzero(turned).tolist():
+        no = src.record_line[r]
+        body, hash_, comment = lines[no].partition("#")
+        tokens = body.split()
+        lines[no] = " ".join(["f", tokens[1], *tokens[:0:-1][:-1]]) + (f" {hash_}{comment}" if hash_ else "")
+    split = np.flatnonzero(~whole & (rec_tris > 0))
+    if len(split):
+        order = np.argsort(src_face[edits.origin], kind="stable")
+        by_rec = src_face[edits.origin][order]
+        bounds = np.searchsorted(by_rec, np.stack([split, split + 1]))
+        for r, a, b in zip(split.tolist(), bounds[0].tolist(), bounds[1].tolist()):
+            no = src.record_line[r]
+            tokens = lines[no].partition("#")[0].split()[1:]
+            out = []
+            for k in order[a:b].tolist():
+                c = src.corners[edits.origin[k]]
+                c = c[[0, 2, 1]] if edits.flipped[k] else c
+                out.append(f"f {tokens[c[0]]} {tokens[c[1]]} {tokens[c[2]]}")
+            lines[no] = "\n".join(out) if out else None
+    if mtl_name:
+        lines = [f"mtllib {mtl_name}" if ln is not None and ln.startswith("mtllib") else ln for ln in lines]
+    if src.default_part is not None and src.default_part != stem:
+        # the faces before any o/g are named after the file: keep the input's name
+        first = int(src.record_line[0])
+        lines[first : first + 1] = [f"o {src.default_part}", lines[first]]
+    return "\n".join(ln for ln in lines if ln is not None) + "\n"
+
+
+def _rebuilt_text(soup: Soup, groups, group_names, mtl_name: str | None, mat_names: list[str]) -> str:
+    """The OBJ text of a soup written from scratch (see :func:`write_obj`)."""
     m = soup.n_faces
     corner_src, faces = weld_corners(soup, use_uv=False, use_colors=True)
-    flat = soup.faces.reshape(-1)
-    pos = soup.vertices[flat[corner_src]]
+    pos = soup.vertices[soup.faces.reshape(-1)[corner_src]]
+    out = [f"# written by meshvis: {m} faces, {len(pos)} vertices, {soup.n_parts} parts\n"]
+    if mtl_name:
+        out.append(f"mtllib {mtl_name}\n")
+    if soup.colors is not None:
+        col = soup.colors.reshape(-1, 4)[corner_src, :3] / 255.0
+        out.append(("v %s %s %s %s %s %s\n" * len(pos)) % tuple(fmt_floats(np.column_stack([pos, col]))))
+    else:
+        out.append(("v %s %s %s\n" * len(pos)) % tuple(fmt_floats(pos)))
     uv_faces = None
     if soup.uv is not None:
         uv_flat = soup.uv.reshape(-1, 2)
         _, uv_first, uv_inverse = np.unique(
             uv_flat[:, 0] + 1j * uv_flat[:, 1], return_index=True, return_inverse=True
         )
-        uv_unique = uv_flat[uv_first]
+        out.append(("vt %s %s\n" * len(uv_first)) % tuple(fmt_floats(uv_flat[uv_first])))
         uv_faces = uv_inverse.reshape(-1, 3)
-    stem = os.path.splitext(os.path.basename(path))[0]
-    folder = os.path.dirname(os.path.abspath(path))
+    out += _face_statements(soup, faces, uv_faces, groups, group_names, mat_names)
+    return "".join(out)
 
-    used_mats = soup.material_id >= 0
-    mtl_name = None
-    mat_names: list[str] = []
-    if used_mats.any():
-        mtl_name = stem + ".mtl"
-        mat_names = unique_names([m.name for m in soup.materials], "material")
 
+def _face_statements(soup, faces, uv_faces, groups, group_names, mat_names) -> list[str]:
+    """``o`` / ``g`` / ``usemtl`` / ``f`` lines, a statement repeated where its value changes."""
+    m = soup.n_faces
     part_names = unique_names(soup.part_names, "part")
-    # runs of faces with the same (part, group, material)
     keys = [soup.part_id, soup.material_id] + ([groups] if groups is not None else [])
     change = np.zeros(m, bool)
     if m:
@@ -521,29 +661,14 @@ def write_obj(
         change[1:] |= k[1:] != k[:-1]
     starts = np.flatnonzero(change)
     ends = np.append(starts[1:], m)
-
     if uv_faces is not None:
         fvals = np.stack([faces + 1, uv_faces + 1], axis=-1).reshape(m, 6)
-        face_fmt = "f %d/%d %d/%d %d/%d\n"
-        per_face = 6
+        face_fmt, per_face = "f %d/%d %d/%d %d/%d\n", 6
     else:
         fvals = faces + 1
-        face_fmt = "f %d %d %d\n"
-        per_face = 3
+        face_fmt, per_face = "f %d %d %d\n", 3
     fvals = fvals.ravel().tolist()
-
-    # the whole text is made before any file is touched: a failure leaves no partial output
-    out = [f"# written by meshvis: {m} faces, {len(pos)} vertices, {soup.n_parts} parts\n"]
-    if mtl_name:
-        out.append(f"mtllib {mtl_name}\n")
-    if soup.colors is not None:
-        col = soup.colors.reshape(-1, 4)[corner_src, :3] / 255.0
-        vals = np.column_stack([pos, col])
-        out.append(("v %s %s %s %s %s %s\n" * len(pos)) % tuple(fmt_floats(vals)))
-    else:
-        out.append(("v %s %s %s\n" * len(pos)) % tuple(fmt_floats(pos)))
-    if uv_faces is not None:
-        out.append(("vt %s %s\n" * len(uv_unique)) % tuple(fmt_floats(uv_unique)))
+    out = []
     cur_part = cur_group = cur_mat = None
     for a, b in zip(starts.tolist(), ends.tolist()):
         p = int(soup.part_id[a])
@@ -559,12 +684,7 @@ def write_obj(
             out.append(f"usemtl {mat_names[mt] if mt >= 0 else 'none'}\n")
             cur_mat = mt
         out.append((face_fmt * (b - a)) % tuple(fvals[a * per_face : b * per_face]))
-    text = "".join(out)
-    del out
-    if mtl_name:
-        write_mtl(soup.materials, mat_names, os.path.join(folder, mtl_name), folder, stem)
-    with atomic_write(path, "w") as fh:
-        fh.write(text)
+    return out
 
 
 #: format name -> reader / writer, collected by :mod:`meshvis.io.reading` and :mod:`meshvis.io.writing`
