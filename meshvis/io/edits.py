@@ -50,6 +50,33 @@ class FaceEdits:
         """(m0,) how many times each input face occurs in the soup."""
         return np.bincount(self.origin, minlength=len(self.record.faces))
 
+    def polygons(self, polygon: np.ndarray, n_polygons: int) -> tuple[np.ndarray, np.ndarray]:
+        """Which input polygons can be written back whole.
+
+        Parameters
+        ----------
+        polygon : (m0,) int64
+            Input polygon of every input triangle.
+        n_polygons : int
+            Number of input polygons (those without triangles included).
+
+        Returns
+        -------
+        whole : (n_polygons,) bool
+            Every triangle of the polygon occurs exactly once and all are turned over or
+            none: the polygon is written as one polygon.  True for polygons without
+            triangles (records the reader skipped), which are written as they were.
+        turned : (n_polygons,) bool
+            Whole and turned over: written with its corners in reverse order.
+        """
+        m0 = len(self.record.faces)
+        n_tri = np.bincount(polygon, minlength=n_polygons)
+        once = np.bincount(polygon, weights=self.kept_count() == 1, minlength=n_polygons) == n_tri
+        flips = np.bincount(self.origin, weights=self.flipped, minlength=m0)
+        n_flip = np.bincount(polygon, weights=flips, minlength=n_polygons)
+        whole = once & ((n_flip == 0) | (n_flip == n_tri))
+        return whole, whole & (n_flip > 0)
+
 
 def face_edits(soup: Soup, formats: tuple[str, ...]) -> FaceEdits | None:
     """The soup as edits of its source file, or None when it cannot be written that way.

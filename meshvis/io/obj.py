@@ -586,16 +586,9 @@ def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:
     """The input's text with its face records replaced by the soup's faces (see :func:`write_obj`)."""
     src: ObjSource = edits.record.data
     lines = list(src.lines)
-    n_tri = len(edits.record.faces)
     src_face = src.record
-    count = edits.kept_count()
-    flips = np.bincount(edits.origin, weights=edits.flipped, minlength=n_tri)
-    # per record: all its triangles once, all turned over or none -> the record stays a polygon
+    whole, turned = edits.polygons(src_face, len(src.record_line))
     rec_tris = np.bincount(src_face, minlength=len(src.record_line))
-    once = np.bincount(src_face, weights=count == 1, minlength=len(src.record_line)) == rec_tris
-    n_flip = np.bincount(src_face, weights=flips, minlength=len(src.record_line))
-    whole = once & ((n_flip == 0) | (n_flip == rec_tris))
-    turned = whole & (n_flip > 0)
     for r in np.flatnonzero(turned).tolist():
         no = src.record_line[r]
         body, hash_, comment = lines[no].partition("#")

@@ -17,13 +17,16 @@ from __future__ import annotations
 import os
 import struct
 import warnings
+from dataclasses import dataclass, field
 
 import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
 from meshvis.io._common import atomic_write, one_line, weld_corners
+from meshvis.io.edits import face_edits
+from meshvis.io.ply_edit import write_edited
 from meshvis.io.triangulate import triangulate
-from meshvis.soup import Material, Soup
+from meshvis.soup import Material, Soup, SourceRecord
 
 _TYPES = {
     "char": "i1",
@@ -271,12 +274,39 @@ def _read_ascii(values: np.ndarray, offset: int, n: int, props: list[_Prop], lab
     return out, pos
 
 
-def read_elements(path: str, label: str):
-    """All elements of a PLY file: ``{element: {property: array or (counts, values)}}`` and comments."""
+@dataclass(eq=False)
+class PlyLayout:
+    """A PLY file's layout as read: what the editing writer copies.
+
+    Parameters
+    ----------
+    fmt : str
+        ``ascii``, ``binary_little_endian`` or ``binary_big_endian``.
+    header : list of str
+        The header lines from ``ply`` to ``end_header``, as written (comments and
+        ``obj_info`` included, in place).
+    elements : list of (name, count, properties)
+        Every element with its properties and their types.
+    raw : list of bytes
+        Binary files: the bytes of every element's rows (copied unchanged); empty for ASCII.
+    """
+
+    fmt: str
+    header: list[str]
+    elements: list
+    raw: list = field(default_factory=list)
+
+
+def read_elements(path: str, label: str, layout: list | None = None):
+    """All elements of a PLY file: ``{element: {property: array or (counts, values)}}`` and comments.
+
+    When ``layout`` is a list, a :class:`PlyLayout` of the file is appended to it.
+    """
     with open(path, "rb") as fh:
         data = fh.read()
     fmt, elements, comments, body = _parse_header(data, label)
     out: dict[str, dict] = {}
+    raw = []
     if fmt == "ascii":
         text = data[body:].decode("latin-1")
         try:
@@ -293,7 +323,13 @@ def read_elements(path: str, label: str):
         buf = memoryview(data)
         pos = body
         for name, n, props in elements:
+            start = pos
             out[name], pos = _read_binary(buf, pos, n, props, endian, label, name)
+            if layout is not None:
+                raw.append(data[start:pos])
+    if layout is not None:
+        header = data[:body].decode("latin-1").splitlines()
+        layout.append(PlyLayout(fmt, header, elements, raw))
     return out, comments
 
 
@@ -316,10 +352,41 @@ def _colors(columns: dict, n: int) -> np.ndarray | None:
     return None
 
 
+@dataclass(eq=False)
+class PlySource:
+    """What the PLY writer needs to edit the file instead of rebuilding it.
+
+    Parameters
+    ----------
+    layout : PlyLayout
+    elements : dict
+        Every element's columns as read, by element name.
+    columns : dict
+        The face element's columns as read.
+    face_element : int
+        Position of the face element in ``layout.elements``.
+    index_name : str
+        The face property holding the vertex indices.
+    record : (m0,) int64
+        Face row of every triangle as read.
+    corners : (m0, 3) int64
+        Positions in the flat vertex index list of the three corners of every triangle.
+    """
+
+    layout: PlyLayout
+    elements: dict
+    columns: dict
+    face_element: int
+    index_name: str
+    record: np.ndarray
+    corners: np.ndarray
+
+
 def read_ply(path: str, label: str | None = None) -> Soup:
     """Read a PLY file into a :class:`Soup` (polygons triangulated, ``source_face`` = face row)."""
     label = label or path
-    elements, comments = read_elements(path, label)
+    layout: list = []
+    elements, comments = read_elements(path, label, layout)
     vert = elements.get("vertex")
     if vert is None or not all(k in vert for k in "xyz"):
         raise ModelFormatError("PLY file has no vertex x, y, z", label)
@@ -327,29 +394,10 @@ def read_ply(path: str, label: str | None = None) -> Soup:
     face = elements.get("face")
     if face is None:
         raise ModelError("the model has no faces (a point cloud?)", label)
-    index_name = next((k for k in ("vertex_indices", "vertex_index") if k in face), None)
-    if index_name is None:
-        index_name = next((k for k, v in face.items() if isinstance(v, tuple)), None)
-    if index_name is None:
-        raise ModelFormatError("PLY faces have no vertex index list", label)
+    index_name = _index_property(face, label)
     counts, corners = face[index_name]
     corners = corners.astype(np.int64)
-    n_faces = len(counts)
-    if n_faces == 0:
-        raise ModelError("the model has no faces", label)
-    keep = counts >= 3
-    if not keep.all():
-        if (counts < 2).any():
-            raise ModelFormatError(
-                f"face {int(np.argmax(counts < 2))} has {int(counts[np.argmax(counts < 2)])} vertices; "
-                "a face needs at least 3",
-                label,
-            )
-        warnings.warn(
-            f"{label}: skipped {int((~keep).sum())} faces with 2 vertices (edges, not faces)", stacklevel=4
-        )
-        if not keep.any():
-            raise ModelError("the model has no faces (only two-vertex records)", label)
+    keep = _polygon_rows(counts, label)
     keep_corner = np.repeat(keep, counts)
     kept = np.flatnonzero(keep)
     k_corners = corners[keep_corner]
@@ -361,29 +409,80 @@ def read_ply(path: str, label: str | None = None) -> Soup:
     tri, src_local = triangulate(vertices, counts[keep], k_corners)
     src = kept[src_local]
     faces = k_corners[tri]
-
-    uv = None
-    if "texcoord" in face and isinstance(face["texcoord"], tuple):
-        tc_counts, tc = face["texcoord"]
-        if np.array_equal(tc_counts, 2 * counts):
-            uv_corner = tc.astype(np.float64).reshape(-1, 2)[keep_corner]
-            uv = uv_corner[tri]
-    if uv is None:
-        for a, b in (("texture_u", "texture_v"), ("u", "v"), ("s", "t"), ("texture_s", "texture_t")):
-            if a in vert and b in vert and not isinstance(vert[a], tuple):
-                table = np.column_stack([np.asarray(vert[a], np.float64), np.asarray(vert[b], np.float64)])
-                uv = table[faces]
-                break
-
+    uv = _uvs(vert, face, counts, keep_corner, tri, faces)
     colors = None
     vcol = _colors(vert, len(vertices))
     if vcol is not None:
         colors = vcol[faces]
     else:
-        fcol = _colors(face, n_faces)
+        fcol = _colors(face, len(counts))
         if fcol is not None:
             colors = np.repeat(fcol[src][:, None, :], 3, axis=1)
+    part_id, part_names, material_id, materials = _ids_and_names(face, comments, src, label)
+    soup = Soup(
+        vertices=vertices,
+        faces=faces,
+        part_id=part_id,
+        part_names=part_names,
+        source_face=src,
+        material_id=material_id,
+        materials=materials,
+        uv=uv,
+        colors=colors,
+        path=label,
+    )
+    face_element = [e[0] for e in layout[0].elements].index("face")
+    flat_pos = np.flatnonzero(keep_corner)[tri]
+    data = PlySource(layout[0], elements, face, face_element, index_name, src.copy(), flat_pos)
+    soup.source = SourceRecord("ply", soup.vertices, soup.faces.copy(), data)
+    return soup
 
+
+def _index_property(face: dict, label: str) -> str:
+    """Name of the face property holding the vertex index lists."""
+    name = next((k for k in ("vertex_indices", "vertex_index") if k in face), None)
+    if name is None:
+        name = next((k for k, v in face.items() if isinstance(v, tuple)), None)
+    if name is None:
+        raise ModelFormatError("PLY faces have no vertex index list", label)
+    return name
+
+
+def _polygon_rows(counts: np.ndarray, label: str) -> np.ndarray:
+    """(p,) bool, the face rows that are polygons; two-corner rows are skipped with a warning."""
+    if len(counts) == 0:
+        raise ModelError("the model has no faces", label)
+    keep = counts >= 3
+    if not keep.all():
+        if (counts < 2).any():
+            raise ModelFormatError(
+                f"face {int(np.argmax(counts < 2))} has {int(counts[np.argmax(counts < 2)])} vertices; "
+                "a face needs at least 3",
+                label,
+            )
+        warnings.warn(
+            f"{label}: skipped {int((~keep).sum())} faces with 2 vertices (edges, not faces)", stacklevel=5
+        )
+        if not keep.any():
+            raise ModelError("the model has no faces (only two-vertex records)", label)
+    return keep
+
+
+def _uvs(vert, face, counts, keep_corner, tri, faces) -> np.ndarray | None:
+    """(m, 3, 2) per-corner UVs from a face ``texcoord`` list or per-vertex coordinates."""
+    if "texcoord" in face and isinstance(face["texcoord"], tuple):
+        tc_counts, tc = face["texcoord"]
+        if np.array_equal(tc_counts, 2 * counts):
+            return tc.astype(np.float64).reshape(-1, 2)[keep_corner][tri]
+    for a, b in (("texture_u", "texture_v"), ("u", "v"), ("s", "t"), ("texture_s", "texture_t")):
+        if a in vert and b in vert and not isinstance(vert[a], tuple):
+            table = np.column_stack([np.asarray(vert[a], np.float64), np.asarray(vert[b], np.float64)])
+            return table[faces]
+    return None
+
+
+def _ids_and_names(face, comments, src, label):
+    """Part and material ids and names from the properties and comments :func:`write_ply` writes."""
     names = _comment_names(comments)
     part_id, part_names = None, []
     if "part_id" in face and not isinstance(face["part_id"], tuple):
@@ -398,18 +497,7 @@ def read_ply(path: str, label: str | None = None) -> Soup:
         material_id = np.asarray(face["material_id"], np.int64)[src]
         n_mat = int(material_id.max()) + 1 if len(material_id) else 0
         materials = [Material(names["material"].get(i, f"material{i}")) for i in range(n_mat)]
-    return Soup(
-        vertices=vertices,
-        faces=faces,
-        part_id=part_id,
-        part_names=part_names,
-        source_face=src,
-        material_id=material_id,
-        materials=materials,
-        uv=uv,
-        colors=colors,
-        path=label,
-    )
+    return part_id, part_names, material_id, materials
 
 
 def _comment_names(comments: list[str]) -> dict[str, dict[int, str]]:
@@ -444,8 +532,16 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
     geometry round-trips exactly.  Face properties: ``part_id``, ``material_id`` (when
     there are materials), ``group`` (when given) and every ``face_values`` entry; the
     names of parts, materials and groups go into ``comment meshvis ...`` header lines.
-    """
 
+    A soup read from a PLY file whose faces are input faces (some removed, turned over or
+    repeated) on the vertices as read is written by editing the input instead
+    (:mod:`meshvis.io.ply_edit`): every element and property keeps its type, the header
+    its comments and ``obj_info``, binary stays binary, ASCII stays ASCII.
+    """
+    edits = face_edits(soup, ("ply",)) if groups is None and not face_values else None
+    if edits is not None:
+        write_edited(edits, path)
+        return
     corner_src, faces = weld_corners(soup)
     flat = soup.faces.reshape(-1)
     pos = soup.vertices[flat[corner_src]]

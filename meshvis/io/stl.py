@@ -1,4 +1,4 @@
-"""STL reader (binary and ASCII) and binary writer.
+"""STL reader (binary and ASCII) and writer.
 
 Binary STL: an 80-byte header, a uint32 triangle count, then 50 bytes per triangle
 (normal, three corners as float32, a uint16 attribute).  The size must match the count
@@ -8,6 +8,11 @@ ASCII STL: ``solid name`` ... ``facet normal`` / ``outer loop`` / three ``vertex
 ``endloop`` / ``endfacet`` ... ``endsolid``.  Each solid becomes a part named after it.
 
 STL has no shared vertices: every triangle gets its own three vertices, in file order.
+
+Writing a soup read from STL (faces removed or turned over, vertices as read) keeps the
+file's kind: binary in, binary out with the input's 80-byte header and each kept
+triangle's record (normal and attribute bytes; a turned-over triangle's normal negated);
+ASCII in, ASCII out with the solid names.  Any other soup is written as binary STL.
 """
 
 from __future__ import annotations
@@ -16,12 +21,14 @@ import os
 import re
 import struct
 import warnings
+from dataclasses import dataclass
 
 import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
-from meshvis.io._common import atomic_write, unique_names
-from meshvis.soup import Soup
+from meshvis.io._common import atomic_write, fmt_floats, unique_names
+from meshvis.io.edits import face_edits
+from meshvis.soup import Soup, SourceRecord
 
 _BINARY = np.dtype([("normal", "<f4", (3,)), ("corners", "<f4", (3, 3)), ("attr", "<u2")])
 _SOLID = re.compile(r"^[ \t]*solid\b[ \t]*(.*)$", re.MULTILINE)
@@ -41,9 +48,11 @@ def read_stl(path: str, label: str | None = None) -> Soup:
                 raise ModelError("the model has no faces", label)
             rec = np.frombuffer(data, _BINARY, count=n, offset=84)
             corners = rec["corners"].astype(np.float64).reshape(-1, 3)
-            return Soup(
+            soup = Soup(
                 corners, np.arange(3 * n, dtype=np.int64).reshape(n, 3), part_names=[stem], path=label
             )
+            soup.source = SourceRecord("stl", soup.vertices, soup.faces.copy(), StlSource(data[:80], rec))
+            return soup
     head = data[:1024].lstrip()
     if not head.startswith(b"solid") or b"\x00" in data[:4096]:
         if len(data) >= 84:
@@ -99,27 +108,71 @@ def _read_ascii(text: str, label: str, stem: str) -> Soup:
     vertices = np.concatenate(chunks)
     m = len(vertices) // 3
 
-    return Soup(
+    soup = Soup(
         vertices,
         np.arange(3 * m, dtype=np.int64).reshape(m, 3),
         part_id=np.concatenate(part_ids),
         part_names=unique_names(names, "solid"),
         path=label,
     )
+    soup.source = SourceRecord("stl", soup.vertices, soup.faces.copy(), StlSource(None, None))
+    return soup
+
+
+@dataclass(eq=False)
+class StlSource:
+    """What the STL writer keeps of its input.
+
+    Parameters
+    ----------
+    header : bytes or None
+        The 80-byte header of a binary file; None for ASCII.
+    records : structured array or None
+        The triangle records of a binary file (normal, corners, attribute).
+    """
+
+    header: bytes | None
+    records: np.ndarray | None
 
 
 def write_stl(soup: Soup, path: str, groups=None, group_names=None, face_values=None) -> None:
-    """Write ``soup`` as binary STL (float32 coordinates, geometry only), atomically."""
-
+    """Write ``soup`` as STL, atomically (see the module docstring for which kind)."""
+    edits = face_edits(soup, ("stl",))
+    if edits is not None and edits.record.data.header is None:
+        _write_ascii(soup, path)
+        return
     tri = soup.triangles
-    rec = np.zeros(soup.n_faces, _BINARY)
-    rec["normal"] = soup.normals.astype(np.float32)
+    if edits is not None:
+        src: StlSource = edits.record.data
+        rec = src.records[edits.origin].copy()
+        rec["normal"] = np.where(edits.flipped[:, None], -rec["normal"], rec["normal"])
+        header = src.header
+    else:
+        rec = np.zeros(soup.n_faces, _BINARY)
+        rec["normal"] = soup.normals.astype(np.float32)
+        header = b"meshvis binary STL".ljust(80, b" ")
     rec["corners"] = tri.astype(np.float32)
-    header = b"meshvis binary STL".ljust(80, b" ")
     with atomic_write(path, "wb") as fh:
         fh.write(header)
         fh.write(struct.pack("<I", soup.n_faces))
         fh.write(rec.tobytes())
+
+
+def _write_ascii(soup: Soup, path: str) -> None:
+    """ASCII STL, one ``solid`` per part (in order of first face), coordinates as read."""
+    normals = fmt_floats(soup.normals)
+    corners = fmt_floats(soup.triangles)
+    facet = "facet normal %s %s %s\nouter loop\nvertex %s %s %s\nvertex %s %s %s\nvertex %s %s %s\nendloop\nendfacet\n"
+    out = []
+    _, first = np.unique(soup.part_id, return_index=True)
+    for p in soup.part_id[np.sort(first)].tolist():
+        name = soup.part_names[p] if p < len(soup.part_names) else f"solid{p}"
+        sel = np.flatnonzero(soup.part_id == p).tolist()
+        out.append(f"solid {name}\n")
+        out += [facet % tuple(normals[3 * i : 3 * i + 3] + corners[9 * i : 9 * i + 9]) for i in sel]
+        out.append(f"endsolid {name}\n")
+    with atomic_write(path, "w") as fh:
+        fh.write("".join(out))
 
 
 #: format name -> reader / writer, collected by :mod:`meshvis.io.reading` and :mod:`meshvis.io.writing`
