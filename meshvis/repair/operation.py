@@ -139,13 +139,16 @@ def run_operation(
     elif op == "remove-interior":
         r = remove_interior(soup, classification=c)
         save(r.kept, o["output"])
-        if o["removed"]:
+        wrote_removed = bool(o["removed"]) and r.removed.n_faces > 0
+        if wrote_removed:
             save(r.removed, o["removed"])
         report = r.report()
         tell(
             f"kept {report['kept_faces']}, removed {report['removed_faces']} of {report['input_faces']} faces; "
-            f"wrote {o['output']}" + (f" and {o['removed']}" if o["removed"] else "")
+            f"wrote {o['output']}" + (f" and {o['removed']}" if wrote_removed else "")
         )
+        if o["removed"] and not wrote_removed:  # an empty model is no model: say so, write nothing
+            tell(f"nothing was removed: {o['removed']} not written")
         if o["preview"]:
             save_png(render(r.kept, color_by="side").image, o["preview"])
     else:  # layers
