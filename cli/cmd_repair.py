@@ -7,16 +7,24 @@ import os
 import time
 
 from meshvis.errors import ParameterError
+from meshvis.io.report import write_report
 from meshvis.repair.operation import CLASSIFY_DEFAULTS, OPERATION_DEFAULTS
 
-from .common import check_output, point, positive_int, say, write_json
+from .common import check_output, point, positive_int, say
 
 
 def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     p.add_argument("input", help="input model (OBJ, PLY, STL, OFF, glTF/GLB, 3MF)")
     if needs_output:
         p.add_argument("-o", "--output", required=True, help="output model; format from the extension")
-    p.add_argument("--report", metavar="REPORT.json", help="write a JSON report with per-face results")
+    p.add_argument(
+        "--report",
+        metavar="REPORT.json",
+        help="write a JSON report with per-face results ('-': standard output)",
+    )
+    p.add_argument(
+        "--per-face", metavar="FILE.npz", help="write the report's per-face arrays to a .npz file instead"
+    )
     p.add_argument("--preview", metavar="PICTURE.png", help="write a ray-cast preview image")
     algorithm_options(p)
     p.add_argument(
@@ -137,7 +145,8 @@ def run(args: argparse.Namespace) -> int:
         x
         for x in (
             getattr(args, "output", None),
-            args.report,
+            args.report if args.report != "-" else None,
+            args.per_face,
             args.preview,
             getattr(args, "removed", None),
             getattr(args, "graphml", None),
@@ -148,6 +157,10 @@ def run(args: argparse.Namespace) -> int:
         raise ParameterError("two outputs share one path")
     for path in outputs:
         check_output(path, [args.input], args.force)
+    if args.per_face and not args.report:
+        raise ParameterError("--per-face needs --report")
+    if args.report == "-":
+        args.quiet = True  # standard output carries the report alone
     t0 = time.perf_counter()
     soup = load(args.input)
     say(args, f"{args.input}: {soup.n_faces} faces, {soup.n_parts} parts")
@@ -156,7 +169,7 @@ def run(args: argparse.Namespace) -> int:
     report["input"] = args.input
     report["seconds_total"] = time.perf_counter() - t0
     if args.report:
-        write_json(args.report, report)
+        write_report(report, args.report, args.per_face)
     return 0
 
 

@@ -101,6 +101,7 @@ def run_operation(
     """
     from meshvis.graphcut.classify import classify
     from meshvis.io import atomic_write, save
+    from meshvis.io.report import with_schema
     from meshvis.rays.render import render, render_layers, save_png
     from meshvis.repair.layers import layers
     from meshvis.repair.orient import orient
@@ -161,4 +162,4 @@ def run_operation(
             save_png(render_layers(soup, r.layer), o["preview"])
     report["operation"] = op
     report["seed"] = o["seed"]
-    return report
+    return with_schema(report)

@@ -80,7 +80,7 @@ class OrientResult:
             d["per_face"] = {
                 "flipped": self.flipped,
                 "duplicated": self.duplicated,
-                "status": self.status,
+                "status": np.asarray(STATUS_NAMES)[self.status],  # names, not codes
                 "outside_front": self.classification.outside[:, 0],
                 "outside_back": self.classification.outside[:, 1],
             }
