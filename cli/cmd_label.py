@@ -68,7 +68,7 @@ def add_parser(sub) -> None:
         "--up",
         choices=UP_AXES,
         default="auto",
-        help="the model's up axis (default auto: y for glTF/GLB, z otherwise)",
+        help="the model's up axis (default auto: y for glTF/GLB and OBJ, z otherwise)",
     )
     cam.add_argument(
         "--fit-margin",

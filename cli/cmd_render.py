@@ -23,7 +23,7 @@ def add_parser(sub) -> None:
         "--up",
         choices=("auto", "x", "y", "z"),
         default="auto",
-        help="the model's up axis (default auto: y for glTF/GLB, z otherwise)",
+        help="the model's up axis (default auto: y for glTF/GLB and OBJ, z otherwise)",
     )
     p.add_argument("--size", type=positive_int, nargs=2, default=(512, 512), metavar=("W", "H"))
     p.add_argument("--seed", type=int, default=0, help="seed of the layer peeling (--color-by layer)")

@@ -26,6 +26,12 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
         "--per-face", metavar="FILE.npz", help="write the report's per-face arrays to a .npz file instead"
     )
     p.add_argument("--preview", metavar="PICTURE.png", help="write a ray-cast preview image")
+    p.add_argument(
+        "--up",
+        choices=("auto", "x", "y", "z"),
+        default="auto",
+        help="the model's up axis in the preview (default auto: y for glTF/GLB and OBJ, z otherwise)",
+    )
     algorithm_options(p)
     p.add_argument(
         "--inside-point",

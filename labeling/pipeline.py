@@ -54,7 +54,7 @@ def fit_camera(
     distance: float | None = None,
     fov: float = 35.0,
     orthographic: bool = False,
-    up: Sequence[float] = (0.0, 0.0, 1.0),
+    up: Sequence[float] | None = None,
     margin: float = 1.6,
 ) -> Camera:
     """The default labeling camera: like :meth:`Camera.fit` but with room around the model.
@@ -394,7 +394,7 @@ def layout(
     color_by: str | None = "part",
     azimuth: float = 30.0,
     elevation: float = 20.0,
-    up: Sequence[float] = (0.0, 0.0, 1.0),
+    up: Sequence[float] | None = None,
     fit_margin: float = 1.6,
     **options: Any,
 ) -> LayoutResult:

@@ -10,7 +10,7 @@ import numpy as np
 
 from meshvis.errors import ModelError
 from meshvis.io.reading import load
-from meshvis.io.scene import soup_from_scene
+from meshvis.io.scene import soup_from_mesh, soup_from_scene
 from meshvis.soup import Soup, validate
 
 
@@ -32,8 +32,7 @@ def as_soup(model: Any, *, name: str | None = None) -> Soup:
     if trimesh is not None and isinstance(model, trimesh.Scene):
         return soup_from_scene(model, path=name)
     if trimesh is not None and isinstance(model, trimesh.Trimesh):
-        validate(model.vertices, model.faces, name)
-        return Soup(np.asarray(model.vertices), np.asarray(model.faces), path=name)
+        return soup_from_mesh(model, path=name)
     if isinstance(model, (tuple, list)) and len(model) == 2:
         v, f = model
         v, f = np.asarray(v), np.asarray(f)

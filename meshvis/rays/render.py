@@ -66,6 +66,7 @@ def render(
     caster: RayCaster | None = None,
     azimuth: float = 30.0,
     elevation: float = 20.0,
+    up: Any = None,
 ) -> Rendering:
     """Render a model to an image with one primary ray per pixel.
 
@@ -77,6 +78,8 @@ def render(
     color_by : "side" (front blue, back orange), "part", "layer" (uses ``face_values``), or None (grey)
     face_values : (m,) int, per-face values coloured by ``color_by="layer"`` (e.g. layer index)
     caster : a prebuilt RayCaster to reuse
+    up : (3,) float, optional; the model's up axis for the fitted camera (default: the rule of
+        :func:`meshvis.rays.camera.model_up`, y for glTF and OBJ files, z otherwise)
 
     Returns
     -------
@@ -91,7 +94,7 @@ def render(
     """
     soup = as_soup(model)
     caster = caster or RayCaster(soup)
-    camera = camera or Camera.fit(soup, azimuth=azimuth, elevation=elevation)
+    camera = camera or Camera.fit(soup, azimuth=azimuth, elevation=elevation, up=up)
     width, height = int(size[0]), int(size[1])
     origins, directions = camera.rays(width, height)
     hits = caster.intersect(origins, directions)
@@ -148,6 +151,7 @@ def render_layers(
     max_peel: int = 12,
     azimuth: float = 30.0,
     elevation: float = 20.0,
+    up: Any = None,
 ) -> np.ndarray:
     """Layered transparency: outer layers translucent, the innermost layer opaque.
 
@@ -163,7 +167,7 @@ def render_layers(
     soup = as_soup(model)
     layer = np.asarray(layer, np.int64)
     caster = caster or RayCaster(soup)
-    camera = camera or Camera.fit(soup, azimuth=azimuth, elevation=elevation)
+    camera = camera or Camera.fit(soup, azimuth=azimuth, elevation=elevation, up=up)
     width, height = int(size[0]), int(size[1])
     origins, directions = camera.rays(width, height)
     n_layers = max(int(layer.max()), 1)

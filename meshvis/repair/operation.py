@@ -102,6 +102,7 @@ def run_operation(
     from meshvis.graphcut.classify import classify
     from meshvis.io import atomic_write, save
     from meshvis.io.report import with_schema
+    from meshvis.rays.camera import up_axis
     from meshvis.rays.render import render, render_layers, save_png
     from meshvis.repair.layers import layers
     from meshvis.repair.orient import orient
@@ -109,6 +110,7 @@ def run_operation(
 
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
     tell = say or (lambda text: None)
+    up = up_axis(o.get("up") or "auto", [soup.path] if soup.path else [])  # of the preview
     c = classify(soup, progress=progress, **classify_kwargs(o))
     tell(c.summary())
     if op == "classify":
@@ -119,7 +121,7 @@ def run_operation(
             with atomic_write(o["graphml"], "wb") as fh:
                 nx.write_graphml(c.graph.to_networkx({"area": c.nodes.area}), fh)
         if o["preview"]:
-            save_png(render(soup, color_by="side").image, o["preview"])
+            save_png(render(soup, color_by="side", up=up).image, o["preview"])
     elif op == "orient":
         r = orient(
             soup,
@@ -136,7 +138,7 @@ def run_operation(
             f"{report['status_counts']}; wrote {o['output']} ({r.soup.n_faces} faces)"
         )
         if o["preview"]:
-            save_png(render(r.soup, color_by="side").image, o["preview"])
+            save_png(render(r.soup, color_by="side", up=up).image, o["preview"])
     elif op == "remove-interior":
         r = remove_interior(soup, classification=c)
         save(r.kept, o["output"])
@@ -151,7 +153,7 @@ def run_operation(
         if o["removed"] and not wrote_removed:  # an empty model is no model: say so, write nothing
             tell(f"nothing was removed: {o['removed']} not written")
         if o["preview"]:
-            save_png(render(r.kept, color_by="side").image, o["preview"])
+            save_png(render(r.kept, color_by="side", up=up).image, o["preview"])
     else:  # layers
         r = layers(soup, classification=c, max_layers=o["max_layers"])
         names = [f"layer{k}" for k in range(1, int(r.layer.max()) + 1)]
@@ -159,7 +161,7 @@ def run_operation(
         report = r.report()
         tell(f"{r.n_layers} layers, faces per layer {report['faces_per_layer']}; wrote {o['output']}")
         if o["preview"]:
-            save_png(render_layers(soup, r.layer), o["preview"])
+            save_png(render_layers(soup, r.layer, up=up), o["preview"])
     report["operation"] = op
     report["seed"] = o["seed"]
     return with_schema(report)
