@@ -256,6 +256,40 @@ def write_gltf(
         node_names + [f"node{i}" for i in range(len(node_names), int(node_of_face.max()) + 1)], "node"
     )
 
+    gl_materials, images, textures = _materials(soup, buf)
+    # UVs are only read back with a material: faces without one get a marked placeholder
+    placeholder = -1
+    if soup.uv is not None and (soup.material_id < 0).any():
+        placeholder = len(gl_materials)
+        gl_materials.append(
+            {
+                "name": "meshvis_none",
+                "extras": {"meshvis_placeholder": True},
+                "pbrMetallicRoughness": {"metallicFactor": 0.0},
+            }
+        )
+
+    nodes, meshes = _nodes_and_meshes(soup, buf, node_of_face, node_names, placeholder)
+    doc: dict = {
+        "asset": {"version": "2.0", "generator": "meshvis"},
+        "scene": 0,
+        "scenes": [{"nodes": list(range(len(nodes)))}],
+        "nodes": nodes,
+        "meshes": meshes,
+        "accessors": buf.accessors,
+        "bufferViews": buf.views,
+    }
+    if gl_materials:
+        doc["materials"] = gl_materials
+    if textures:
+        doc["textures"] = textures
+        doc["images"] = images
+        doc["samplers"] = [{}]
+    _serialise(doc, buf.data(), path, binary)
+
+
+def _materials(soup: Soup, buf: _Buffer) -> tuple[list, list, list]:
+    """glTF materials, images and textures of the soup's materials (images into ``buf``)."""
     mat_names = unique_names([m.name for m in soup.materials], "material")
     gl_materials, images, textures = [], [], []
     image_cache: dict[bytes, int] = {}
@@ -278,18 +312,11 @@ def write_gltf(
             entry["alphaMode"] = desc.alpha_mode
         gl_materials.append(entry)
 
-    # UVs are only read back with a material: faces without one get a marked placeholder
-    placeholder = -1
-    if soup.uv is not None and (soup.material_id < 0).any():
-        placeholder = len(gl_materials)
-        gl_materials.append(
-            {
-                "name": "meshvis_none",
-                "extras": {"meshvis_placeholder": True},
-                "pbrMetallicRoughness": {"metallicFactor": 0.0},
-            }
-        )
+    return gl_materials, images, textures
 
+
+def _nodes_and_meshes(soup: Soup, buf: _Buffer, node_of_face, node_names, placeholder: int):
+    """One node and mesh per node number, one primitive per run of faces with one material."""
     _, first = np.unique(node_of_face, return_index=True)
     node_order = node_of_face[np.sort(first)]
     nodes, meshes = [], []
@@ -332,22 +359,11 @@ def write_gltf(
             {"name": node_names[g], "mesh": len(meshes) - 1, "translation": [float(c) for c in centre]}
         )
 
-    doc: dict = {
-        "asset": {"version": "2.0", "generator": "meshvis"},
-        "scene": 0,
-        "scenes": [{"nodes": list(range(len(nodes)))}],
-        "nodes": nodes,
-        "meshes": meshes,
-        "accessors": buf.accessors,
-        "bufferViews": buf.views,
-    }
-    if gl_materials:
-        doc["materials"] = gl_materials
-    if textures:
-        doc["textures"] = textures
-        doc["images"] = images
-        doc["samplers"] = [{}]
-    blob = buf.data()
+    return nodes, meshes
+
+
+def _serialise(doc: dict, blob: bytes, path: str, binary: bool) -> None:
+    """Write the document with its buffer as GLB, or as .gltf with a data URI."""
     if binary:
         doc["buffers"] = [{"byteLength": len(blob)}]
         js = json.dumps(doc, separators=(",", ":")).encode("utf-8")

@@ -101,9 +101,8 @@ def _read_binary(
     buf: memoryview, offset: int, n: int, props: list[_Prop], endian: str, label: str, name: str
 ):
     """Read ``n`` rows of one element from ``buf`` at ``offset``; returns (columns, new offset)."""
-    lists = [p for p in props if p.count_dtype]
     total = len(buf)
-    if not lists:
+    if not any(p.count_dtype for p in props):
         dt = np.dtype([(f"p{i}", endian + p.dtype) for i, p in enumerate(props)])
         if offset + n * dt.itemsize > total:
             raise ModelFormatError(f"the file is truncated (in the '{name}' data)", label)
@@ -114,7 +113,16 @@ def _read_binary(
             p.name: (np.zeros(0, np.int64), np.zeros(0, p.dtype)) if p.count_dtype else np.zeros(0, p.dtype)
             for p in props
         }, offset
-    # fast path: every list as long as in the first row
+    fixed = _read_fixed_lists(buf, offset, n, props, endian, label, name)
+    if fixed is not None:
+        return fixed
+    row_start, counts, end = _walk_rows(buf, offset, n, props, endian, label, name)
+    return _gather_rows(buf, row_start, counts, props, endian), end
+
+
+def _read_fixed_lists(buf, offset: int, n: int, props: list[_Prop], endian: str, label: str, name: str):
+    """Fast path: every list as long as in the first row (one structured read), or None."""
+    total = len(buf)
     fields, pos, first_len = [], offset, {}
     for i, p in enumerate(props):
         if p.count_dtype:
@@ -130,33 +138,31 @@ def _read_binary(
             fields.append((f"p{i}", endian + p.dtype))
             pos += np.dtype(p.dtype).itemsize
     dt = np.dtype(fields)
-    if offset + n * dt.itemsize <= total:
-        arr = np.frombuffer(buf, dt, count=n, offset=offset)
-        if all((arr[f"c{i}"] == k).all() for i, k in first_len.items()):
-            out = {}
-            for i, p in enumerate(props):
-                if p.count_dtype:
-                    k = first_len[i]
-                    out[p.name] = (np.full(n, k, np.int64), arr[f"p{i}"].reshape(-1).astype(p.dtype))
-                else:
-                    out[p.name] = arr[f"p{i}"].astype(p.dtype)
-            return out, offset + n * dt.itemsize
-    # slow path: walk the rows to find where each one starts
+    if offset + n * dt.itemsize > total:
+        return None
+    arr = np.frombuffer(buf, dt, count=n, offset=offset)
+    if not all((arr[f"c{i}"] == k).all() for i, k in first_len.items()):
+        return None
+    out = {}
+    for i, p in enumerate(props):
+        if p.count_dtype:
+            k = first_len[i]
+            out[p.name] = (np.full(n, k, np.int64), arr[f"p{i}"].reshape(-1).astype(p.dtype))
+        else:
+            out[p.name] = arr[f"p{i}"].astype(p.dtype)
+    return out, offset + n * dt.itemsize
+
+
+def _walk_rows(buf, offset: int, n: int, props: list[_Prop], endian: str, label: str, name: str):
+    """Slow path: walk the rows to find where each starts; returns (row starts, list counts, end)."""
     layout = []  # per property: (is_list, struct format of count, count size, item size)
     for p in props:
         if p.count_dtype:
-            layout.append(
-                (
-                    True,
-                    endian + np.dtype(p.count_dtype).char,
-                    np.dtype(p.count_dtype).itemsize,
-                    np.dtype(p.dtype).itemsize,
-                )
-            )
+            c = np.dtype(p.count_dtype)
+            layout.append((True, endian + c.char, c.itemsize, np.dtype(p.dtype).itemsize))
         else:
             layout.append((False, "", np.dtype(p.dtype).itemsize, 0))
-    n_lists = len(lists)
-    counts = np.empty((n, n_lists), np.int64)
+    counts = np.empty((n, sum(1 for p in props if p.count_dtype)), np.int64)
     row_start = np.empty(n, np.int64)
     unpack = struct.unpack_from
     pos = offset
@@ -174,28 +180,34 @@ def _read_binary(
                     pos += csize
     except struct.error:
         raise ModelFormatError(f"the file is truncated (in the '{name}' data)", label) from None
-    if pos > total:
+    if pos > len(buf):
         raise ModelFormatError(f"the file is truncated (in the '{name}' data)", label)
+    return row_start, counts, pos
+
+
+def _gather_rows(buf, row_start: np.ndarray, counts: np.ndarray, props: list[_Prop], endian: str) -> dict:
+    """Every property's values, gathered from the rows found by :func:`_walk_rows`."""
     raw = np.frombuffer(buf, np.uint8)
     out = {}
     cursor = row_start.copy()
     j = 0
-    for p, (is_list, _, csize, isize) in zip(props, layout):
-        if is_list:
+    for p in props:
+        isize = np.dtype(p.dtype).itemsize
+        if p.count_dtype:
+            csize = np.dtype(p.count_dtype).itemsize
             k = counts[:, j]
             j += 1
             item_start = np.repeat(cursor + csize, k) + isize * (
                 np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
             )
             idx = item_start[:, None] + np.arange(isize)
-            vals = raw[idx.ravel()].view(endian + p.dtype).astype(p.dtype)
-            out[p.name] = (k, vals)
+            out[p.name] = (k, raw[idx.ravel()].view(endian + p.dtype).astype(p.dtype))
             cursor = cursor + csize + k * isize
         else:
-            idx = cursor[:, None] + np.arange(csize)
+            idx = cursor[:, None] + np.arange(isize)
             out[p.name] = raw[idx.ravel()].view(endian + p.dtype).astype(p.dtype)
-            cursor = cursor + csize
-    return out, pos
+            cursor = cursor + isize
+    return out
 
 
 def _read_ascii(values: np.ndarray, offset: int, n: int, props: list[_Prop], label: str, name: str):
@@ -543,10 +555,29 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
         write_edited(edits, path)
         return
     corner_src, faces = weld_corners(soup)
-    flat = soup.faces.reshape(-1)
-    pos = soup.vertices[flat[corner_src]]
-    n, m = len(pos), soup.n_faces
+    vdata, header_v = _vertex_rows(soup, corner_src)
+    fdata, header_f, comments = _face_rows(soup, faces, groups, group_names, face_values)
+    header = "\n".join(
+        [
+            "ply",
+            "format binary_little_endian 1.0",
+            *comments,
+            f"element vertex {len(vdata)}",
+            *header_v,
+            f"element face {len(fdata)}",
+            *header_f,
+            "end_header",
+        ]
+    )
+    with atomic_write(path, "wb") as fh:
+        fh.write((header + "\n").encode("utf-8"))
+        fh.write(vdata.tobytes())
+        fh.write(fdata.tobytes())
 
+
+def _vertex_rows(soup: Soup, corner_src: np.ndarray) -> tuple[np.ndarray, list[str]]:
+    """Vertex records (double positions, UVs, RGBA) and their header lines."""
+    pos = soup.vertices[soup.faces.reshape(-1)[corner_src]]
     vfields = [("x", "<f8"), ("y", "<f8"), ("z", "<f8")]
     vcols = [pos[:, 0], pos[:, 1], pos[:, 2]]
     header_v = ["property double x", "property double y", "property double z"]
@@ -561,7 +592,17 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
             vfields.append((c, "u1"))
             vcols.append(col[:, i])
             header_v.append(f"property uchar {c}")
+    vdata = np.empty(len(pos), np.dtype(vfields))
+    for (name, *_), col in zip(vfields, vcols):
+        vdata[name] = col
+    return vdata, header_v
 
+
+def _face_rows(
+    soup: Soup, faces, groups, group_names, face_values
+) -> tuple[np.ndarray, list[str], list[str]]:
+    """Face records (indices, ids, values), their header lines and the naming comments."""
+    m = soup.n_faces
     ffields = [("n", "u1"), ("idx", "<i4", (3,))]
     fcols: list = [np.full(m, 3, np.uint8), faces.astype(np.int32)]
     header_f = ["property list uchar int vertex_indices"]
@@ -588,32 +629,10 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
         ffields.append((key, np_type))
         fcols.append(np.asarray(val).astype(np_type))
         header_f.append(f"property {ply_name} {key}")
-
-    vdata = np.empty(n, np.dtype(vfields))
-    for (name, *_), col in zip(vfields, vcols):
-        vdata[name] = col
     fdata = np.empty(m, np.dtype(ffields))
     for (name, *_), col in zip(ffields, fcols):
         fdata[name] = col
-    header = (
-        "\n".join(
-            [
-                "ply",
-                "format binary_little_endian 1.0",
-                *comments,
-                f"element vertex {n}",
-                *header_v,
-                f"element face {m}",
-                *header_f,
-                "end_header",
-            ]
-        )
-        + "\n"
-    )
-    with atomic_write(path, "wb") as fh:
-        fh.write(header.encode("utf-8"))
-        fh.write(vdata.tobytes())
-        fh.write(fdata.tobytes())
+    return fdata, header_f, comments
 
 
 #: format name -> reader / writer, collected by :mod:`meshvis.io.reading` and :mod:`meshvis.io.writing`
