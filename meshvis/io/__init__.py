@@ -2,7 +2,8 @@
 
 :func:`load` reads OBJ, PLY (ASCII and binary), STL (ASCII and binary), OFF, glTF/GLB and
 3MF into a :class:`~meshvis.soup.Soup`; :func:`save` writes OBJ, PLY, STL, OFF and
-glTF/GLB, keeping every attribute the format can hold; :func:`as_soup` turns what users
+glTF/GLB, keeping every attribute the format can hold (a repaired soup is written by editing
+the file it was read from, see :mod:`meshvis.io.edits`); :func:`as_soup` turns what users
 have (a path, a trimesh object, ``(vertices, faces)``) into a soup.
 
 One module per format (:mod:`~meshvis.io.obj`, :mod:`~meshvis.io.ply`, ...), each

@@ -241,8 +241,11 @@ def write_gltf(
     written from scratch.
     """
     edits = face_edits(soup, ("glb", "gltf")) if groups is None else None
-    if edits is not None and can_edit(edits.record.data, path):
-        write_edited(edits, soup.faces, path, binary)
+    if (
+        edits is not None
+        and can_edit(edits.record.data, path)
+        and write_edited(edits, soup.faces, path, binary)
+    ):
         return
 
     buf = _Buffer()

@@ -17,7 +17,8 @@ Rules:
   data: instances needing the input's faces keep the mesh, every other variant gets a copy;
 * a primitive left without faces is dropped from its mesh; a node whose mesh is left
   without primitives loses its mesh (and skin / morph weights), the mesh stays unused;
-* a primitive drawn as a strip or a fan that changed is rewritten as a triangle list.
+* a primitive drawn as a strip or a fan that changed is rewritten as a triangle list;
+* a changed Draco-compressed primitive cannot be edited: the soup is then written anew.
 
 The library pygltflib was measured as the document layer and not used: loading and saving
 CesiumMilkTruck.glb with it adds default values to every material and accessor, rewrites
@@ -149,7 +150,7 @@ def can_edit(src: GltfSource, path: str) -> bool:
     return os.path.abspath(src.folder) == out_folder
 
 
-def write_edited(edits: FaceEdits, faces: np.ndarray, path: str, binary: bool) -> None:
+def write_edited(edits: FaceEdits, faces: np.ndarray, path: str, binary: bool) -> bool:
     """Write the input document with the faces of the soup (see the module docstring).
 
     Parameters
@@ -162,14 +163,33 @@ def write_edited(edits: FaceEdits, faces: np.ndarray, path: str, binary: bool) -
         Output file.
     binary : bool
         GLB (True) or a self-contained .gltf with data URIs (False).
+
+    Returns
+    -------
+    bool
+        False (nothing written) when a changed primitive is Draco-compressed.
     """
     src: GltfSource = edits.record.data
+    variants = _piece_indices(src, edits, faces)
+    if _compressed(src.doc, variants):
+        return False
     doc = copy.deepcopy(src.doc)
     buffers = [bytearray(b) if b is not None else None for b in src.buffers]
     state = _EditState(doc, buffers, src.glb_bin)
-    variants = _piece_indices(src, edits, faces)
     _apply_variants(state, src, variants)
     _write_document(state, path, binary)
+    return True
+
+
+def _compressed(doc: dict, changes: dict) -> bool:
+    """Whether a changed primitive stores its data compressed (Draco): its indices cannot be edited."""
+    nodes, meshes = doc.get("nodes", []), doc.get("meshes", [])
+    for node, prims in changes.items():
+        mesh = meshes[nodes[node]["mesh"]]
+        for k in prims:
+            if "KHR_draco_mesh_compression" in (mesh["primitives"][k].get("extensions") or {}):
+                return True
+    return False
 
 
 def _piece_indices(src: GltfSource, edits: FaceEdits, faces: np.ndarray) -> dict:
@@ -264,7 +284,7 @@ class _EditState:
             return False
         bv = self.doc["bufferViews"][view]
         data = self.buffers[bv["buffer"]] if bv["buffer"] < len(self.buffers) else None
-        if data is None or "byteStride" in bv:
+        if data is None or "byteStride" in bv or "extensions" in bv:  # e.g. meshopt-compressed
             return False
         raw = flat.astype(_INDEX_TYPES[ctype]).tobytes()
         start = bv.get("byteOffset", 0) + acc.get("byteOffset", 0)

@@ -50,6 +50,14 @@ def save(
 
     What each format keeps
     ----------------------
+    A soup read from a file of the output's format whose faces are input faces (some
+    removed, turned over, reordered or repeated; ``Soup.origin`` tells which) on the
+    vertices as read, saved without ``face_groups`` / ``face_values``, is written by
+    editing the input file: everything but the face data is kept as it was (glTF nodes,
+    instancing, accessors, materials, texture bytes, animations, extensions; OBJ ``vn``,
+    smoothing groups, comments, polygons; every PLY element and property with its type;
+    the STL header).  Any other soup is written from scratch:
+
     * OBJ: parts (``o``), groups (``g``), materials (an MTL file next to the OBJ, textures
       copied next to it), UVs, vertex colours (RGB).
     * PLY (binary): vertex colours (RGBA), UVs (welded per vertex), part / material /
