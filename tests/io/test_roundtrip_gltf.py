@@ -209,3 +209,33 @@ def test_edits_of_larger_models_add_no_validator_error(name, tmp_path):
     assert after["errors"] <= before["errors"]
     assert {m.split()[0] for m in after["messages"]} <= codes, after["messages"]
     _assert_only_faces_changed(src, out)
+
+
+def _write_glb(doc, blob, path):
+    import struct
+
+    js = json.dumps(doc).encode()
+    js += b" " * ((-len(js)) % 4)
+    blob += b"\x00" * ((-len(blob)) % 4)
+    with open(path, "wb") as fh:
+        fh.write(struct.pack("<4sII", b"glTF", 2, 28 + len(js) + len(blob)))
+        fh.write(struct.pack("<II", len(js), 0x4E4F534A) + js)
+        fh.write(struct.pack("<II", len(blob), 0x004E4942) + blob)
+
+
+def test_a_mirrored_instance_is_edited_in_the_file_winding(tmp_path):
+    doc, buffers, _ = read_container(_model("pins.glb"), "pins")
+    m = doc["nodes"][3]["matrix"]
+    doc["nodes"][3]["matrix"] = [-v for v in m[:4]] + m[4:]  # mirror the third node's x axis
+    src = str(tmp_path / "mirror.glb")
+    _write_glb(doc, bytes(buffers[0]), src)
+    soup = meshvis.load(src)
+    mirrored = soup.part_id == soup.part_names.index(doc["nodes"][3]["name"])
+    flip = mirrored | (soup.part_id == soup.part_names.index(doc["nodes"][2]["name"]))
+    out = str(tmp_path / "o.glb")
+    meshvis.save(soup.flipped(flip), out)
+    back = meshvis.load(out)
+    assert np.allclose(back.normals, soup.flipped(flip).normals, atol=1e-9)
+    # the mirrored node and its unmirrored sibling both turned over: one shared copy, no more
+    b, _, _ = read_container(out, "out")
+    assert len(b["meshes"]) == 3 and b["nodes"][2]["mesh"] == b["nodes"][3]["mesh"] == 2
