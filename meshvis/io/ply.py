@@ -24,7 +24,7 @@ import numpy as np
 from meshvis.errors import ModelError, ModelFormatError
 from meshvis.io._common import atomic_write, one_line, weld_corners
 from meshvis.io.edits import face_edits
-from meshvis.io.ply_edit import write_edited
+from meshvis.io.ply_edit import NewProperty, write_edited
 from meshvis.io.triangulate import triangulate
 from meshvis.soup import Material, Soup, SourceRecord
 
@@ -548,11 +548,13 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
     A soup read from a PLY file whose faces are input faces (some removed, turned over or
     repeated) on the vertices as read is written by editing the input instead
     (:mod:`meshvis.io.ply_edit`): every element and property keeps its type, the header
-    its comments and ``obj_info``, binary stays binary, ASCII stays ASCII.
+    its comments and ``obj_info``, binary stays binary, ASCII stays ASCII; ``groups`` and
+    ``face_values`` are added as face properties (named groups in header comments).
     """
-    edits = face_edits(soup, ("ply",)) if groups is None and not face_values else None
+    edits = face_edits(soup, ("ply",))
     if edits is not None:
-        write_edited(edits, path)
+        added, comments = _added_properties(edits, groups, group_names, face_values)
+        write_edited(edits, path, added, comments)
         return
     corner_src, faces = weld_corners(soup)
     vdata, header_v = _vertex_rows(soup, corner_src)
@@ -573,6 +575,23 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
         fh.write((header + "\n").encode("utf-8"))
         fh.write(vdata.tobytes())
         fh.write(fdata.tobytes())
+
+
+def _added_properties(edits, groups, group_names, face_values) -> tuple[list[NewProperty], list[str]]:
+    """``group`` and ``face_values`` as new face properties of an edited file, with comments."""
+    taken = set(edits.record.data.columns)
+    added, comments = [], []
+    values = ({"group": groups} if groups is not None else {}) | dict(face_values or {})
+    for key, val in values.items():
+        safe = "".join(ch if ch.isalnum() or ch == "_" else "_" for ch in key) or "value"
+        while safe in taken:
+            safe += "_"
+        taken.add(safe)
+        ply_name, np_type = _ply_type(val)
+        added.append(NewProperty(safe, ply_name, np.dtype(np_type).str[1:], np.asarray(val).astype(np_type)))
+    if groups is not None:
+        comments = [f"meshvis group {i} {one_line(nm, 1000)}" for i, nm in enumerate(group_names or [])]
+    return added, comments
 
 
 def _vertex_rows(soup: Soup, corner_src: np.ndarray) -> tuple[np.ndarray, list[str]]:

@@ -11,13 +11,39 @@ their corners.  A binary file stays binary in the same byte order, ASCII stays A
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from meshvis.io._common import atomic_write
 from meshvis.io.edits import FaceEdits
 
 
-def write_edited(edits: FaceEdits, path: str) -> None:
+@dataclass(frozen=True)
+class NewProperty:
+    """A face property the editing writer adds (e.g. the ``layer`` of :func:`meshvis.layers`).
+
+    Parameters
+    ----------
+    name : str
+    type_name : str
+        PLY type (``int``, ``uchar``, ``double``, ...).
+    dtype : str
+        numpy type without byte order (``i4``, ``u1``, ``f8``, ...).
+    values : (m,) array
+        One value per face of the soup.
+    """
+
+    name: str
+    type_name: str
+    dtype: str
+    values: np.ndarray
+    count_dtype: None = None
+
+
+def write_edited(
+    edits: FaceEdits, path: str, added: list[NewProperty] | None = None, comments: list[str] | None = None
+) -> None:
     """Write the input PLY with the soup's faces (see the module docstring).
 
     Parameters
@@ -26,17 +52,23 @@ def write_edited(edits: FaceEdits, path: str) -> None:
         The soup as edits of its source (``edits.record.data`` is a ``PlySource``).
     path : str
         Output file.
+    added : list of NewProperty, optional
+        Face properties to add after the input's; a polygon whose triangles have different
+        values is written as its triangles.
+    comments : list of str, optional
+        Header comment lines to add (without ``comment``).
     """
     src = edits.record.data
     layout = src.layout
-    columns = _face_rows(edits, src)
+    added = list(added or [])
+    columns = _face_rows(edits, src, added)
     n_rows = len(columns[src.index_name][0])
     name, _, props = layout.elements[src.face_element]
-    header = [f"element {name} {n_rows}" if _is_element_line(ln, name) else ln for ln in layout.header]
-    head = ("\n".join(header) + "\n").encode("latin-1")
+    props = list(props) + added
+    head = _header(layout.header, name, n_rows, added, comments or [])
     if layout.fmt == "ascii":
         body = [
-            _encode_ascii(columns, p, n_rows)
+            _encode_ascii(columns, props, n_rows)
             if i == src.face_element
             else _encode_ascii(src.elements[e], p, n)
             for i, (e, n, p) in enumerate(layout.elements)
@@ -51,17 +83,46 @@ def write_edited(edits: FaceEdits, path: str) -> None:
         fh.write(data)
 
 
+def _header(lines: list[str], face: str, n_rows: int, added: list, comments: list[str]) -> bytes:
+    """The input's header with the new face count, added properties and comments."""
+    out: list[str] = []
+    in_face = False
+    for line in lines:
+        tok = line.split()
+        if tok and tok[0] in ("element", "end_header"):
+            if in_face:  # the face element's properties end here
+                out += [f"property {p.type_name} {p.name}" for p in added]
+            if tok[0] == "element" and comments and not any(t.split()[:1] == ["element"] for t in out):
+                out += [f"comment {c}" for c in comments]
+            in_face = _is_element_line(line, face)
+            if in_face:
+                line = f"element {face} {n_rows}"
+        out.append(line)
+    return ("\n".join(out) + "\n").encode("latin-1")
+
+
 def _is_element_line(line: str, name: str) -> bool:
     tok = line.split()
     return len(tok) == 3 and tok[0] == "element" and tok[1] == name
 
 
-def _face_rows(edits: FaceEdits, src) -> dict:
-    """The face element's columns for the soup's faces."""
+def _face_rows(edits: FaceEdits, src, added: list) -> dict:
+    """The face element's columns for the soup's faces (``added`` properties included)."""
     counts, values = src.columns[src.index_name]
     n_rows = len(counts)
     start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
     whole, turned = edits.polygons(src.record, n_rows)
+    row_of = src.record[edits.origin]
+    for prop in added:  # a row is whole only where its triangles agree on every added value
+        v = np.asarray(prop.values, np.float64)
+        lo, hi = np.full(n_rows, np.inf), np.full(n_rows, -np.inf)
+        np.minimum.at(lo, row_of, v)
+        np.maximum.at(hi, row_of, v)
+        agree = (lo == hi) | ~np.isfinite(lo)
+        whole &= agree
+        turned &= agree
+    first = np.full(n_rows, -1, np.int64)
+    first[row_of[::-1]] = np.arange(len(row_of))[::-1]  # first soup face of every row
     rows = np.flatnonzero(whole)
     # corners of the whole rows: in order, or the first one then the others backwards
     k = counts[rows].astype(np.int64)
@@ -82,6 +143,11 @@ def _face_rows(edits: FaceEdits, src) -> dict:
         [np.repeat(np.arange(len(rows)), k), len(rows) + np.repeat(np.arange(len(occ)), 3)]
     )
     flat = np.concatenate([whole_corners, tri.reshape(-1)])
+    rep = first[rows]  # rows without triangles (skipped edges) get 0
+    added_values = {
+        p.name: np.concatenate([np.where(rep >= 0, p.values[np.maximum(rep, 0)], 0), p.values[occ]])
+        for p in added
+    }
     order = np.argsort(out_src, kind="stable")
     rank = np.empty(len(order), np.int64)
     rank[order] = np.arange(len(order))
@@ -105,6 +171,8 @@ def _face_rows(edits: FaceEdits, src) -> dict:
                 np.repeat(c_start[out_src], kk) + np.arange(int(kk.sum())) - np.repeat(np.cumsum(kk) - kk, kk)
             )
             columns[name] = (kk, v[idx])
+    for name, v in added_values.items():
+        columns[name] = v[order]
     return columns
 
 

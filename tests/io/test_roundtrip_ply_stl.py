@@ -166,3 +166,32 @@ def test_ascii_stl_stays_ascii(tmp_path):
     assert text.startswith("solid thing") and text.count("facet normal") == 2
     back = meshvis.load(str(out))
     assert np.allclose(back.normals, [[0, 0, -1], [0, 0, 1]])
+
+
+def test_layers_add_face_properties_to_the_edited_ply(tmp_path):
+    src = _model("pymeshlab_face000.ply")
+    soup = meshvis.load(src)
+    layer = np.arange(soup.n_faces) % 3 + 1
+    out = str(tmp_path / "l.ply")
+    meshvis.save(soup, out, face_groups=layer - 1, group_names=["a", "b", "c"], face_values={"layer": layer})
+    a, comments_a = read_elements(src, "in")
+    b, comments_b = read_elements(out, "out")
+    _equal_columns(a["camera"], b["camera"])
+    _equal_columns(a["vertex"], b["vertex"])
+    assert comments_b == comments_a + ["meshvis group 0 a", "meshvis group 1 b", "meshvis group 2 c"]
+    assert np.array_equal(b["face"]["layer"], layer) and np.array_equal(b["face"]["group"], layer - 1)
+    for prop in ("vertex_indices", "flags", "quality"):
+        assert np.array_equal(b["face"][prop][1] if prop == "vertex_indices" else b["face"][prop],
+                              a["face"][prop][1] if prop == "vertex_indices" else a["face"][prop])  # fmt: skip
+
+
+def test_a_polygon_whose_triangles_differ_in_layer_is_split(tmp_path):
+    src = tmp_path / "q.ply"
+    src.write_text(ASCII_QUADS)
+    soup = meshvis.load(str(src))
+    layer = np.array([1, 2, 1, 1])  # the first quad's triangles in two layers
+    out = tmp_path / "o.ply"
+    meshvis.save(soup, str(out), face_values={"layer": layer})
+    b, _ = read_elements(str(out), "out")
+    assert b["face"]["vertex_indices"][0].tolist() == [3, 3, 4]
+    assert b["face"]["layer"].tolist() == [1, 2, 1] and b["face"]["tag"].tolist() == [7, 7, -3]
