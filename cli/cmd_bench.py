@@ -25,10 +25,9 @@ def add_parser(sub) -> None:
     c.add_argument("--json", metavar="FILE")
     c.set_defaults(func=run_classify)
 
-    outside = {"labeling": "meshvis.labeling.bench", "labeling-sweep": "meshvis.labeling.sweep"}
     for name in ("accuracy", "stability", "labeling", "labeling-sweep", "compare"):
         try:
-            mod = __import__(outside.get(name, f"meshvis.eval.bench.{name}"), fromlist=["add_arguments"])
+            mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])
         except ModuleNotFoundError:
             continue
         if hasattr(mod, "add_arguments"):

@@ -511,7 +511,7 @@ def test_cli(tmp_path, scene):
 
 
 def test_bench_runs_small(scene):
-    from meshvis.labeling import bench
+    from meshvis.eval.bench import labeling as bench
 
     r = bench.run(
         scene,
@@ -547,7 +547,7 @@ def test_bench_runs_small(scene):
 
 
 def test_sweep_runs_small(scene):
-    from meshvis.labeling import sweep
+    from meshvis.eval.bench import labeling_sweep as sweep
 
     r = sweep.run(
         [("scene", scene, (0, 0, 1))],

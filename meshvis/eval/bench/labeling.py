@@ -30,17 +30,17 @@ from typing import Any
 
 import numpy as np
 
+from meshvis.labeling.baselines import adjust_text
+from meshvis.labeling.boxes import Spacing
+from meshvis.labeling.candidates import LAYOUTS
+from meshvis.labeling.frames import layout_frames, orbit
+from meshvis.labeling.geometry2d import polyline_length
+from meshvis.labeling.idbuffer import id_buffer
+from meshvis.labeling.inputs import label_texts, load_models
+from meshvis.labeling.metrics import is_clean, sequence_metrics
+from meshvis.labeling.output import write_json
+from meshvis.labeling.pipeline import LAYOUT_STAGES, fit_camera, solve
 from meshvis.rays.caster import RayCaster
-
-from .baselines import adjust_text
-from .boxes import Spacing
-from .candidates import LAYOUTS
-from .frames import layout_frames, orbit
-from .geometry2d import polyline_length
-from .idbuffer import id_buffer
-from .inputs import label_texts, load_models
-from .metrics import is_clean, sequence_metrics
-from .pipeline import LAYOUT_STAGES, fit_camera, solve
 
 #: metrics shown in the tables
 QUALITY = (
@@ -500,8 +500,6 @@ def main(args: argparse.Namespace) -> int:
 
 def report(result: dict[str, Any], text: str, json_path: str | None) -> int:
     """Print a benchmark's tables after its progress lines and write its JSON; exit status 0."""
-    from .output import write_json
-
     print()
     print(text)
     if json_path:

@@ -1,6 +1,6 @@
 """Guarantee sweep of the label layout: many views, sizes and models, every layout, both methods.
 
-The layout benchmark (:mod:`labeling.bench`) measures one model closely; this sweep checks
+The layout benchmark (:mod:`meshvis.eval.bench.labeling`) measures one model closely; this sweep checks
 the promises everywhere it can reach in a minute or two: for every (model, view, image
 size, layout, method) it lays the labels out once and records whether the layout is
 clean (no box overlap, no leader crossing, no box over the model, no bad anchor, no
@@ -22,13 +22,14 @@ from typing import Any
 import numpy as np
 
 from meshvis.eval.generators import real_models_dir
+from meshvis.labeling.candidates import LAYOUTS
+from meshvis.labeling.idbuffer import id_buffer
+from meshvis.labeling.inputs import label_texts, load_models
+from meshvis.labeling.metrics import is_clean
+from meshvis.labeling.pipeline import METHODS, fit_camera, solve, warm_up
 from meshvis.rays.caster import RayCaster
 
-from .candidates import LAYOUTS
-from .idbuffer import id_buffer
-from .inputs import label_texts, load_models
-from .metrics import is_clean
-from .pipeline import METHODS, fit_camera, solve, warm_up
+from .labeling import default_model, report
 
 #: (name, files, up axis) of the real models the sweep uses when they are present
 REAL = (
@@ -44,8 +45,6 @@ REAL = (
 
 def default_models() -> list[tuple[str, Any, tuple[float, float, float]]]:
     """The generated engine assembly and the real multi-part models that are available."""
-    from .bench import default_model
-
     out: list[tuple[str, Any, tuple[float, float, float]]] = [
         ("assembly", default_model()[0], (0.0, 0.0, 1.0))
     ]
@@ -183,8 +182,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def main(args: argparse.Namespace) -> int:
     """Entry point of ``meshvis bench labeling-sweep``."""
-    from .bench import report
-
     result = run(
         azimuths=args.azimuths,
         elevations=args.elevations,
