@@ -54,7 +54,6 @@ __all__ = [
     "from_closed_mesh",
     "is_closed",
     "signed_volume",
-    "real_models_dir",
     "GENERATORS",
 ]
 
@@ -1209,27 +1208,6 @@ def sphere_pair(
 
 
 # ====================================================================== 9. skin and ribcage
-def real_models_dir() -> Path:
-    """Folder of the shared real test models.
-
-    ``$MESHVIS_REAL_MODELS`` if set; otherwise the first existing ``shared/models/real``
-    beside the project: next to the source tree (editable install) or next to the current
-    folder or one of its parents (a checkout with the package installed elsewhere).
-    The first candidate is returned when none exists, so messages name a sensible path.
-    """
-    env = os.environ.get("MESHVIS_REAL_MODELS")
-    if env:
-        return Path(env)
-    rel = Path("shared") / "models" / "real"
-    candidates = [Path(__file__).resolve().parents[1].parent / rel]
-    here = Path.cwd().resolve()
-    candidates += [folder.parent / rel for folder in (here, *here.parents)]
-    for c in candidates:
-        if c.is_dir():
-            return c
-    return candidates[0]
-
-
 def _load_mesh(path: Path) -> Soup:
     if not path.exists():
         raise FileNotFoundError(f"{path}: real test model not found")
@@ -1255,14 +1233,13 @@ def _load_mesh(path: Path) -> Soup:
     return Soup(np.asarray(m.vertices, np.float64), np.asarray(m.faces, np.int64), path=os.fspath(path))
 
 
-def skin_and_ribcage(folder: str | os.PathLike | None = None) -> GroundTruth:
+def skin_and_ribcage(folder: str | os.PathLike) -> GroundTruth:
     """The dm_control dog skin with its rib cage inside: real hidden geometry.
 
     Parameters
     ----------
-    folder : path, optional
-        Where ``dm_control__SKINbody.stl`` and ``dm_control__BONERibcage.stl`` are;
-        default :func:`real_models_dir`.
+    folder : str or os.PathLike
+        Where ``dm_control__SKINbody.stl`` and ``dm_control__BONERibcage.stl`` are.
 
     Returns
     -------
@@ -1282,7 +1259,7 @@ def skin_and_ribcage(folder: str | os.PathLike | None = None) -> GroundTruth:
     """
     from meshvis.geometry.adjacency import duplicate_faces, weld
 
-    folder = Path(folder) if folder is not None else real_models_dir()
+    folder = Path(folder)
     skin = _load_mesh(folder / "dm_control__SKINbody.stl")
     ribs = _load_mesh(folder / "dm_control__BONERibcage.stl")
     both = Soup.concatenate([skin, ribs])
@@ -1608,6 +1585,5 @@ GENERATORS = {
     "terrain": terrain,
     "overlapping_solids": overlapping_solids,
     "sphere_pair": sphere_pair,
-    "skin_and_ribcage": skin_and_ribcage,
     "assembly": assembly,
 }

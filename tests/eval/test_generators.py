@@ -432,7 +432,7 @@ def test_from_closed_real_model():
 
 def test_skin_and_ribcage():
     try:
-        t = g.skin_and_ribcage()
+        t = g.skin_and_ribcage(ROOT.parent / "shared" / "models" / "real")
     except FileNotFoundError:
         pytest.skip("real models not available")
     s = t.soup

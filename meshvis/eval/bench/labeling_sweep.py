@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from meshvis.eval.generators import real_models_dir
+from meshvis.eval.bench.real import DEFAULT_MODELS, add_models_argument, models_folder
 from meshvis.labeling.candidates import LAYOUTS
 from meshvis.labeling.idbuffer import id_buffer
 from meshvis.labeling.inputs import label_texts, load_models
@@ -43,12 +43,20 @@ REAL = (
 )
 
 
-def default_models() -> list[tuple[str, Any, tuple[float, float, float]]]:
-    """The generated engine assembly and the real multi-part models that are available."""
+def default_models(
+    models_dir: str | os.PathLike = DEFAULT_MODELS,
+) -> list[tuple[str, Any, tuple[float, float, float]]]:
+    """The generated engine assembly and the real multi-part models of ``models_dir`` that are there.
+
+    Raises
+    ------
+    ParameterError
+        When ``models_dir`` is not a folder.
+    """
     out: list[tuple[str, Any, tuple[float, float, float]]] = [
         ("assembly", default_model()[0], (0.0, 0.0, 1.0))
     ]
-    folder = real_models_dir()
+    folder = models_folder(models_dir)
     for name, files, up in REAL:
         paths = [os.path.join(folder, f) for f in files]
         if all(os.path.exists(p) for p in paths):
@@ -65,6 +73,7 @@ def run(
     layouts: Sequence[str] = tuple(LAYOUTS),
     methods: Sequence[str] = METHODS,
     progress: Callable[[str], None] | None = None,
+    models_dir: str | os.PathLike = DEFAULT_MODELS,
 ) -> dict[str, Any]:
     """Lay out every case once and summarise.
 
@@ -76,6 +85,7 @@ def run(
     sizes : image widths = heights (pixels)
     layouts, methods : what to run
     progress : called with a line of text after each model
+    models_dir : folder of the real models of the default ``models``
 
     Returns
     -------
@@ -87,7 +97,7 @@ def run(
     say = progress or (lambda s: None)
     warm_up()  # one-time imports are not a layout's time
     cases: dict[str, dict[str, Any]] = {}
-    for name, model, up in models if models is not None else default_models():
+    for name, model, up in models if models is not None else default_models(models_dir):
         soup = load_models(model)
         caster = RayCaster(soup)
         texts = label_texts(soup.part_names)
@@ -178,6 +188,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--layouts", nargs="+", choices=tuple(LAYOUTS), default=list(LAYOUTS))
     parser.add_argument("--json", metavar="FILE", help="also write every case and the summary as JSON")
+    add_models_argument(parser)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -188,5 +199,6 @@ def main(args: argparse.Namespace) -> int:
         sizes=args.sizes,
         layouts=args.layouts,
         progress=lambda s: print(s, flush=True),
+        models_dir=args.models_dir,
     )
     return report(result, format(result), args.json)
