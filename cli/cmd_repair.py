@@ -21,6 +21,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     algorithm_options(p)
     p.add_argument(
         "--inside-point",
+        dest="inside_points",
         type=point,
         action="append",
         default=[],
@@ -29,6 +30,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     )
     p.add_argument(
         "--outside-point",
+        dest="outside_points",
         type=point,
         action="append",
         default=[],
@@ -37,6 +39,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     )
     p.add_argument(
         "--inside-box",
+        dest="inside_boxes",
         type=box,
         action="append",
         default=[],
@@ -45,6 +48,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     )
     p.add_argument(
         "--outside-box",
+        dest="outside_boxes",
         type=box,
         action="append",
         default=[],
@@ -82,8 +86,19 @@ def algorithm_options(p: argparse.ArgumentParser) -> None:
         default=d["samples_per_face"],
         help="sample points per intersecting/coplanar face (default 4)",
     )
-    p.add_argument("--no-filter", action="store_true", help="switch off the cosine filter (Eq. 8-9)")
-    p.add_argument("--no-progressive", action="store_true", help="cast the whole ray budget in one round")
+    # the flags switch off what the library's keywords (use_filter, progressive) switch on
+    p.add_argument(
+        "--no-filter",
+        dest="use_filter",
+        action="store_false",
+        help="switch off the cosine filter (Eq. 8-9)",
+    )
+    p.add_argument(
+        "--no-progressive",
+        dest="progressive",
+        action="store_false",
+        help="cast the whole ray budget in one round",
+    )
     p.add_argument("--solver", choices=("pymaxflow", "scipy"), default=d["solver"])
 
 
