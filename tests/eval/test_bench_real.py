@@ -37,3 +37,12 @@ def test_cli_names_the_missing_folder(tmp_path, capsys):
     assert main(["bench", "labeling-sweep", "--models", str(tmp_path / "nowhere")]) == 2
     err = capsys.readouterr().err.strip()
     assert err.startswith("meshvis: error:") and "nowhere" in err and len(err.splitlines()) == 1
+
+
+def test_labeling_default_model_is_the_repository_assembly():
+    import os
+
+    from meshvis.eval.bench.labeling import default_model
+
+    soup, name = default_model()
+    assert name.endswith(os.path.join("models", "assembly.obj")) and soup.n_parts == 36

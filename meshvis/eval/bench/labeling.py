@@ -58,10 +58,13 @@ QUALITY = (
 )
 
 
+#: the repository root of an editable install (meshvis/eval/bench/ is three folders down)
+_SOURCE_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))))
+
+
 def default_model() -> tuple[Any, str]:
-    """The project's engine-like assembly (``models/assembly.obj``, else the generator)."""
-    here = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
-    path = os.path.join(here, "models", "assembly.obj")
+    """The project's engine-like assembly (``models/assembly.obj`` of the source tree, else the generator)."""
+    path = os.path.join(_SOURCE_ROOT, "models", "assembly.obj")
     if os.path.exists(path):
         return load_models(path), path
     from meshvis.eval.generators import assembly
