@@ -26,6 +26,7 @@ import os
 import statistics
 import time
 from collections.abc import Callable, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -81,6 +82,188 @@ def _median_timings(runs: Sequence[dict[str, float]]) -> dict[str, float]:
     return {k: float(statistics.median(r.get(k, 0.0) for r in runs)) for k in keys}
 
 
+def _load(model: Any) -> tuple[Any, str]:
+    """The model to measure and its name (default: :func:`default_model`)."""
+    if model is None:
+        return default_model()
+    soup = load_models(model)
+    return soup, soup.path or str(model)
+
+
+@dataclass(frozen=True)
+class _Solver:
+    """The settings every timed layout of one benchmark run shares."""
+
+    texts: Sequence[str]
+    d_e: float | None
+    spacing: Spacing
+    repeat: int
+
+    def timed(self, ib: Any, layout: str, method: str) -> list:
+        """One untimed warm-up layout (fonts, caches), then ``repeat`` timed ones."""
+        solve(ib, self.texts, layout=layout, method=method, d_e=self.d_e, spacing=self.spacing)
+        return [
+            solve(ib, self.texts, layout=layout, method=method, d_e=self.d_e, spacing=self.spacing)
+            for _ in range(max(1, self.repeat))
+        ]
+
+
+def _compare_layout(
+    solver: _Solver, ib: Any, layout: str, adjusttext: bool, iterations: int, say: Callable[[str], None]
+) -> dict[str, Any]:
+    """Median stage times and the metrics of both methods (and adjustText) on one layout."""
+    entry: dict[str, Any] = {}
+    for method in ("fuzzy", "two-step"):
+        runs = solver.timed(ib, layout, method)
+        entry[method] = {
+            "timings": _median_timings([r.timings for r in runs]),
+            "metrics": _pick(runs[-1].metrics),
+        }
+        if method == "two-step" and adjusttext:
+            at = adjust_text(runs[-1], iterations=iterations)
+            entry["adjusttext"] = {
+                "timings": {"boxes": at.timings["boxes"], "layout_ms": 1000.0 * at.timings["boxes"]},
+                "metrics": _pick(at.metrics),
+            }
+    f = entry["fuzzy"]
+    say(
+        f"{layout:11s} fuzzy {f['timings']['layout_ms']:6.1f} ms, leader {f['metrics']['leader_mean_norm']:.3f}, "
+        f"salience {f['metrics']['salience_mean']:.3f}"
+    )
+    return entry
+
+
+def _anchor_error(anchors: dict[int, np.ndarray], ref: dict[int, np.ndarray], ref_ds: float) -> float:
+    """Mean distance of the anchors from the reference anchors of the same parts, / ``d_S``."""
+    common = sorted(set(anchors) & set(ref))
+    if not common:
+        return 0.0
+    return float(np.mean([np.linalg.norm(anchors[p] - ref[p]) for p in common]) / ref_ds)
+
+
+def _size_curve(
+    solver: _Solver, idbuf_at: Callable, sizes: Sequence[int], layout: str, say: Callable[[str], None]
+) -> dict[int, dict[str, Any]]:
+    """Quality and time against the image size; the largest size is each method's reference."""
+    ref_anchor: dict[str, dict[int, np.ndarray]] = {}
+    ref_ds: dict[str, float] = {}
+    per_size = {}
+    for n in sorted(sizes, reverse=True):
+        ibn, idn = idbuf_at(n)
+        rec: dict[str, Any] = {"idbuffer_s": idn}
+        for method in ("fuzzy", "two-step"):
+            runs = solver.timed(ibn, layout, method)
+            r = runs[-1]
+            lay_ms = float(statistics.median(x.timings["layout_ms"] for x in runs))
+            scale = 1.0 / n  # anchors in fractions of the image, comparable across sizes
+            anchors = {lab.part: lab.anchor * scale for lab in r.labels}
+            if method not in ref_anchor:
+                ref_anchor[method] = dict(anchors)
+                ref_ds[method] = r.sphere_diameter * scale
+            rec[method] = {
+                "layout_ms": lay_ms,
+                "total_s": idn + lay_ms / 1000.0,
+                "error": _anchor_error(anchors, ref_anchor[method], ref_ds[method]),
+                "metrics": _pick(r.metrics),
+            }
+        per_size[int(n)] = rec
+        say(
+            f"size {n:5d}: id buffer {idn * 1000:7.1f} ms, fuzzy layout {rec['fuzzy']['layout_ms']:6.1f} ms, "
+            f"error {rec['fuzzy']['error']:.4f}"
+        )
+    return {k: per_size[k] for k in sorted(per_size)}
+
+
+#: the orbit's variants: fuzzy with and without the coherence terms f6, f7, and two-step
+_ORBIT_VARIANTS = {
+    "fuzzy": dict(method="fuzzy"),
+    "fuzzy-no-coherence": dict(method="fuzzy", coherence=False),
+    "two-step": dict(method="two-step", coherence=False),
+}
+
+
+def _orbit(
+    soup: Any,
+    cams: list,
+    caster: RayCaster,
+    layout: str,
+    size: int,
+    d_e: float | None,
+    spacing: Spacing,
+    say: Callable[[str], None],
+) -> dict[str, dict[str, Any]]:
+    """Frame-to-frame motion and quality along an orbit, per variant."""
+    out = {}
+    for key, kw in _ORBIT_VARIANTS.items():
+        res = layout_frames(
+            soup, cams, caster=caster, layout=layout, size=(size, size), d_e=d_e, spacing=spacing, **kw
+        )
+        seq = sequence_metrics(res)
+        seq["clean_frames"] = int(
+            sum(
+                r.metrics["overlaps"] == 0
+                and r.metrics["crossings"] == 0
+                and r.metrics["label_over_model"] == 0
+                for r in res
+            )
+        )
+        seq["layout_ms_mean"] = float(np.mean([r.timings["layout_ms"] for r in res[1:]] or [0.0]))
+        seq["leader_mean_norm"] = float(np.mean([r.metrics["leader_mean_norm"] for r in res]))
+        seq["salience_mean"] = float(np.mean([r.metrics["salience_mean"] for r in res]))
+        out[key] = seq
+        say(
+            f"orbit {key:18s} label motion {seq['label_motion_mean']:.2f} px/frame, anchor motion "
+            f"{seq['anchor_motion_mean']:.2f}, flips {seq['side_flips']}, swaps {seq['order_swaps']}"
+        )
+    return out
+
+
+def _header(
+    name: str, soup: Any, *, d_e: float | None, spacing: Spacing, size: int, repeat: int, setup_s: float
+) -> dict[str, Any]:
+    """The result's description of the run, with empty sections to fill."""
+    return {
+        "model": name,
+        "d_e": d_e,
+        "rotate": spacing.rotate,
+        "parts": soup.n_parts,
+        "faces": soup.n_faces,
+        "size": int(size),
+        "repeat": int(repeat),
+        "setup_s": setup_s,
+        "layouts": {},
+        "sizes": {},
+        "orbit": {},
+        "views": {},
+    }
+
+
+def _view_buffers(
+    soup: Any, caster: RayCaster, views: int, elevations: Sequence[float], up: Sequence[float], size: int
+) -> list:
+    """ID buffers of ``views`` azimuths evenly spaced at each elevation."""
+    cams = [
+        fit_camera(soup, azimuth=az, elevation=el, up=up)
+        for el in elevations
+        for az in np.arange(views) * 360.0 / views
+    ]
+    return [id_buffer(soup, c, (size, size), caster=caster) for c in cams]
+
+
+def _many_views(
+    bufs: list, solver: _Solver, layouts: Sequence[str], say: Callable[[str], None]
+) -> dict[str, dict[str, Any]]:
+    """:func:`compare_views` of every layout over the ID buffers ``bufs``."""
+    out = {}
+    for layout in layouts:
+        out[layout] = v = compare_views(bufs, solver.texts, layout, solver.d_e, solver.spacing)
+        say(
+            f"views {layout:11s} leader fuzzy {v['fuzzy']['leader_mean']:.3f} two-step "
+            f"{v['two-step']['leader_mean']:.3f}, fuzzy shorter in {v['fuzzy_shorter']} of {v['views']}"
+        )
+    return out
+
+
 def run(
     model: Any = None,
     *,
@@ -134,158 +317,32 @@ def run(
     """
     say = progress or (lambda s: None)
     spacing = Spacing() if rotate is None else Spacing(rotate=float(rotate))
-    if model is None:
-        soup, name = default_model()
-    else:
-        soup = load_models(model)
-        name = soup.path or str(model)
+    soup, name = _load(model)
     texts = label_texts(soup.part_names)
     t0 = time.perf_counter()
     caster = RayCaster(soup)
     setup_s = time.perf_counter() - t0
     cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up)
-    out: dict[str, Any] = {
-        "model": name,
-        "d_e": d_e,
-        "rotate": spacing.rotate,
-        "parts": soup.n_parts,
-        "faces": soup.n_faces,
-        "size": int(size),
-        "repeat": int(repeat),
-        "setup_s": setup_s,
-        "layouts": {},
-        "sizes": {},
-        "orbit": {},
-        "views": {},
-        "view_elevations": [float(e) for e in view_elevations],
-    }
+    out = _header(name, soup, d_e=d_e, spacing=spacing, size=size, repeat=repeat, setup_s=setup_s)
+    out["view_elevations"] = [float(e) for e in view_elevations]  # the last key of the header
 
-    def idbuf_at(n: int):
+    def idbuf_at(n: int):  # the ID buffer of the benchmark view at n x n pixels, and its seconds
         t = time.perf_counter()
-        ib = id_buffer(soup, cam, (n, n), caster=caster)
-        return ib, time.perf_counter() - t
+        return id_buffer(soup, cam, (n, n), caster=caster), time.perf_counter() - t
 
     ib, id_s = idbuf_at(size)
-    out["visible_parts"] = int(len(ib.visible()))
-    out["idbuffer_s"] = id_s
+    out.update(visible_parts=int(len(ib.visible())), idbuffer_s=id_s)
+    solver = _Solver(texts=texts, d_e=d_e, spacing=spacing, repeat=repeat)
     for layout in layouts:
-        entry: dict[str, Any] = {}
-        for method in ("fuzzy", "two-step"):
-            solve(
-                ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing
-            )  # warm-up (fonts, caches)
-            runs = [
-                solve(ib, texts, layout=layout, method=method, d_e=d_e, spacing=spacing)
-                for _ in range(max(1, repeat))
-            ]
-            entry[method] = {
-                "timings": _median_timings([r.timings for r in runs]),
-                "metrics": _pick(runs[-1].metrics),
-            }
-            ref = runs[-1]
-            if method == "two-step" and adjusttext:
-                at = adjust_text(ref, iterations=adjusttext_iterations)
-                entry["adjusttext"] = {
-                    "timings": {"boxes": at.timings["boxes"], "layout_ms": 1000.0 * at.timings["boxes"]},
-                    "metrics": _pick(at.metrics),
-                }
-        out["layouts"][layout] = entry
-        f = entry["fuzzy"]
-        say(
-            f"{layout:11s} fuzzy {f['timings']['layout_ms']:6.1f} ms, leader {f['metrics']['leader_mean_norm']:.3f}, "
-            f"salience {f['metrics']['salience_mean']:.3f}"
-        )
-    # quality and time against the image size
-    ref_anchor: dict[str, dict[int, np.ndarray]] = {}
-    ref_ds: dict[str, float] = {}
-    per_size = {}
-    for n in sorted(sizes, reverse=True):
-        ibn, idn = idbuf_at(n)
-        rec: dict[str, Any] = {"idbuffer_s": idn}
-        for method in ("fuzzy", "two-step"):
-            solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing)
-            runs = [
-                solve(ibn, texts, layout=size_layout, method=method, d_e=d_e, spacing=spacing)
-                for _ in range(max(1, repeat))
-            ]
-            r = runs[-1]
-            lay_ms = float(statistics.median(x.timings["layout_ms"] for x in runs))
-            scale = 1.0 / n  # anchors in fractions of the image, comparable across sizes
-            anchors = {lab.part: lab.anchor * scale for lab in r.labels}
-            if method not in ref_anchor:  # the largest size is each method's reference
-                ref_anchor[method] = dict(anchors)
-                ref_ds[method] = r.sphere_diameter * scale
-            ref = ref_anchor[method]
-            common = sorted(set(anchors) & set(ref))
-            err = (
-                float(np.mean([np.linalg.norm(anchors[p] - ref[p]) for p in common]) / ref_ds[method])
-                if common
-                else 0.0
-            )
-            rec[method] = {
-                "layout_ms": lay_ms,
-                "total_s": idn + lay_ms / 1000.0,
-                "error": err,
-                "metrics": _pick(r.metrics),
-            }
-        per_size[int(n)] = rec
-        say(
-            f"size {n:5d}: id buffer {idn * 1000:7.1f} ms, fuzzy layout {rec['fuzzy']['layout_ms']:6.1f} ms, "
-            f"error {rec['fuzzy']['error']:.4f}"
-        )
-    out["sizes"] = {k: per_size[k] for k in sorted(per_size)}
-    out["size_layout"] = size_layout
+        out["layouts"][layout] = _compare_layout(solver, ib, layout, adjusttext, adjusttext_iterations, say)
+    out.update(sizes=_size_curve(solver, idbuf_at, sizes, size_layout, say), size_layout=size_layout)
     if orbit_frames and orbit_frames > 1:
         cams = orbit(soup, orbit_frames, elevation=elevation, start=azimuth, up=up)
-        variants = {
-            "fuzzy": dict(method="fuzzy"),
-            "fuzzy-no-coherence": dict(method="fuzzy", coherence=False),
-            "two-step": dict(method="two-step", coherence=False),
-        }
-        for key, kw in variants.items():
-            res = layout_frames(
-                soup,
-                cams,
-                caster=caster,
-                layout=orbit_layout,
-                size=(size, size),
-                d_e=d_e,
-                spacing=spacing,
-                **kw,
-            )
-            seq = sequence_metrics(res)
-            seq["clean_frames"] = int(
-                sum(
-                    r.metrics["overlaps"] == 0
-                    and r.metrics["crossings"] == 0
-                    and r.metrics["label_over_model"] == 0
-                    for r in res
-                )
-            )
-            seq["layout_ms_mean"] = float(np.mean([r.timings["layout_ms"] for r in res[1:]] or [0.0]))
-            seq["leader_mean_norm"] = float(np.mean([r.metrics["leader_mean_norm"] for r in res]))
-            seq["salience_mean"] = float(np.mean([r.metrics["salience_mean"] for r in res]))
-            out["orbit"][key] = seq
-            say(
-                f"orbit {key:18s} label motion {seq['label_motion_mean']:.2f} px/frame, anchor motion "
-                f"{seq['anchor_motion_mean']:.2f}, flips {seq['side_flips']}, swaps {seq['order_swaps']}"
-            )
-        out["orbit_layout"] = orbit_layout
-        out["orbit_frames"] = int(orbit_frames)
+        out["orbit"] = _orbit(soup, cams, caster, orbit_layout, size, d_e, spacing, say)
+        out.update(orbit_layout=orbit_layout, orbit_frames=int(orbit_frames))
     if views:
-        cams = [
-            fit_camera(soup, azimuth=az, elevation=el, up=up)
-            for el in view_elevations
-            for az in np.arange(views) * 360.0 / views
-        ]
-        bufs = [id_buffer(soup, c, (size, size), caster=caster) for c in cams]
-        for layout in layouts:
-            out["views"][layout] = compare_views(bufs, texts, layout, d_e, spacing)
-            v = out["views"][layout]
-            say(
-                f"views {layout:11s} leader fuzzy {v['fuzzy']['leader_mean']:.3f} two-step "
-                f"{v['two-step']['leader_mean']:.3f}, fuzzy shorter in {v['fuzzy_shorter']} of {v['views']}"
-            )
+        bufs = _view_buffers(soup, caster, views, view_elevations, up, size)
+        out["views"] = _many_views(bufs, solver, layouts, say)
     return out
 
 
@@ -342,18 +399,11 @@ def compare_views(
     return out
 
 
-def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' common name
-    """Plain-text tables of a :func:`run` result."""
-    lines = [
-        f"labeling benchmark: {result['model']} ({result['parts']} parts, {result['visible_parts']} visible), "
-        f"{result['size']} x {result['size']}, median of {result['repeat']} runs, d_e "
-        f"{'paper default' if result.get('d_e') is None else result['d_e']}, rotate {result.get('rotate')} px",
-        f"ray caster build {result['setup_s'] * 1000:.1f} ms, ID buffer {result['idbuffer_s'] * 1000:.1f} ms",
-        "",
-    ]
-    stages = [s for s in LAYOUT_STAGES]
+def _format_times(result: dict[str, Any]) -> list[str]:
+    """Per-stage time per frame of every layout and method."""
+    stages = list(LAYOUT_STAGES)
     head = f"{'layout':11s} {'method':10s} " + " ".join(f"{s[:6]:>6s}" for s in stages) + f" {'layout':>7s}"
-    lines += ["per-stage time per frame (ms)", head]
+    lines = ["per-stage time per frame (ms)", head]
     for layout, entry in result["layouts"].items():
         for method in ("fuzzy", "two-step"):
             t = entry[method]["timings"]
@@ -368,7 +418,12 @@ def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' co
                 + " ".join(f"{'':6s}" for _ in stages)
                 + f" {entry['adjusttext']['timings']['layout_ms']:7.1f}"
             )
-    lines += [
+    return lines
+
+
+def _format_quality(result: dict[str, Any]) -> list[str]:
+    """The quality metrics of every layout and method."""
+    lines = [
         "",
         "quality",
         f"{'layout':11s} {'method':10s} {'labels':>6s} {'overlap':>7s} {'cross':>5s} "
@@ -385,56 +440,87 @@ def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' co
                 f"{m['salience_mean']:8.3f} {m['leader_mean_norm']:7.3f} {m['leader_max_norm']:6.3f} "
                 f"{m.get('shifted_labels', 0):7d}"
             )
+    return lines
+
+
+def _format_sizes(result: dict[str, Any]) -> list[str]:
+    """Quality and time against the image size."""
+    lines = [
+        "",
+        f"quality against image size ({result['size_layout']}); error = mean anchor distance to the "
+        f"same method's anchors at the largest size / d_S",
+        f"{'size':>5s} {'id_ms':>7s} {'fz_ms':>7s} {'fz_err':>7s} {'fz_leader':>9s} {'fz_sal':>6s} "
+        f"{'2s_ms':>7s} {'2s_err':>7s} {'2s_leader':>9s} {'2s_sal':>6s}",
+    ]
+    for n, rec in result["sizes"].items():
+        f, t = rec["fuzzy"], rec["two-step"]
+        lines.append(
+            f"{int(n):5d} {rec['idbuffer_s'] * 1000:7.1f} {f['layout_ms']:7.1f} {f['error']:7.4f} "
+            f"{f['metrics']['leader_mean_norm']:9.3f} {f['metrics']['salience_mean']:6.3f} "
+            f"{t['layout_ms']:7.1f} {t['error']:7.4f} {t['metrics']['leader_mean_norm']:9.3f} "
+            f"{t['metrics']['salience_mean']:6.3f}"
+        )
+    return lines
+
+
+def _format_orbit(result: dict[str, Any]) -> list[str]:
+    """Motion per frame along the orbit, per variant."""
+    lines = [
+        "",
+        f"orbit of {result['orbit_frames']} frames ({result['orbit_layout']}), motion per frame (px)",
+        f"{'variant':20s} {'label':>6s} {'anchor':>6s} {'flips':>5s} {'swaps':>5s} {'clean':>5s} "
+        f"{'leader':>6s} {'salience':>8s} {'ms':>6s}",
+    ]
+    for key, s in result["orbit"].items():
+        lines.append(
+            f"{key:20s} {s['label_motion_mean']:6.2f} {s['anchor_motion_mean']:6.2f} {s['side_flips']:5d} "
+            f"{s['order_swaps']:5d} {s['clean_frames']:5d} {s['leader_mean_norm']:6.3f} "
+            f"{s['salience_mean']:8.3f} {s['layout_ms_mean']:6.1f}"
+        )
+    return lines
+
+
+def _format_views(result: dict[str, Any]) -> list[str]:
+    """Both methods over many views, per layout."""
+    n = next(iter(result["views"].values()))["views"]
+    lines = [
+        "",
+        f"{n} views (azimuths evenly spaced, elevations {result.get('view_elevations')}), "
+        "per layout; leader = mean over the views of the mean leader / d_S; common = summed over "
+        "the labels both methods place; box = median box-stage ms; fz_ms, fz_max = median and "
+        "slowest layout ms of the fuzzy method; most = most labels in one view",
+        f"{'layout':11s} {'fz_labels':>9s} {'2s_labels':>9s} {'fz_clean':>8s} {'2s_clean':>8s} "
+        f"{'fz_leader':>9s} {'2s_leader':>9s} {'shorter':>7s} {'fz_common':>9s} {'2s_common':>9s} "
+        f"{'fz_sal':>6s} {'fz_box':>6s} {'2s_box':>6s} {'fz_ms':>6s} {'fz_max':>6s} {'most':>4s}",
+    ]
+    for layout, v in result["views"].items():
+        f, t = v["fuzzy"], v["two-step"]
+        lines.append(
+            f"{layout:11s} {f['labels']:9d} {t['labels']:9d} {f['clean']:8d} {t['clean']:8d} "
+            f"{f['leader_mean']:9.3f} {t['leader_mean']:9.3f} {v['fuzzy_shorter']:7d} "
+            f"{v['common_leader']['fuzzy']:9.2f} {v['common_leader']['two-step']:9.2f} "
+            f"{f['salience_mean']:6.3f} {f['box_ms']:6.1f} {t['box_ms']:6.1f} "
+            f"{f['layout_ms']:6.1f} {f['layout_ms_max']:6.1f} {f['labels_max']:4d}"
+        )
+    return lines
+
+
+def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' common name
+    """Plain-text tables of a :func:`run` result."""
+    lines = [
+        f"labeling benchmark: {result['model']} ({result['parts']} parts, {result['visible_parts']} visible), "
+        f"{result['size']} x {result['size']}, median of {result['repeat']} runs, d_e "
+        f"{'paper default' if result.get('d_e') is None else result['d_e']}, rotate {result.get('rotate')} px",
+        f"ray caster build {result['setup_s'] * 1000:.1f} ms, ID buffer {result['idbuffer_s'] * 1000:.1f} ms",
+        "",
+    ]
+    lines += _format_times(result) + _format_quality(result)
     if result.get("sizes"):
-        lines += [
-            "",
-            f"quality against image size ({result['size_layout']}); error = mean anchor distance to the "
-            f"same method's anchors at the largest size / d_S",
-            f"{'size':>5s} {'id_ms':>7s} {'fz_ms':>7s} {'fz_err':>7s} {'fz_leader':>9s} {'fz_sal':>6s} "
-            f"{'2s_ms':>7s} {'2s_err':>7s} {'2s_leader':>9s} {'2s_sal':>6s}",
-        ]
-        for n, rec in result["sizes"].items():
-            f, t = rec["fuzzy"], rec["two-step"]
-            lines.append(
-                f"{int(n):5d} {rec['idbuffer_s'] * 1000:7.1f} {f['layout_ms']:7.1f} {f['error']:7.4f} "
-                f"{f['metrics']['leader_mean_norm']:9.3f} {f['metrics']['salience_mean']:6.3f} "
-                f"{t['layout_ms']:7.1f} {t['error']:7.4f} {t['metrics']['leader_mean_norm']:9.3f} "
-                f"{t['metrics']['salience_mean']:6.3f}"
-            )
+        lines += _format_sizes(result)
     if result.get("orbit"):
-        lines += [
-            "",
-            f"orbit of {result['orbit_frames']} frames ({result['orbit_layout']}), motion per frame (px)",
-            f"{'variant':20s} {'label':>6s} {'anchor':>6s} {'flips':>5s} {'swaps':>5s} {'clean':>5s} "
-            f"{'leader':>6s} {'salience':>8s} {'ms':>6s}",
-        ]
-        for key, s in result["orbit"].items():
-            lines.append(
-                f"{key:20s} {s['label_motion_mean']:6.2f} {s['anchor_motion_mean']:6.2f} {s['side_flips']:5d} "
-                f"{s['order_swaps']:5d} {s['clean_frames']:5d} {s['leader_mean_norm']:6.3f} "
-                f"{s['salience_mean']:8.3f} {s['layout_ms_mean']:6.1f}"
-            )
+        lines += _format_orbit(result)
     if result.get("views"):
-        n = next(iter(result["views"].values()))["views"]
-        lines += [
-            "",
-            f"{n} views (azimuths evenly spaced, elevations {result.get('view_elevations')}), "
-            "per layout; leader = mean over the views of the mean leader / d_S; common = summed over "
-            "the labels both methods place; box = median box-stage ms; fz_ms, fz_max = median and "
-            "slowest layout ms of the fuzzy method; most = most labels in one view",
-            f"{'layout':11s} {'fz_labels':>9s} {'2s_labels':>9s} {'fz_clean':>8s} {'2s_clean':>8s} "
-            f"{'fz_leader':>9s} {'2s_leader':>9s} {'shorter':>7s} {'fz_common':>9s} {'2s_common':>9s} "
-            f"{'fz_sal':>6s} {'fz_box':>6s} {'2s_box':>6s} {'fz_ms':>6s} {'fz_max':>6s} {'most':>4s}",
-        ]
-        for layout, v in result["views"].items():
-            f, t = v["fuzzy"], v["two-step"]
-            lines.append(
-                f"{layout:11s} {f['labels']:9d} {t['labels']:9d} {f['clean']:8d} {t['clean']:8d} "
-                f"{f['leader_mean']:9.3f} {t['leader_mean']:9.3f} {v['fuzzy_shorter']:7d} "
-                f"{v['common_leader']['fuzzy']:9.2f} {v['common_leader']['two-step']:9.2f} "
-                f"{f['salience_mean']:6.3f} {f['box_ms']:6.1f} {t['box_ms']:6.1f} "
-                f"{f['layout_ms']:6.1f} {f['layout_ms_max']:6.1f} {f['labels_max']:4d}"
-            )
+        lines += _format_views(result)
     return "\n".join(lines)
 
 
