@@ -59,19 +59,8 @@ def house(
         the cabinet.  The safe is layer 3.  Faces lying on another solid (furniture
         bottoms, upper-floor triangles partly or wholly under furniture) are ``ambiguous``.
     """
-    nx, ny = int(rooms[0]), int(rooms[1])
-    floors = int(floors)
-    if nx < 1 or ny < 1 or floors < 1:
-        raise ParameterError(
-            f"house needs at least one room and one floor, got rooms={rooms}, floors={floors}"
-        )
-    if nx > 2 and ny > 2 and floors > 1:
-        raise ParameterError(
-            f"rooms={rooms} with {floors} floors has rooms that do not touch the exterior "
-            "(their layer would depend on coplanar duplicates); use at most 2 rooms along x or y"
-        )
-    if not 0 <= furniture <= 4:
-        raise ParameterError(f"furniture must be 0..4 per room, got {furniture}")
+    nx, ny, floors = int(rooms[0]), int(rooms[1]), int(floors)
+    _check_house(rooms, floors, furniture)
     rng = np.random.default_rng(seed)
     W, D, H = (float(s) for s in room_size)
     xs = np.concatenate([[0.0], np.cumsum(W * rng.uniform(0.8, 1.2, nx))])
@@ -87,84 +76,127 @@ def house(
                 tris, side = _box_tris(lo, hi, cell * rng.uniform(0.8, 1.25))
                 # which of the six box sides have a neighbour (room, or roof above)
                 shared = np.array([i > 0, i < nx - 1, j > 0, j < ny - 1, k > 0, k < floors - 1 or roof])
-                inner = shared[side]
-                amb = np.zeros(len(tris), bool)
-                # furniture: one box per chosen quadrant of the floor
-                slots = rng.permutation(4)[:furniture]
-                for s_i, slot in enumerate(slots):
-                    qx, qy = slot % 2, slot // 2
-                    s_lo = lo[:2] + np.array([qx, qy]) * (hi[:2] - lo[:2]) / 2
-                    s_size = (hi[:2] - lo[:2]) / 2
-                    margin = 0.08 * s_size
-                    size = rng.uniform(0.35, 0.8, 2) * (s_size - 2 * margin)
-                    pos = s_lo + margin + rng.uniform(0, 1, 2) * (s_size - 2 * margin - size)
-                    f_lo = np.array([pos[0], pos[1], lo[2]])
-                    f_hi = np.array([pos[0] + size[0], pos[1] + size[1], lo[2] + rng.uniform(0.25, 0.7) * H])
-                    f_tris, f_side = _box_tris(f_lo, f_hi, 0.5 * cell)
-                    first = (i, j, k) == (0, 0, 0) and s_i == 0
-                    fname = "cabinet" if first else f"furniture_{i}{j}{k}_{s_i}"
-                    fV, fF = _weld(f_tris)
-                    # the bottom stands on the floor: coplanar contact, a matter of convention
-                    f_amb = f_side == 4  # _weld keeps the triangle order
-                    furn_pieces.append(
-                        _Piece(fV, fF, fname, outside=(False, False), layer=2, ambiguous=f_amb)
-                    )
-                    if first:
-                        c, e = (f_lo + f_hi) / 2, (f_hi - f_lo) / 2
-                        sV, sF = _box(c - 0.45 * e, c + 0.45 * e, 0.25 * cell)
-                        furn_pieces.append(_Piece(sV, sF, "safe", outside=(False, False), layer=3))
-                    if k > 0:
-                        # hidden floor triangles (partly) under the furniture are partly
-                        # sandwiched: which side faces outward is a matter of convention
-                        tmin, tmax = tris[..., :2].min(axis=1), tris[..., :2].max(axis=1)
-                        under = np.all((tmax > f_lo[:2]) & (tmin < f_hi[:2]), axis=1)
-                        amb |= under & (side == 4)
-                V, F = _weld(tris)
-                vis = ~inner
-                pieces.append(
-                    _Piece(
-                        V,
-                        F,
-                        f"room_{i}{j}{k}",
-                        outside=np.stack([vis, np.zeros_like(vis)], 1),
-                        layer=np.where(inner, 2, 1),
-                        outward=vis,
-                        ambiguous=amb,
-                    )
-                )
+                furn, amb = _furniture(rng, lo, hi, (i, j, k), furniture, cell, H, tris, side)
+                furn_pieces += furn
+                pieces.append(_room(tris, shared[side], amb, f"room_{i}{j}{k}"))
                 if partition and (i, j, k) == (nx - 1, ny - 1, floors - 1):
-                    cy = 0.5 * (lo[1] + hi[1])
-                    ub = np.linspace(lo[2], lo[2] + 0.6 * H, max(2, int(round(0.6 * H / cell)) + 1))
-                    vc = np.linspace(
-                        lo[0] + 0.2 * (hi[0] - lo[0]),
-                        hi[0] - 0.2 * (hi[0] - lo[0]),
-                        max(2, int(round(0.6 * (hi[0] - lo[0]) / cell)) + 1),
-                    )
-                    pV, pF = _weld(_axis_patch(1, cy, 1, ub, vc))
-                    furn_pieces.append(
-                        _Piece(pV, pF, "partition", outside=(False, False), layer=2, two_sided=True)
-                    )
+                    furn_pieces.append(_partition(lo, hi, H, cell))
     if roof:
-        Z0, Y, X = zs[-1], ys[-1], xs[-1]
-        section = np.array([[0.0, Z0], [Y, Z0], [Y / 2, Z0 + 0.45 * Y]])
-        rV, rF = _prism_x(xs[0], X, section, cell)
-        bottom = np.all(rV[rF][..., 2] == Z0, axis=1)
-        pieces.append(
-            _Piece(
-                rV,
-                rF,
-                "roof",
-                outside=np.stack([~bottom, np.zeros_like(bottom)], 1),
-                layer=np.where(bottom, 2, 1),
-                outward=~bottom,
-            )
-        )
+        pieces.append(_roof(xs, ys, zs, cell))
     return _compose(
         pieces + furn_pieces,
         "house",
         "closed house of room boxes with coplanar duplicate walls, roof, furniture, a cabinet "
         "with a safe inside (layer 3) and a two-sided partition; tests inside removal "
         "(only the hull is outside), coplanar handling and layers",
+    )
+
+
+def _check_house(rooms: tuple[int, int], floors: int, furniture: int) -> None:
+    """ParameterError unless every room of the house touches the exterior."""
+    nx, ny = int(rooms[0]), int(rooms[1])
+    if nx < 1 or ny < 1 or floors < 1:
+        raise ParameterError(
+            f"house needs at least one room and one floor, got rooms={rooms}, floors={floors}"
+        )
+    if nx > 2 and ny > 2 and floors > 1:
+        raise ParameterError(
+            f"rooms={rooms} with {floors} floors has rooms that do not touch the exterior "
+            "(their layer would depend on coplanar duplicates); use at most 2 rooms along x or y"
+        )
+    if not 0 <= furniture <= 4:
+        raise ParameterError(f"furniture must be 0..4 per room, got {furniture}")
+
+
+def _furniture(
+    rng: np.random.Generator,
+    lo: np.ndarray,
+    hi: np.ndarray,
+    room: tuple[int, int, int],
+    n: int,
+    cell: float,
+    height: float,
+    tris: np.ndarray,
+    side: np.ndarray,
+) -> tuple[list[_Piece], np.ndarray]:
+    """Furniture of one room: one box per chosen quadrant of its floor (the first room's first
+    box is a cabinet with a safe floating inside); and which of the room's triangles are
+    ambiguous (floor triangles of an upper storey partly under furniture)."""
+    i, j, k = room
+    pieces = []
+    amb = np.zeros(len(tris), bool)
+    slots = rng.permutation(4)[:n]
+    for s_i, slot in enumerate(slots):
+        qx, qy = slot % 2, slot // 2
+        s_lo = lo[:2] + np.array([qx, qy]) * (hi[:2] - lo[:2]) / 2
+        s_size = (hi[:2] - lo[:2]) / 2
+        margin = 0.08 * s_size
+        size = rng.uniform(0.35, 0.8, 2) * (s_size - 2 * margin)
+        pos = s_lo + margin + rng.uniform(0, 1, 2) * (s_size - 2 * margin - size)
+        f_lo = np.array([pos[0], pos[1], lo[2]])
+        f_hi = np.array([pos[0] + size[0], pos[1] + size[1], lo[2] + rng.uniform(0.25, 0.7) * height])
+        f_tris, f_side = _box_tris(f_lo, f_hi, 0.5 * cell)
+        first = (i, j, k) == (0, 0, 0) and s_i == 0
+        fname = "cabinet" if first else f"furniture_{i}{j}{k}_{s_i}"
+        fV, fF = _weld(f_tris)
+        # the bottom stands on the floor: coplanar contact, a matter of convention
+        f_amb = f_side == 4  # _weld keeps the triangle order
+        pieces.append(_Piece(fV, fF, fname, outside=(False, False), layer=2, ambiguous=f_amb))
+        if first:
+            c, e = (f_lo + f_hi) / 2, (f_hi - f_lo) / 2
+            sV, sF = _box(c - 0.45 * e, c + 0.45 * e, 0.25 * cell)
+            pieces.append(_Piece(sV, sF, "safe", outside=(False, False), layer=3))
+        if k > 0:
+            # hidden floor triangles (partly) under the furniture are partly
+            # sandwiched: which side faces outward is a matter of convention
+            tmin, tmax = tris[..., :2].min(axis=1), tris[..., :2].max(axis=1)
+            under = np.all((tmax > f_lo[:2]) & (tmin < f_hi[:2]), axis=1)
+            amb |= under & (side == 4)
+    return pieces, amb
+
+
+def _room(tris: np.ndarray, inner: np.ndarray, amb: np.ndarray, name: str) -> _Piece:
+    """A room box: its sides towards the exterior are outside (layer 1, front outward), the
+    sides shared with a neighbour hidden (layer 2, back outward)."""
+    V, F = _weld(tris)
+    vis = ~inner
+    return _Piece(
+        V,
+        F,
+        name,
+        outside=np.stack([vis, np.zeros_like(vis)], 1),
+        layer=np.where(inner, 2, 1),
+        outward=vis,
+        ambiguous=amb,
+    )
+
+
+def _partition(lo: np.ndarray, hi: np.ndarray, height: float, cell: float) -> _Piece:
+    """A free-standing single sheet across the middle of a room: hidden, two-sided."""
+    cy = 0.5 * (lo[1] + hi[1])
+    ub = np.linspace(lo[2], lo[2] + 0.6 * height, max(2, int(round(0.6 * height / cell)) + 1))
+    vc = np.linspace(
+        lo[0] + 0.2 * (hi[0] - lo[0]),
+        hi[0] - 0.2 * (hi[0] - lo[0]),
+        max(2, int(round(0.6 * (hi[0] - lo[0]) / cell)) + 1),
+    )
+    pV, pF = _weld(_axis_patch(1, cy, 1, ub, vc))
+    return _Piece(pV, pF, "partition", outside=(False, False), layer=2, two_sided=True)
+
+
+def _roof(xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, cell: float) -> _Piece:
+    """The gable roof: a closed prism on the top ceilings; its bottom (coplanar with them) is hidden."""
+    Z0, Y, X = zs[-1], ys[-1], xs[-1]
+    section = np.array([[0.0, Z0], [Y, Z0], [Y / 2, Z0 + 0.45 * Y]])
+    rV, rF = _prism_x(xs[0], X, section, cell)
+    bottom = np.all(rV[rF][..., 2] == Z0, axis=1)
+    return _Piece(
+        rV,
+        rF,
+        "roof",
+        outside=np.stack([~bottom, np.zeros_like(bottom)], 1),
+        layer=np.where(bottom, 2, 1),
+        outward=~bottom,
     )
 
 

@@ -12,6 +12,47 @@ from .closed import _welded
 from .truth import GroundTruth
 
 
+def _punch_holes(t: GroundTruth, holes: int, rng: np.random.Generator) -> GroundTruth:
+    """Delete ``holes`` random faces and every face sharing a corner position with one."""
+    m = t.n_faces
+    keys = _welded(t.soup)
+    seeds = rng.choice(m, size=min(holes, m), replace=False)
+    marked = np.zeros(int(keys.max()) + 1, bool)
+    marked[keys[seeds].ravel()] = True
+    return t.subset(~marked[keys].any(axis=1))
+
+
+def _shuffle(t: GroundTruth, rng: np.random.Generator) -> GroundTruth:
+    """Shuffle the face order and rotate every face's corners cyclically (keeps the winding)."""
+    t = t.subset(rng.permutation(t.n_faces))
+    shift = rng.integers(0, 3, t.n_faces)
+    order = (np.arange(3)[None, :] + shift[:, None]) % 3  # cyclic: keeps the winding
+    rows = np.arange(t.n_faces)[:, None]
+    s = t.soup
+    return replace(
+        t,
+        soup=replace(
+            s,
+            faces=s.faces[rows, order],
+            uv=None if s.uv is None else s.uv[rows, order],
+            colors=None if s.colors is None else s.colors[rows, order],
+        ),
+    )
+
+
+def _unweld(t: GroundTruth) -> GroundTruth:
+    """Give every face its own three vertices."""
+    s = t.soup
+    return replace(
+        t,
+        soup=replace(
+            s,
+            vertices=s.triangles.reshape(-1, 3).copy(),
+            faces=np.arange(3 * s.n_faces, dtype=np.int64).reshape(-1, 3),
+        ),
+    )
+
+
 def soupify(
     truth: GroundTruth,
     flip: float = 0.3,
@@ -53,13 +94,8 @@ def soupify(
         raise ParameterError(f"holes must be >= 0, got {holes}")
     rng = np.random.default_rng(seed)
     t = truth
-    m = t.n_faces
-    if holes and m:
-        keys = _welded(t.soup)
-        seeds = rng.choice(m, size=min(int(holes), m), replace=False)
-        marked = np.zeros(int(keys.max()) + 1, bool)
-        marked[keys[seeds].ravel()] = True
-        t = t.subset(~marked[keys].any(axis=1))
+    if holes and t.n_faces:
+        t = _punch_holes(t, int(holes), rng)
     if duplicate:
         k = int(round(duplicate * t.n_faces))
         extra = rng.choice(t.n_faces, size=k, replace=False)
@@ -70,30 +106,9 @@ def soupify(
         mask[rng.choice(t.n_faces, size=k, replace=False)] = True
         t = t.flip_faces(mask)
     if shuffle:
-        t = t.subset(rng.permutation(t.n_faces))
-        shift = rng.integers(0, 3, t.n_faces)
-        order = (np.arange(3)[None, :] + shift[:, None]) % 3  # cyclic: keeps the winding
-        rows = np.arange(t.n_faces)[:, None]
-        s = t.soup
-        t = replace(
-            t,
-            soup=replace(
-                s,
-                faces=s.faces[rows, order],
-                uv=None if s.uv is None else s.uv[rows, order],
-                colors=None if s.colors is None else s.colors[rows, order],
-            ),
-        )
+        t = _shuffle(t, rng)
     if unweld:
-        s = t.soup
-        t = replace(
-            t,
-            soup=replace(
-                s,
-                vertices=s.triangles.reshape(-1, 3).copy(),
-                faces=np.arange(3 * s.n_faces, dtype=np.int64).reshape(-1, 3),
-            ),
-        )
+        t = _unweld(t)
     bits = (
         [f"flip={flip:g}"]
         + (["unwelded"] if unweld else [])
