@@ -21,6 +21,7 @@ import time
 from collections import deque
 from collections.abc import Callable
 from dataclasses import asdict
+from typing import Any
 
 from .plan import default_jobs
 from .tasks import CRASHED, DEFAULT_RUNNER, INTERRUPTED, TIMEOUT, FileTask, empty_row
@@ -126,6 +127,66 @@ def _exit_text(code: int | None) -> str:
     return f"exit code {code}"
 
 
+#: worker processes that may fail to start in a row before the batch gives up
+_START_ATTEMPTS = 3
+
+
+def _start_tasks(workers: list[_Worker], queue: deque, tasks: list[FileTask], on_start: Callable) -> None:
+    """Hand the next queued tasks to the idle workers."""
+    for w in workers:
+        if w.state == "idle" and queue:
+            i = queue.popleft()
+            w.conn.send(tasks[i])
+            w.state, w.index, w.since = "busy", i, time.monotonic()
+            on_start(i)
+
+
+def _wait(workers: list[_Worker], time_limit: float | None) -> None:
+    """Sleep until a worker says something or dies, or the next deadline passes."""
+    deadlines = [d for d in (w.deadline(time_limit) for w in workers) if d is not None]
+    timeout = max(0.0, min(deadlines) - time.monotonic()) if deadlines else None
+    multiprocessing.connection.wait([w.conn for w in workers] + [w.proc.sentinel for w in workers], timeout)
+
+
+def _news(w: _Worker, time_limit: float | None, now: float) -> tuple[str | None, Any]:
+    """What happened to ``w``: ``("ready" | "done", payload)``, ``("dead" | "timeout", None)``,
+    or ``(None, None)`` while it works within its deadline."""
+    kind = payload = None
+    try:
+        if w.conn.poll():
+            kind, payload = w.conn.recv()
+    except (EOFError, OSError):
+        kind = "dead"
+    if kind is None:
+        if not w.proc.is_alive():
+            kind = "dead"
+        elif (d := w.deadline(time_limit)) is not None and now >= d:
+            kind = "timeout"
+    return kind, payload
+
+
+def _lost_row(w: _Worker, task: FileTask, kind: str, time_limit: float | None, now: float) -> dict:
+    """The row of a task whose (stopped) worker timed out or died."""
+    row = empty_row(task)
+    row["seconds"] = round(now - w.since, 3)
+    if kind == "timeout":
+        _fail(task, row, TIMEOUT, f"{task.input}: stopped after the time limit of {time_limit:g} s")
+    else:
+        _fail(task, row, CRASHED, f"{task.input}: the worker process died ({_exit_text(w.proc.exitcode)})")
+    return row
+
+
+def _interrupt(workers: list[_Worker], tasks: list[FileTask], rows: list[dict]) -> None:
+    """Ctrl-C: stop every worker, discard the partial outputs of their tasks, mark them interrupted."""
+    with _sigint_ignored():
+        for w in workers:
+            w.stop()
+            if w.index is not None:
+                discard_partial(tasks[w.index])
+                rows[w.index] = empty_row(tasks[w.index], INTERRUPTED, f"{tasks[w.index].input}: interrupted")
+        workers.clear()
+
+
 def _run_local(
     tasks: list[FileTask],
     todo: list[int],
@@ -148,32 +209,13 @@ def _run_local(
             n_busy = sum(w.state == "busy" for w in workers)
             while len(workers) < min(jobs, len(queue) + n_busy):
                 workers.append(_Worker(ctx, threads, runner))
-            for w in workers:
-                if w.state == "idle" and queue:
-                    i = queue.popleft()
-                    w.conn.send(tasks[i])
-                    w.state, w.index, w.since = "busy", i, time.monotonic()
-                    on_start(i)
-            deadlines = [d for d in (w.deadline(time_limit) for w in workers) if d is not None]
-            timeout = max(0.0, min(deadlines) - time.monotonic()) if deadlines else None
-            multiprocessing.connection.wait(
-                [w.conn for w in workers] + [w.proc.sentinel for w in workers], timeout
-            )
+            _start_tasks(workers, queue, tasks, on_start)
+            _wait(workers, time_limit)
             now = time.monotonic()
             for w in list(workers):
-                kind = payload = None
-                try:
-                    if w.conn.poll():
-                        kind, payload = w.conn.recv()
-                except (EOFError, OSError):
-                    kind = "dead"
+                kind, payload = _news(w, time_limit, now)
                 if kind is None:
-                    if not w.proc.is_alive():
-                        kind = "dead"
-                    elif (d := w.deadline(time_limit)) is not None and now >= d:
-                        kind = "timeout"
-                    else:
-                        continue
+                    continue
                 if kind == "ready":
                     w.state = "idle"
                     failed_starts = 0
@@ -186,42 +228,17 @@ def _run_local(
                     w.stop()
                     workers.remove(w)
                     if w.index is not None:
-                        task = tasks[w.index]
-                        row = empty_row(task)
-                        row["seconds"] = round(now - w.since, 3)
-                        if kind == "timeout":
-                            _fail(
-                                task,
-                                row,
-                                TIMEOUT,
-                                f"{task.input}: stopped after the time limit of {time_limit:g} s",
-                            )
-                        else:
-                            _fail(
-                                task,
-                                row,
-                                CRASHED,
-                                f"{task.input}: the worker process died ({_exit_text(w.proc.exitcode)})",
-                            )
-                        rows[w.index] = row
+                        rows[w.index] = row = _lost_row(w, tasks[w.index], kind, time_limit, now)
                         on_done(w.index, row)
                     elif was_starting:
                         failed_starts += 1
-                        if failed_starts >= 3:
+                        if failed_starts >= _START_ATTEMPTS:
                             raise RuntimeError(
                                 f"batch worker processes fail to start ({_exit_text(w.proc.exitcode)})"
                             )
         return False
     except KeyboardInterrupt:
-        with _sigint_ignored():
-            for w in workers:
-                w.stop()
-                if w.index is not None:
-                    discard_partial(tasks[w.index])
-                    rows[w.index] = empty_row(
-                        tasks[w.index], INTERRUPTED, f"{tasks[w.index].input}: interrupted"
-                    )
-            workers.clear()
+        _interrupt(workers, tasks, rows)
         return True
     finally:
         with _sigint_ignored():

@@ -66,6 +66,32 @@ from .stability_cases import (
 from .stability_models import tiny_beside_huge
 
 
+def _crack_group(quick: bool, rays_per_node: int, seed: int) -> CaseResult:
+    """Group 3, the cracked box at the widths, rays and probes of a quick or a full run."""
+    return crack_case(
+        CRACK_WIDTHS_QUICK if quick else CRACK_WIDTHS_FULL,
+        0.1 if quick else 0.05,
+        rays_per_node,
+        seed,
+        SHARE_RAYS_QUICK if quick else SHARE_RAYS_FULL,
+        SLIT_WIDTHS_QUICK if quick else SLIT_WIDTHS_FULL,
+        () if quick else OFFSET_WIDTHS,
+        OFFSET_RAYS,
+    )
+
+
+def _machine() -> dict:
+    """Python, platform, processor and CPU count of the machine the run measured."""
+    import platform
+
+    return {
+        "python": platform.python_version(),
+        "platform": platform.platform(),
+        "processor": platform.processor() or platform.machine(),
+        "cpus": os.cpu_count(),
+    }
+
+
 def run(
     quick: bool = False,
     seed: int = 0,
@@ -108,29 +134,12 @@ def run(
             seed,
         )
     )
-    emit(
-        [
-            _timed(
-                lambda: crack_case(
-                    CRACK_WIDTHS_QUICK if quick else CRACK_WIDTHS_FULL,
-                    0.1 if quick else 0.05,
-                    rays_per_node,
-                    seed,
-                    SHARE_RAYS_QUICK if quick else SHARE_RAYS_FULL,
-                    SLIT_WIDTHS_QUICK if quick else SLIT_WIDTHS_FULL,
-                    () if quick else OFFSET_WIDTHS,
-                    OFFSET_RAYS,
-                )
-            )
-        ]
-    )
+    emit([_timed(lambda: _crack_group(quick, rays_per_node, seed))])
     wmodels = {TINY_NAME: tiny_beside_huge(), "cracked box": cracked}
     if not quick:
         wmodels["house"] = base["house"]
     emit(weight_cases(wmodels, rays_per_node, seed, require_span={TINY_NAME}))
     emit(tiny_cases(rays_per_node, seed))
-    import platform
-
     cases = [asdict(r) for r in results]
     return {
         "quick": quick,
@@ -139,12 +148,7 @@ def run(
         "passed": sum(r.passed for r in results),
         "failed": sum(not r.passed for r in results),
         "seconds": time.perf_counter() - t0,
-        "machine": {
-            "python": platform.python_version(),
-            "platform": platform.platform(),
-            "processor": platform.processor() or platform.machine(),
-            "cpus": os.cpu_count(),
-        },
+        "machine": _machine(),
         "cases": cases,
     }
 

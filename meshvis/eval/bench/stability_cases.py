@@ -187,103 +187,110 @@ def similarity_cases(
     return out
 
 
+def _sliver_case(name: str, soup: Soup, ref: Classification, rays_per_node: int, seed: int) -> CaseResult:
+    """Faces split into slivers: every piece must keep the label of the face it was cut from."""
+    m = soup.n_faces
+    s, parent = split_into_slivers(soup, seed=seed)
+    c = classify(s, rays_per_node=rays_per_node, seed=seed)
+    # every piece is compared with the face it was cut from, weighted by its own area
+    agree = area_agreement(ref.side_outside[parent], c.side_outside, s.areas)
+    k = s.n_faces - m  # faces were split: [untouched, slivers (k), remainders (k)]
+    pos = np.arange(s.n_faces)
+    sliver = (pos >= m - k) & (pos < m)
+    n_flip = int(np.sum(np.any(ref.side_outside[parent] != c.side_outside, axis=1) & sliver))
+    ar = float(aspect_ratios(s).max())
+    bad = nonfinite(c)
+    return CaseResult(
+        group="degenerate",
+        name=f"{name}: slivers (aspect ratio up to {ar:.1e})",
+        passed=agree >= AGREEMENT and not bad,
+        figure=f"agreement {100 * agree:.4f}% of area; {n_flip} of {int(sliver.sum())} slivers "
+        f"differ from their face" + _finite_note(bad),
+        values={
+            "agreement": agree,
+            "max_aspect_ratio": ar,
+            "slivers": int(sliver.sum()),
+            "slivers_differing": n_flip,
+            "nonfinite": bad,
+        },
+    )
+
+
+def _appended_case(
+    name: str,
+    soup: Soup,
+    ref: Classification,
+    label: str,
+    make: Callable[[], Soup],
+    extra: Callable[[Classification], dict],
+    rays_per_node: int,
+    seed: int,
+) -> CaseResult:
+    """Faces appended to the model (``make``): the original faces must keep their labels;
+    ``extra`` adds figures of the classification."""
+    m = soup.n_faces
+    s = make()
+    c = classify(s, rays_per_node=rays_per_node, seed=seed)
+    agree = area_agreement(ref.side_outside, c.side_outside[:m], soup.areas)
+    bad = nonfinite(c)
+    info = extra(c)
+    tail = "; ".join(f"{k.replace('_', ' ')} {v}" for k, v in info.items())
+    return CaseResult(
+        group="degenerate",
+        name=f"{name}: {label}",
+        passed=agree >= AGREEMENT and not bad,
+        figure=f"original faces agree on {100 * agree:.4f}% of area; {tail}" + _finite_note(bad),
+        values={"agreement": agree, "added_faces": s.n_faces - m, **info, "nonfinite": bad},
+    )
+
+
+def _perturbed_case(name: str, soup: Soup, ref: Classification, rays_per_node: int, seed: int) -> CaseResult:
+    """Corners unwelded and moved by 1e-9 x size: the labels must not change."""
+    s = perturb_corners(soup, 1e-9, seed=seed)
+    c = classify(s, rays_per_node=rays_per_node, seed=seed)
+    agree = area_agreement(ref.side_outside, c.side_outside, soup.areas)
+    bad = nonfinite(c)
+    return CaseResult(
+        group="degenerate",
+        name=f"{name}: corners unwelded and moved by 1e-9 x size",
+        passed=agree >= AGREEMENT and not bad,
+        figure=f"agreement {100 * agree:.4f}% of area; {int(c.flagged.sum())} faces flagged"
+        + _finite_note(bad),
+        values={"agreement": agree, "nonfinite": bad},
+    )
+
+
 def degenerate_cases(models: dict[str, Soup], rays_per_node: int, seed: int) -> list[CaseResult]:
     """Group 2: slivers, zero-area faces, duplicates, near-coplanar copies, perturbed corners."""
     out = []
+    budget = dict(rays_per_node=rays_per_node, seed=seed)
     for name, soup in models.items():
         ref = classify(soup, rays_per_node=rays_per_node, seed=seed)
         m = soup.n_faces
-
-        def sliver_case() -> CaseResult:
-            s, parent = split_into_slivers(soup, seed=seed)
-            c = classify(s, rays_per_node=rays_per_node, seed=seed)
-            # every piece is compared with the face it was cut from, weighted by its own area
-            agree = area_agreement(ref.side_outside[parent], c.side_outside, s.areas)
-            k = s.n_faces - m  # faces were split: [untouched, slivers (k), remainders (k)]
-            pos = np.arange(s.n_faces)
-            sliver = (pos >= m - k) & (pos < m)
-            n_flip = int(np.sum(np.any(ref.side_outside[parent] != c.side_outside, axis=1) & sliver))
-            ar = float(aspect_ratios(s).max())
-            bad = nonfinite(c)
-            return CaseResult(
-                "degenerate",
-                f"{name}: slivers (aspect ratio up to {ar:.1e})",
-                agree >= AGREEMENT and not bad,
-                f"agreement {100 * agree:.4f}% of area; {n_flip} of {int(sliver.sum())} slivers "
-                f"differ from their face" + _finite_note(bad),
-                {
-                    "agreement": agree,
-                    "max_aspect_ratio": ar,
-                    "slivers": int(sliver.sum()),
-                    "slivers_differing": n_flip,
-                    "nonfinite": bad,
+        appended = [
+            (
+                "zero-area faces (+10%)",
+                lambda soup=soup: add_zero_area(soup, seed=seed),
+                lambda c, m=m: {
+                    "degenerate_faces": int(c.degenerate.sum()),
+                    "added_classified_outside": int(c.side_outside[m:].any(axis=1).sum()),
                 },
-            )
-
-        def appended_case(
-            label: str, make: Callable[[], Soup], extra: Callable[[Classification], dict]
-        ) -> CaseResult:
-            s = make()
-            c = classify(s, rays_per_node=rays_per_node, seed=seed)
-            agree = area_agreement(ref.side_outside, c.side_outside[:m], soup.areas)
-            bad = nonfinite(c)
-            info = extra(c)
-            tail = "; ".join(f"{k.replace('_', ' ')} {v}" for k, v in info.items())
-            return CaseResult(
-                "degenerate",
-                f"{name}: {label}",
-                agree >= AGREEMENT and not bad,
-                f"original faces agree on {100 * agree:.4f}% of area; {tail}" + _finite_note(bad),
-                {"agreement": agree, "added_faces": s.n_faces - m, **info, "nonfinite": bad},
-            )
-
-        out.append(_timed(sliver_case))
-        out.append(
-            _timed(
-                lambda: appended_case(
-                    "zero-area faces (+10%)",
-                    lambda: add_zero_area(soup, seed=seed),
-                    lambda c: {
-                        "degenerate_faces": int(c.degenerate.sum()),
-                        "added_classified_outside": int(c.side_outside[m:].any(axis=1).sum()),
-                    },
-                )
-            )
-        )
-        out.append(
-            _timed(
-                lambda: appended_case(
-                    "duplicate faces (+10% same, +10% reversed)",
-                    lambda: add_duplicates(soup, seed=seed),
-                    lambda c: {"flagged_faces": int(c.flagged.sum())},
-                )
-            )
-        )
-        out.append(
-            _timed(
-                lambda: appended_case(
-                    "near-coplanar copies 1e-7 x size away (+10%)",
-                    lambda: add_near_coplanar(soup, 1e-7, seed=seed),
-                    lambda c: {"flagged_faces": int(c.flagged.sum())},
-                )
-            )
-        )
-
-        def perturbed_case() -> CaseResult:
-            s = perturb_corners(soup, 1e-9, seed=seed)
-            c = classify(s, rays_per_node=rays_per_node, seed=seed)
-            agree = area_agreement(ref.side_outside, c.side_outside, soup.areas)
-            bad = nonfinite(c)
-            return CaseResult(
-                "degenerate",
-                f"{name}: corners unwelded and moved by 1e-9 x size",
-                agree >= AGREEMENT and not bad,
-                f"agreement {100 * agree:.4f}% of area; {int(c.flagged.sum())} faces flagged"
-                + _finite_note(bad),
-                {"agreement": agree, "nonfinite": bad},
-            )
-
-        out.append(_timed(perturbed_case))
+            ),
+            (
+                "duplicate faces (+10% same, +10% reversed)",
+                lambda soup=soup: add_duplicates(soup, seed=seed),
+                lambda c: {"flagged_faces": int(c.flagged.sum())},
+            ),
+            (
+                "near-coplanar copies 1e-7 x size away (+10%)",
+                lambda soup=soup: add_near_coplanar(soup, 1e-7, seed=seed),
+                lambda c: {"flagged_faces": int(c.flagged.sum())},
+            ),
+        ]
+        out.append(_timed(lambda: _sliver_case(name, soup, ref, **budget)))
+        for label, make, extra in appended:
+            out.append(_timed(lambda: _appended_case(name, soup, ref, label, make, extra, **budget)))
+        out.append(_timed(lambda: _perturbed_case(name, soup, ref, **budget)))
     return out
 
 
