@@ -94,5 +94,7 @@ def _simplify(pts: np.ndarray) -> np.ndarray:
 
 
 def _place(ctx: Context, k: int, leader: np.ndarray, box: np.ndarray, tier: int, shift: float) -> None:
-    ctx.placed[k] = Placement(_simplify(leader), box.copy(), int(ctx.sides[k]), int(tier), float(shift))
+    ctx.placed[k] = Placement(
+        leader=_simplify(leader), box=box.copy(), side=int(ctx.sides[k]), tier=int(tier), shift=float(shift)
+    )
     ctx.stats.shifted += int(shift > SHIFTED)

@@ -177,5 +177,9 @@ def _place_row(ctx: Context, idx: np.ndarray, side: int) -> None:
             shift = abs(port_x[j] - ctx.endpoints[k, 0])
             ctx.stats.shifted += int(shift > SHIFTED)
             ctx.placed[k] = Placement(
-                ctx.row_leader(k, side, float(port_x[j]), r), box, side, r, float(shift)
+                leader=ctx.row_leader(k, side, float(port_x[j]), r),
+                box=box,
+                side=side,
+                tier=r,
+                shift=float(shift),
             )

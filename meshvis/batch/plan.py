@@ -161,13 +161,13 @@ def plan(
         used.add(name.casefold())
         stem = os.path.join(out_dir, f"{name}.{op}")
         task = FileTask(
-            path,
-            name,
-            stem + output_extension(path, op),
-            stem + ".report.json",
-            op,
-            dict(options or {}),
-            runner,
+            input=path,
+            name=name,
+            output=stem + output_extension(path, op),
+            report=stem + ".report.json",
+            op=op,
+            options=dict(options or {}),
+            runner=runner,
         )
         for p in (task.output, task.report):
             if os.path.realpath(p) in in_paths:

@@ -86,7 +86,7 @@ def run_batch(
             else:
                 todo.append(i)
     except KeyboardInterrupt:
-        return BatchResult(rows, time.perf_counter() - t0, True)
+        return BatchResult(rows=rows, seconds=time.perf_counter() - t0, interrupted=True)
     if todo:
         todo = largest_first(tasks, todo)
         if scheduler:
@@ -95,4 +95,4 @@ def run_batch(
             interrupted = _run_local(
                 tasks, todo, rows, jobs or default_jobs(len(todo)), time_limit, on_start, on_done
             )
-    return BatchResult(rows, time.perf_counter() - t0, interrupted)
+    return BatchResult(rows=rows, seconds=time.perf_counter() - t0, interrupted=interrupted)

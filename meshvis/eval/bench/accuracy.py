@@ -82,14 +82,14 @@ def sweep(
             res = C.meshvis_run(truth, TASKS, seed=seed, **kw)
             for task, (sec, values, info) in res.items():
                 p = C.Point(
-                    case.name,
-                    truth.n_faces,
-                    task,
-                    "meshvis_default" if default else "meshvis",
-                    "meshvis default (progressive)" if default else "meshvis",
-                    "rays_per_node",
-                    r,
-                    sec,
+                    case=case.name,
+                    faces=truth.n_faces,
+                    task=task,
+                    method="meshvis_default" if default else "meshvis",
+                    label="meshvis default (progressive)" if default else "meshvis",
+                    knob="rays_per_node",
+                    value=r,
+                    seconds=sec,
                     load1=C.load1(),
                     default=default,
                     extra=info,

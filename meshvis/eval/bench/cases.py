@@ -267,14 +267,14 @@ def baseline_point(
     s = score(truth, b.task, r.values if r.ok else None)
     shown = b.default if value is None else value
     return Point(
-        case,
-        truth.n_faces,
-        b.task,
-        name,
-        b.label,
-        (b.knob + (" per face" if b.per_face else "")) if b.knob else "",
-        float("nan") if shown is None else float(shown),
-        r.seconds,
+        case=case,
+        faces=truth.n_faces,
+        task=b.task,
+        method=name,
+        label=b.label,
+        knob=(b.knob + (" per face" if b.per_face else "")) if b.knob else "",
+        value=float("nan") if shown is None else float(shown),
+        seconds=r.seconds,
         ok=r.ok,
         message=r.message,
         load1=load1(),

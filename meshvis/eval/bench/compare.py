@@ -61,14 +61,14 @@ def compare_case(
         def run_meshvis(task=task):
             sec, values, info = C.meshvis_run(truth, (task,), seed=seed, share=False)[task]
             return C.Point(
-                case,
-                truth.n_faces,
-                task,
-                "meshvis",
-                "meshvis (defaults)",
-                "rays_per_node",
-                32,
-                sec,
+                case=case,
+                faces=truth.n_faces,
+                task=task,
+                method="meshvis",
+                label="meshvis (defaults)",
+                knob="rays_per_node",
+                value=32,
+                seconds=sec,
                 load1=C.load1(),
                 default=True,
                 extra=info,

@@ -176,11 +176,12 @@ def similarity_cases(
                 bad = nonfinite(c) + nonfinite(ref)
                 ok = agree >= need and not bad
                 return CaseResult(
-                    "similarity",
-                    f"{name}: {label}",
-                    ok,
-                    f"agreement {100 * agree:.4f}% of area (need >= {100 * need:g}%)" + _finite_note(bad),
-                    {"agreement": agree, "required": need, "nonfinite": bad, "faces": soup.n_faces},
+                    group="similarity",
+                    name=f"{name}: {label}",
+                    passed=ok,
+                    figure=f"agreement {100 * agree:.4f}% of area (need >= {100 * need:g}%)"
+                    + _finite_note(bad),
+                    values={"agreement": agree, "required": need, "nonfinite": bad, "faces": soup.n_faces},
                 )
 
             out.append(_timed(case))
@@ -533,11 +534,11 @@ def crack_case(
         fig = f"interior holds at every width tried (up to {max(holding):g})"
     fig += "; monotone" if monotone else "; NOT MONOTONE"
     return CaseResult(
-        "cracks",
-        "cracked box with an inner box, crack width sweep",
-        monotone and not bad,
-        fig + _finite_note(bad),
-        {
+        group="cracks",
+        name="cracked box with an inner box, crack width sweep",
+        passed=monotone and not bad,
+        figure=fig + _finite_note(bad),
+        values={
             "leak_from": min(leaking) if leaking else None,
             "holds_to": max(holding) if holding else None,
             "monotone": monotone,
@@ -643,11 +644,11 @@ def weight_cases(
                         }
                     )
             return CaseResult(
-                "weights",
-                f"{name}: pymaxflow vs scipy (integer) on one graph",
-                ok,
-                fig + _finite_note(bad),
-                {**r, "nonfinite": bad},
+                group="weights",
+                name=f"{name}: pymaxflow vs scipy (integer) on one graph",
+                passed=ok,
+                figure=fig + _finite_note(bad),
+                values={**r, "nonfinite": bad},
                 table=table,
             )
 
@@ -690,11 +691,15 @@ def tiny_cases(rays_per_node: int, seed: int, folder: str | None = None) -> list
                     f"outside (expected all: a lone sheet is seen from both sides)"
                 )
                 return CaseResult(
-                    "tiny",
-                    label,
-                    ok and not bad,
-                    fig + _finite_note(bad),
-                    {"faces": c.soup.n_faces, "sides_outside": int(c.side_outside.sum()), "nonfinite": bad},
+                    group="tiny",
+                    name=label,
+                    passed=ok and not bad,
+                    figure=fig + _finite_note(bad),
+                    values={
+                        "faces": c.soup.n_faces,
+                        "sides_outside": int(c.side_outside.sum()),
+                        "nonfinite": bad,
+                    },
                 )
 
             out.append(_timed(case))
@@ -711,21 +716,23 @@ def tiny_cases(rays_per_node: int, seed: int, folder: str | None = None) -> list
                     msg = str(exc)
                     ok = path in msg and "\n" not in msg
                     return CaseResult(
-                        "tiny",
-                        label,
-                        ok,
-                        f"ModelError: {msg.replace(tmp, '<tmp>')}",
-                        {"error": type(exc).__name__, "names_file": path in msg},
+                        group="tiny",
+                        name=label,
+                        passed=ok,
+                        figure=f"ModelError: {msg.replace(tmp, '<tmp>')}",
+                        values={"error": type(exc).__name__, "names_file": path in msg},
                     )
                 except Exception as exc:  # anything else is a bug
                     return CaseResult(
-                        "tiny",
-                        label,
-                        False,
-                        f"{type(exc).__name__} instead of ModelError: {exc}",
-                        {"error": type(exc).__name__},
+                        group="tiny",
+                        name=label,
+                        passed=False,
+                        figure=f"{type(exc).__name__} instead of ModelError: {exc}",
+                        values={"error": type(exc).__name__},
                     )
-                return CaseResult("tiny", label, False, "no error raised", {"error": None})
+                return CaseResult(
+                    group="tiny", name=label, passed=False, figure="no error raised", values={"error": None}
+                )
 
             out.append(_timed(error_case))
     return out
