@@ -240,7 +240,7 @@ def leader_candidates(area: InternalArea, layout: str) -> Candidates:
     exi, eyi, length = image(ex, np.nan), image(ey, np.nan), image(best, np.nan)
     side_img, key_img = image(side, -1), image(key, -1)
     inside = key_img >= 0
-    uniq, first, inv = np.unique(key_img[inside], return_index=True, return_inverse=True)
+    _, first, inv = np.unique(key_img[inside], return_index=True, return_inverse=True)
     eid = np.full(key_img.shape, -1, np.int64)
     eid[inside] = inv
     endpoints = np.column_stack([exi[inside][first], eyi[inside][first]])
