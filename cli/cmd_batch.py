@@ -45,7 +45,7 @@ def _algorithm_dests() -> list[str]:
 
 
 def add_parser(sub) -> None:
-    from meshvis.batch.runner import OPERATIONS
+    from meshvis.batch import OPERATIONS
 
     from .cmd_repair import algorithm_options
 
@@ -197,7 +197,7 @@ def _summary_table(result, out_dir: str, limit: int = 60):
 
 
 def run(args: argparse.Namespace) -> int:
-    from meshvis.batch.runner import default_jobs, plan, run_batch, write_summary
+    from meshvis.batch import default_jobs, plan, run_batch, write_summary
     from meshvis.errors import ParameterError
     from meshvis.io import ensure_folder
 

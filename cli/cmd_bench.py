@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from meshvis.eval.bench.real import add_models_argument
+
 from .common import positive_int, write_json
 
 
@@ -23,12 +25,12 @@ def add_parser(sub) -> None:
     c.add_argument("--rays-per-node", type=positive_int, default=32)
     c.add_argument("--seed", type=int, default=0)
     c.add_argument("--json", metavar="FILE")
+    add_models_argument(c)
     c.set_defaults(func=run_classify)
 
-    outside = {"labeling": "meshvis.labeling.bench", "labeling-sweep": "meshvis.labeling.sweep"}
     for name in ("accuracy", "stability", "labeling", "labeling-sweep", "compare"):
         try:
-            mod = __import__(outside.get(name, f"meshvis.eval.bench.{name}"), fromlist=["add_arguments"])
+            mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])
         except ModuleNotFoundError:
             continue
         if hasattr(mod, "add_arguments"):
@@ -52,7 +54,9 @@ def run_rays(args: argparse.Namespace) -> int:
 def run_classify(args: argparse.Namespace) -> int:
     from meshvis.eval.bench import classify as bc
 
-    results = bc.run(args.models or None, rays_per_node=args.rays_per_node, seed=args.seed)
+    results = bc.run(
+        args.models or None, rays_per_node=args.rays_per_node, seed=args.seed, models_dir=args.models_dir
+    )
     print(bc.format(results))
     if args.json:
         write_json(args.json, results)

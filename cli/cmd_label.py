@@ -52,7 +52,17 @@ def add_parser(sub) -> None:
         metavar=("W", "H"),
         help="image size in pixels (default 512 512)",
     )
-    cam = p.add_argument_group("camera")
+    _camera_arguments(p.add_argument_group("camera"))
+    _optimisation_arguments(p.add_argument_group("optimisation (appendix I)"))
+    p.add_argument("--show-area", action="store_true", help="draw the internal area's boundary")
+    p.add_argument("--duration", type=positive_int, default=120, help="GIF frame time in ms (default 120)")
+    p.add_argument("--force", action="store_true", help="overwrite existing outputs")
+    p.add_argument("--quiet", "-q", action="store_true")
+    p.set_defaults(func=run)
+
+
+def _camera_arguments(cam: argparse._ArgumentGroup) -> None:
+    """Where the views come from: one fitted camera, an orbit, a camera file or a path."""
     src = cam.add_mutually_exclusive_group()
     src.add_argument("--orbit", type=positive_int, metavar="N", help="N frames turning once around the model")
     src.add_argument(
@@ -76,7 +86,10 @@ def add_parser(sub) -> None:
         default=1.6,
         help="room around the model when fitting the camera (default 1.6)",
     )
-    opt = p.add_argument_group("optimisation (appendix I)")
+
+
+def _optimisation_arguments(opt: argparse._ArgumentGroup) -> None:
+    """The thresholds and weights of the fuzzy-greedy optimisation, font and visibility."""
     opt.add_argument(
         "--d-a", type=float, default=0.05, help="anchor distance threshold, fraction of d_S (default 0.05)"
     )
@@ -93,11 +106,6 @@ def add_parser(sub) -> None:
     opt.add_argument(
         "--min-pixels", type=positive_int, default=1, help="parts with fewer visible pixels are not labelled"
     )
-    p.add_argument("--show-area", action="store_true", help="draw the internal area's boundary")
-    p.add_argument("--duration", type=positive_int, default=120, help="GIF frame time in ms (default 120)")
-    p.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    p.add_argument("--quiet", "-q", action="store_true")
-    p.set_defaults(func=run)
 
 
 def _up(args: argparse.Namespace) -> tuple[float, float, float]:
@@ -118,7 +126,7 @@ def _weights(text: str | None):
         raise ParameterError(f"--weights: expected 6 numbers, got {text!r}") from None
     if len(vals) != 6:
         raise ParameterError(f"--weights: expected 6 numbers (w2..w7), got {len(vals)}")
-    return Weights(*vals)
+    return Weights(**dict(zip(("w2", "w3", "w4", "w5", "w6", "w7"), vals)))
 
 
 def _frame_paths(output: str, n: int) -> list[str]:
@@ -128,23 +136,17 @@ def _frame_paths(output: str, n: int) -> list[str]:
     return [f"{stem}_{i:03d}{ext}" for i in range(n)]
 
 
-def run(args: argparse.Namespace) -> int:
+def _cameras(args: argparse.Namespace, soup) -> list:
+    """The cameras of the frames: an orbit, a camera path, one camera file or one fitted view."""
     import json
 
-    from meshvis.errors import OutputError, ParameterError
+    from meshvis.errors import ParameterError
     from meshvis.labeling import frames as fr
-    from meshvis.labeling import output as out
-    from meshvis.labeling.inputs import load_models, read_texts
-    from meshvis.labeling.metrics import sequence_metrics
     from meshvis.rays.camera import Camera
 
-    ext = os.path.splitext(args.output)[1].lower()
-    if ext not in (".svg", ".png", ".gif"):
-        raise OutputError("unknown output format (use .svg, .png or .gif)", args.output)
-    soup = load_models(args.inputs if len(args.inputs) > 1 else args.inputs[0])
     up = _up(args)
     if args.orbit:
-        cameras = fr.orbit(
+        return fr.orbit(
             soup,
             args.orbit,
             elevation=args.elevation,
@@ -155,45 +157,33 @@ def run(args: argparse.Namespace) -> int:
             fit_margin=args.fit_margin,
             distance=args.distance,
         )
-    elif args.camera_path:
-        cameras = fr.read_camera_path(args.camera_path)
-    elif args.camera:
+    if args.camera_path:
+        return fr.read_camera_path(args.camera_path)
+    if args.camera:
         try:
             with open(args.camera, encoding="utf-8") as fh:
-                cameras = [Camera.from_json(json.load(fh))]
+                return [Camera.from_json(json.load(fh))]
         except (OSError, ValueError, TypeError) as exc:
             raise ParameterError(f"{args.camera}: cannot read the camera: {exc}") from None
-    else:
-        cameras = [
-            Camera.fit(
-                soup,
-                azimuth=args.azimuth,
-                elevation=args.elevation,
-                distance=args.distance,
-                fov=args.fov,
-                orthographic=args.orthographic,
-                margin=args.fit_margin,
-                up=up,
-            )
-        ]
-    paths = _frame_paths(args.output, len(cameras))
-    for path in paths + [p for p in (args.json, args.png) if p]:
-        check_output(path, args.inputs, args.force)
-    texts = read_texts(args.texts) if args.texts else None
-    options = dict(
-        layout=args.layout,
-        area=args.area,
-        margin=args.margin,
-        method=args.method,
-        size=tuple(args.size),
-        texts=texts,
-        weights=_weights(args.weights),
-        d_a=args.d_a,
-        d_e=args.d_e,
-        font_size=args.font_size,
-        min_pixels=args.min_pixels,
-    )
-    results = fr.layout_frames(soup, cameras, coherence=not args.no_coherence, **options)
+    return [
+        Camera.fit(
+            soup,
+            azimuth=args.azimuth,
+            elevation=args.elevation,
+            distance=args.distance,
+            fov=args.fov,
+            orthographic=args.orthographic,
+            margin=args.fit_margin,
+            up=up,
+        )
+    ]
+
+
+def _write_outputs(args: argparse.Namespace, results: list, ext: str) -> None:
+    """The picture(s) or GIF, the optional PNG of the first frame and the JSON."""
+    from meshvis.labeling import output as out
+    from meshvis.labeling.metrics import sequence_metrics
+
     if ext == ".gif":
         out.write_gif(results, args.output, duration_ms=args.duration)
     else:
@@ -205,6 +195,12 @@ def run(args: argparse.Namespace) -> int:
         if len(results) > 1:
             data["sequence"] = sequence_metrics(results)
         out.write_json(data, args.json)
+
+
+def _report(args: argparse.Namespace, results: list, paths: list[str]) -> None:
+    """One-line summaries: what was written, the first frame's quality, the motion of a sequence."""
+    from meshvis.labeling.metrics import sequence_metrics
+
     first = results[0]
     m = first.metrics
     say(args, f"wrote {', '.join(paths if len(paths) <= 3 else paths[:2] + ['...', paths[-1]])}")
@@ -225,4 +221,36 @@ def run(args: argparse.Namespace) -> int:
             f"{len(results)} frames; mean label motion {s['label_motion_mean']:.1f} px, "
             f"side flips {s['side_flips']}, order swaps {s['order_swaps']}",
         )
+
+
+def run(args: argparse.Namespace) -> int:
+    from meshvis.errors import OutputError
+    from meshvis.labeling import frames as fr
+    from meshvis.labeling.inputs import load_models, read_texts
+
+    ext = os.path.splitext(args.output)[1].lower()
+    if ext not in (".svg", ".png", ".gif"):
+        raise OutputError("unknown output format (use .svg, .png or .gif)", args.output)
+    soup = load_models(args.inputs if len(args.inputs) > 1 else args.inputs[0])
+    cameras = _cameras(args, soup)
+    paths = _frame_paths(args.output, len(cameras))
+    for path in paths + [p for p in (args.json, args.png) if p]:
+        check_output(path, args.inputs, args.force)
+    texts = read_texts(args.texts) if args.texts else None
+    options = dict(
+        layout=args.layout,
+        area=args.area,
+        margin=args.margin,
+        method=args.method,
+        size=tuple(args.size),
+        texts=texts,
+        weights=_weights(args.weights),
+        d_a=args.d_a,
+        d_e=args.d_e,
+        font_size=args.font_size,
+        min_pixels=args.min_pixels,
+    )
+    results = fr.layout_frames(soup, cameras, coherence=not args.no_coherence, **options)
+    _write_outputs(args, results, ext)
+    _report(args, results, paths)
     return 0

@@ -35,6 +35,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     algorithm_options(p)
     p.add_argument(
         "--inside-point",
+        dest="inside_points",
         type=point,
         action="append",
         default=[],
@@ -43,6 +44,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     )
     p.add_argument(
         "--outside-point",
+        dest="outside_points",
         type=point,
         action="append",
         default=[],
@@ -51,6 +53,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     )
     p.add_argument(
         "--inside-box",
+        dest="inside_boxes",
         type=box,
         action="append",
         default=[],
@@ -59,6 +62,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
     )
     p.add_argument(
         "--outside-box",
+        dest="outside_boxes",
         type=box,
         action="append",
         default=[],
@@ -96,8 +100,19 @@ def algorithm_options(p: argparse.ArgumentParser) -> None:
         default=d["samples_per_face"],
         help="sample points per intersecting/coplanar face (default 4)",
     )
-    p.add_argument("--no-filter", action="store_true", help="switch off the cosine filter (Eq. 8-9)")
-    p.add_argument("--no-progressive", action="store_true", help="cast the whole ray budget in one round")
+    # the flags switch off what the library's keywords (use_filter, progressive) switch on
+    p.add_argument(
+        "--no-filter",
+        dest="use_filter",
+        action="store_false",
+        help="switch off the cosine filter (Eq. 8-9)",
+    )
+    p.add_argument(
+        "--no-progressive",
+        dest="progressive",
+        action="store_false",
+        help="cast the whole ray budget in one round",
+    )
     p.add_argument("--solver", choices=("pymaxflow", "scipy"), default=d["solver"])
 
 

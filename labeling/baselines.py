@@ -49,40 +49,31 @@ def _nearest_on_box(p: np.ndarray, box: np.ndarray) -> np.ndarray:
     return np.array([np.clip(p[0], box[0], box[2]), np.clip(p[1], box[1], box[3])])
 
 
-def adjust_text(reference: LayoutResult, *, iterations: int = 300, obstacle_cell: int = 16) -> LayoutResult:
-    """Re-lay the labels of ``reference`` with adjustText, keeping its anchors.
+#: figure resolution of the adjustText canvas: at 72 dots per inch a point is one pixel
+_DPI = 72.0
 
-    Parameters
-    ----------
-    reference : a LayoutResult (usually :func:`two_step`'s) whose anchors, texts and font
-        are reused
-    iterations : adjustText iterations (``iter_lim``); no time limit is used
-    obstacle_cell : size in pixels of the blocks the model's pixels are given to
-        adjustText as obstacles
 
-    Returns
-    -------
-    LayoutResult with ``method="adjusttext"``; ``timings["boxes"]`` is adjustText's time.
-    """
-    import adjustText
+def _text_axes(w: int, h: int):
+    """A matplotlib figure and axes of ``w`` x ``h`` pixels, y down like the image."""
     from matplotlib.backends.backend_agg import FigureCanvasAgg
     from matplotlib.figure import Figure
-    from matplotlib.font_manager import FontProperties
-    from matplotlib.transforms import Bbox
 
-    t0 = time.perf_counter()
-    w, h = reference.size
-    dpi = 72.0
-    fig = Figure(figsize=(w / dpi, h / dpi), dpi=dpi)
+    fig = Figure(figsize=(w / _DPI, h / _DPI), dpi=_DPI)
     FigureCanvasAgg(fig)
     ax = fig.add_axes((0.0, 0.0, 1.0, 1.0))
     ax.set_xlim(0, w)
     ax.set_ylim(h, 0)
     ax.axis("off")
+    return fig, ax
+
+
+def _text_artists(ax, reference: LayoutResult) -> list:
+    """One boxed text per label of ``reference``, centred on its anchor, in its font."""
+    from matplotlib.font_manager import FontProperties
+
     style = TextStyle(reference.font_size)
-    prop = FontProperties(fname=font_file(), size=reference.font_size * 72.0 / dpi)
-    labs = reference.labels
-    texts = [
+    prop = FontProperties(fname=font_file(), size=reference.font_size * 72.0 / _DPI)
+    return [
         ax.text(
             lab.anchor[0],
             lab.anchor[1],
@@ -94,27 +85,13 @@ def adjust_text(reference: LayoutResult, *, iterations: int = 300, obstacle_cell
                 boxstyle=f"square,pad={style.pad_y / reference.font_size:.3f}", fc="white", ec="0.4", lw=0.6
             ),
         )
-        for lab in labs
+        for lab in reference.labels
     ]
-    obstacles = _model_obstacles(reference.ids, obstacle_cell)
-    # display coordinates: pixels with y up
-    objects = [Bbox([[b[0], h - b[3]], [b[2], h - b[1]]]) for b in obstacles]
-    anchors = np.array([lab.anchor for lab in labs]).reshape(-1, 2)
-    if labs:
-        adjustText.adjust_text(
-            texts,
-            x=anchors[:, 0],
-            y=anchors[:, 1],
-            objects=objects,
-            ax=ax,
-            iter_lim=int(iterations),
-            time_lim=None,
-            ensure_inside_axes=True,
-            expand_axes=False,
-            prevent_crossings=True,
-        )
-    fig.canvas.draw()  # places the text boxes at the adjusted positions
-    renderer = fig.canvas.get_renderer()
+
+
+def _adjusted_labels(labs: Sequence[Label], texts: list, renderer, h: int) -> list[Label]:
+    """The labels where adjustText left their texts, each with a straight leader from its
+    anchor to the nearest point of its box."""
     out = []
     for lab, txt in zip(labs, texts):
         bb = txt.get_bbox_patch().get_window_extent(renderer)
@@ -134,24 +111,69 @@ def adjust_text(reference: LayoutResult, *, iterations: int = 300, obstacle_cell
                 rank=lab.rank,
             )
         )
+    return out
+
+
+def adjust_text(reference: LayoutResult, *, iterations: int = 300, obstacle_cell: int = 16) -> LayoutResult:
+    """Re-lay the labels of ``reference`` with adjustText, keeping its anchors.
+
+    Parameters
+    ----------
+    reference : a LayoutResult (usually :func:`two_step`'s) whose anchors, texts and font
+        are reused
+    iterations : adjustText iterations (``iter_lim``); no time limit is used
+    obstacle_cell : size in pixels of the blocks the model's pixels are given to
+        adjustText as obstacles
+
+    Returns
+    -------
+    LayoutResult with ``method="adjusttext"``; ``timings["boxes"]`` is adjustText's time.
+    """
+    import adjustText
+    from matplotlib.transforms import Bbox
+
+    t0 = time.perf_counter()
+    w, h = reference.size
+    fig, ax = _text_axes(w, h)
+    labs = reference.labels
+    texts = _text_artists(ax, reference)
+    obstacles = _model_obstacles(reference.ids, obstacle_cell)
+    # display coordinates: pixels with y up
+    objects = [Bbox([[b[0], h - b[3]], [b[2], h - b[1]]]) for b in obstacles]
+    anchors = np.array([lab.anchor for lab in labs]).reshape(-1, 2)
+    if labs:
+        adjustText.adjust_text(
+            texts,
+            x=anchors[:, 0],
+            y=anchors[:, 1],
+            objects=objects,
+            ax=ax,
+            iter_lim=int(iterations),
+            time_lim=None,
+            ensure_inside_axes=True,
+            expand_axes=False,
+            prevent_crossings=True,
+        )
+    fig.canvas.draw()  # places the text boxes at the adjusted positions
+    out = _adjusted_labels(labs, texts, fig.canvas.get_renderer(), h)
     elapsed = time.perf_counter() - t0
     res = LayoutResult(
-        out,
-        reference.invisible,
-        reference.unplaced,
-        reference.skipped,
-        reference.image,
-        reference.ids,
-        reference.camera,
-        reference.layout,
-        "adjusttext",
-        reference.area_polygon,
-        reference.font_size,
-        reference.box_height,
-        reference.sphere_diameter,
-        {"iterations": int(iterations), "obstacle_cell": int(obstacle_cell)},
-        {},
-        {"boxes": elapsed},
+        labels=out,
+        invisible=reference.invisible,
+        unplaced=reference.unplaced,
+        skipped=reference.skipped,
+        image=reference.image,
+        ids=reference.ids,
+        camera=reference.camera,
+        layout=reference.layout,
+        method="adjusttext",
+        area_polygon=reference.area_polygon,
+        font_size=reference.font_size,
+        box_height=reference.box_height,
+        sphere_diameter=reference.sphere_diameter,
+        params={"iterations": int(iterations), "obstacle_cell": int(obstacle_cell)},
+        metrics={},
+        timings={"boxes": elapsed},
     )
     res.metrics = frame_metrics(res)
     return res

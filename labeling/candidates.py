@@ -140,31 +140,27 @@ def _radial(
     return length.reshape(hp, wp), ex.reshape(hp, wp), ey.reshape(hp, wp), key
 
 
-def leader_candidates(area: InternalArea, layout: str) -> Candidates:
-    """Compute the candidate endpoint, length and side of every pixel of ``A_I``.
+#: floor of ``d_max`` (pixels), which divides the leader lengths in ``f2``
+_MIN_D_MAX = 1e-9
 
-    Parameters
-    ----------
-    area : InternalArea
-    layout : a key of :data:`LAYOUTS`
 
-    Returns
-    -------
-    Candidates
-        Arrays cover the image (the padding of ``area`` is cut off); ``d_max`` is taken
-        over the whole of ``A_I``, padding included.
-    """
-    sides = check_layout(layout)
+def _window(full: np.ndarray) -> tuple[int, int, int, int]:
+    """Rows ``r0:r1`` and columns ``c0:c1`` of the bounding box of ``A_I`` plus a pixel
+    (the whole grid when it is empty)."""
+    hp, wp = full.shape
+    rows, cols = np.flatnonzero(full.any(axis=1)), np.flatnonzero(full.any(axis=0))
+    if len(rows):
+        return max(rows[0] - 1, 0), min(rows[-1] + 2, hp), max(cols[0] - 1, 0), min(cols[-1] + 2, wp)
+    return 0, hp, 0, wp
+
+
+def _shortest(area: InternalArea, sides: tuple[int, ...], window: tuple[int, int, int, int]) -> tuple:
+    """Per pixel of the window: the shortest leader over ``sides`` (length, endpoint, endpoint
+    key on the padded grid, side code); the first side listed wins ties."""
     full = area.mask
     hp, wp = full.shape
     p = area.pad
-    # work on the bounding box of A_I only (plus a pixel); keys keep the padded grid's indices
-    rows, cols = np.flatnonzero(full.any(axis=1)), np.flatnonzero(full.any(axis=0))
-    if len(rows):
-        r0, r1 = max(rows[0] - 1, 0), min(rows[-1] + 2, hp)
-        c0, c1 = max(cols[0] - 1, 0), min(cols[-1] + 2, wp)
-    else:
-        r0, r1, c0, c1 = 0, hp, 0, wp
+    r0, r1, c0, c1 = window
     mask = full[r0:r1, c0:c1]
     hb, wb = mask.shape
     xc = np.arange(c0, c1, dtype=np.float64) + 0.5 - p
@@ -206,6 +202,29 @@ def leader_candidates(area: InternalArea, layout: str) -> Candidates:
                 k = (k // wb + r0) * wp + k % wb + c0
                 offer(code, length, bx, by, 2 * hp + 2 * wp + k.reshape(hb, wb))
     best[~mask] = np.nan
+    return mask, best, ex, ey, side, key
+
+
+def leader_candidates(area: InternalArea, layout: str) -> Candidates:
+    """Compute the candidate endpoint, length and side of every pixel of ``A_I``.
+
+    Parameters
+    ----------
+    area : InternalArea
+    layout : a key of :data:`LAYOUTS`
+
+    Returns
+    -------
+    Candidates
+        Arrays cover the image (the padding of ``area`` is cut off); ``d_max`` is taken
+        over the whole of ``A_I``, padding included.
+    """
+    sides = check_layout(layout)
+    hp, wp = area.mask.shape
+    p = area.pad
+    # work on the bounding box of A_I only (plus a pixel); keys keep the padded grid's indices
+    r0, r1, c0, c1 = window = _window(area.mask)
+    mask, best, ex, ey, side, key = _shortest(area, sides, window)
     d_max = float(np.nanmax(best)) if mask.any() else 1.0
     # out to the image: the part of the box inside it (the padding is cut off)
     H, W = hp - 2 * p, wp - 2 * p
@@ -221,8 +240,16 @@ def leader_candidates(area: InternalArea, layout: str) -> Candidates:
     exi, eyi, length = image(ex, np.nan), image(ey, np.nan), image(best, np.nan)
     side_img, key_img = image(side, -1), image(key, -1)
     inside = key_img >= 0
-    uniq, first, inv = np.unique(key_img[inside], return_index=True, return_inverse=True)
+    _, first, inv = np.unique(key_img[inside], return_index=True, return_inverse=True)
     eid = np.full(key_img.shape, -1, np.int64)
     eid[inside] = inv
     endpoints = np.column_stack([exi[inside][first], eyi[inside][first]])
-    return Candidates(exi, eyi, length, side_img, eid, endpoints, max(d_max, 1e-9))
+    return Candidates(
+        ex=exi,
+        ey=eyi,
+        length=length,
+        side=side_img,
+        eid=eid,
+        endpoints=endpoints,
+        d_max=max(d_max, _MIN_D_MAX),
+    )

@@ -133,12 +133,6 @@ def segment_hits_box(seg: np.ndarray, boxes: np.ndarray, shrink: float = 0.0) ->
     return out
 
 
-def polyline_segments(points: np.ndarray) -> np.ndarray:
-    """(k - 1, 2, 2) segments of a polyline ``(k, 2)``."""
-    points = np.asarray(points, np.float64).reshape(-1, 2)
-    return np.stack([points[:-1], points[1:]], axis=1)
-
-
 def polyline_length(points: np.ndarray) -> float:
     """Length of a polyline ``(k, 2)``."""
     points = np.asarray(points, np.float64).reshape(-1, 2)

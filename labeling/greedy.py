@@ -81,6 +81,40 @@ class GreedyResult:
     priority: np.ndarray
 
 
+#: f5 of a used endpoint in the ranking of an area whose candidates are all infeasible: above
+#: zero, so the other terms still order them
+_F5_FLOOR = 1e-6
+
+
+def _infeasible_pick(rest: np.ndarray, f5a: np.ndarray, w5: float, d_e: float) -> int:
+    """Candidate of an area whose candidates are all infeasible: keep to endpoints nobody
+    uses, then the rest; ``rest`` = the candidates' memberships other than f5, ``f5a`` =
+    their f5."""
+    tie = rest * np.maximum(f5a, _F5_FLOOR) ** w5
+    tie = np.where(f5a > 0, tie + 1.0, tie) if d_e > 0 else tie
+    return int(np.argmax(tie))
+
+
+def _lower_f4(
+    near: np.ndarray,
+    new: np.ndarray,
+    w4: float,
+    static: np.ndarray,
+    cell: np.ndarray,
+    f4: np.ndarray,
+    f4w: np.ndarray,
+    S: np.ndarray,
+) -> None:
+    """Lower f4 of the candidates ``near`` to ``new`` (in place), and the sums ``S`` of their
+    (area, endpoint) cells with it."""
+    if len(near):
+        new_w = new**w4 if w4 != 1 else new
+        delta = static[near] * (new_w - f4w[near])
+        S += np.bincount(cell[near], weights=delta, minlength=S.size).reshape(S.shape)
+        f4[near] = new
+        f4w[near] = new_w
+
+
 def greedy_layout(
     area: np.ndarray,
     ax: np.ndarray,
@@ -136,11 +170,7 @@ def greedy_layout(
         F = static[lo:hi] * f4w[lo:hi] * f5w[eid[lo:hi]]
         j = int(np.argmax(F))
         if F[j] <= 0.0:
-            # every candidate is infeasible: keep to endpoints nobody uses, then the rest
-            f5a = f5[eid[lo:hi]]
-            tie = static[lo:hi] * f4w[lo:hi] * np.maximum(f5a, 1e-6) ** w5
-            tie = np.where(f5a > 0, tie + 1.0, tie) if d_e > 0 else tie
-            j = int(np.argmax(tie))
+            j = _infeasible_pick(static[lo:hi] * f4w[lo:hi], f5[eid[lo:hi]], w5, d_e)
         pick = lo + j
         order.append(i)
         picks.append(pick)
@@ -153,14 +183,13 @@ def greedy_layout(
             near = near[~done[near]]
             new = np.minimum(f4[near], dist_threshold(ax[near] - ax[pick], ay[near] - ay[pick], d_a))
             changed = new < f4[near]
-            near, new = near[changed], new[changed]
-            if len(near):
-                new_w = new**w4 if w4 != 1 else new
-                delta = static[near] * (new_w - f4w[near])
-                S += np.bincount(cell[near], weights=delta, minlength=n_areas * n_e).reshape(n_areas, n_e)
-                f4[near] = new
-                f4w[near] = new_w
+            _lower_f4(near[changed], new[changed], w4, static, cell, f4, f4w, S)
         if d_e > 0:
             e = endpoints[eid[pick]]
             np.minimum(f5, dist_threshold(endpoints[:, 0] - e[0], endpoints[:, 1] - e[1], d_e), out=f5)
-    return GreedyResult(np.array(order, np.int64), np.array(picks, np.int64), np.array(feas), np.array(prio))
+    return GreedyResult(
+        area_order=np.array(order, np.int64),
+        pick=np.array(picks, np.int64),
+        feasibility=np.array(feas),
+        priority=np.array(prio),
+    )

@@ -203,7 +203,18 @@ def internal_area(
         mask = (xc[None, :] >= left[:, None]) & (xc[None, :] <= right[:, None])
     integral = np.zeros((hp + 1, wp + 1), np.int64)
     integral[1:, 1:] = mask.cumsum(axis=0).cumsum(axis=1)
-    return InternalArea(kind, margin, polygon, pad, mask, left, right, top, bottom, integral)
+    return InternalArea(
+        kind=kind,
+        margin=margin,
+        polygon=polygon,
+        pad=pad,
+        mask=mask,
+        left=left,
+        right=right,
+        top=top,
+        bottom=bottom,
+        integral=integral,
+    )
 
 
 def resample_boundary(polygon: np.ndarray, step: float) -> tuple[np.ndarray, np.ndarray]:

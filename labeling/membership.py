@@ -77,11 +77,6 @@ def f4_anchor_distance(ax: np.ndarray, ay: np.ndarray, placed: np.ndarray, d_a: 
     return out
 
 
-def f5_endpoint_distance(ex: np.ndarray, ey: np.ndarray, placed: np.ndarray, d_e: float) -> np.ndarray:
-    """Eq. 7: conjunction (minimum) of Eq. 6 over the placed endpoints ``placed`` (k, 2)."""
-    return f4_anchor_distance(ex, ey, placed, d_e)
-
-
 def f_coherence(x: np.ndarray, y: np.ndarray, prev: np.ndarray, d_s: float) -> np.ndarray:
     """Eq. 8 / Eq. 9: ``1 - |p_t - p_{t-1}| / d_S``, clipped to [0, 1]; 1 where ``prev`` is NaN.
 

@@ -20,6 +20,7 @@ from __future__ import annotations
 
 import time
 from collections.abc import Mapping, Sequence
+from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
@@ -105,6 +106,354 @@ def _previous_frame(
     return anchor, endpoint, box
 
 
+class _Stopwatch:
+    """Seconds per stage, added up under the stage's timing key."""
+
+    def __init__(self) -> None:
+        self.timings: dict[str, float] = {}
+
+    def tick(self, key: str, t0: float) -> float:
+        """Add the time since ``t0`` to ``key``; return now (the next stage's start)."""
+        t = time.perf_counter()
+        self.timings[key] = self.timings.get(key, 0.0) + t - t0
+        return t
+
+
+@dataclass
+class _Pixels:
+    """The candidates of the labelled areas' pixels, grouped by area (row-major inside one).
+
+    ``slot``: (parts,) the area index of each labelled part (-1: not labelled); the others
+    are per pixel: its flat index, area, anchor ``(ax, ay)``, candidate endpoint
+    ``(ex, ey)``, endpoint id, leader length, side code and salience.
+    """
+
+    slot: np.ndarray
+    pix: np.ndarray
+    area_of: np.ndarray
+    ax: np.ndarray
+    ay: np.ndarray
+    ex: np.ndarray
+    ey: np.ndarray
+    eid: np.ndarray
+    length: np.ndarray
+    side: np.ndarray
+    sal: np.ndarray
+
+
+def _check_arguments(
+    layout: str, method: str, d_a: float, d_e: float | None, n_texts: int, n_parts: int
+) -> None:
+    """Raise ParameterError on an argument of :func:`solve` out of its range."""
+    check_layout(layout)
+    if method not in METHODS:
+        raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    if not (np.isfinite(d_a) and d_a >= 0):
+        raise ParameterError(f"d_a must be >= 0, got {d_a}")
+    if d_e is not None and not (np.isfinite(d_e) and d_e >= 0):
+        raise ParameterError(f"d_e must be >= 0, got {d_e}")
+    if n_texts != n_parts:
+        raise ParameterError(f"{n_texts} label texts for {n_parts} parts")
+
+
+def _sort_parts(idbuf: IdBuffer, texts: Sequence[str], min_pixels: int) -> tuple[list, list, np.ndarray]:
+    """(part id, name) of the invisible parts and of the visible ones without a text; the
+    ids of the parts to label."""
+    names = idbuf.part_names
+    visible = idbuf.visible(min_pixels)
+    invisible = [(int(p), names[p]) for p in idbuf.invisible(min_pixels)]
+    skipped = [(int(p), names[p]) for p in visible if not texts[p]]
+    labelled = np.array([p for p in visible if texts[p]], np.int64)
+    return invisible, skipped, labelled
+
+
+def _params(
+    layout: str,
+    area: str,
+    margin: float,
+    method: str,
+    weights: Weights,
+    thresholds: dict,
+    min_pixels: int,
+    stats,
+) -> dict[str, Any]:
+    """``LayoutResult.params``: the parameters used and the counts of the box corrections."""
+    return {
+        "layout": layout,
+        "area": area,
+        "margin": margin,
+        "method": method,
+        "weights": weights.as_dict(),
+        **thresholds,
+        "min_pixels": int(min_pixels),
+        "corrections": {"shifted": stats.shifted, "swaps": stats.swaps, "repaired": stats.repaired},
+    }
+
+
+def _thresholds(d_a: float, d_e: float | None, d_s: float, da_px: float, de_px: float, d_max: float) -> dict:
+    """The distance thresholds used, as fractions of ``d_S`` and in pixels (``params``)."""
+    return {
+        "d_a": d_a,
+        "d_e": (de_px / d_s) if d_e is None else d_e,
+        "d_a_px": da_px,
+        "d_e_px": de_px,
+        "d_max_px": d_max,
+    }
+
+
+def _nothing_to_label(
+    idbuf: IdBuffer,
+    invisible: list,
+    skipped: list,
+    *,
+    layout: str,
+    method: str,
+    area: str,
+    margin: float | None,
+    font_size: int | None,
+    timings: dict[str, float],
+) -> LayoutResult:
+    """The result of a view without a labelled visible part (or without any model pixel)."""
+    ia = internal_area(idbuf.model_mask, area, margin) if idbuf.model_mask.any() else None
+    return LayoutResult(
+        labels=[],
+        invisible=invisible,
+        unplaced=[],
+        skipped=skipped,
+        image=idbuf.image,
+        ids=idbuf.ids,
+        camera=idbuf.camera,
+        layout=layout,
+        method=method,
+        area_polygon=ia.polygon if ia is not None else np.zeros((0, 2)),
+        font_size=font_size or default_font_size(idbuf.shape[0]),
+        box_height=0.0,
+        sphere_diameter=idbuf.sphere_diameter,
+        params={},
+        metrics=frame_metrics_empty(),
+        timings=timings,
+    )
+
+
+def _pixels(idbuf: IdBuffer, cand, dist_sil: np.ndarray, labelled: np.ndarray, n_parts: int) -> _Pixels:
+    """Gather the candidates of every pixel of the labelled areas (stable: row-major inside an area)."""
+    w = idbuf.shape[1]
+    slot = np.full(n_parts, -1, np.int64)
+    slot[labelled] = np.arange(len(labelled))
+    ids_flat = idbuf.ids.ravel()
+    pix = np.flatnonzero(ids_flat >= 0)
+    pix = pix[slot[ids_flat[pix]] >= 0]
+    area_of = slot[ids_flat[pix]]
+    order = np.argsort(area_of, kind="stable")
+    pix, area_of = pix[order], area_of[order]
+    row, col = np.divmod(pix, w)
+    return _Pixels(
+        slot=slot,
+        pix=pix,
+        area_of=area_of,
+        ax=col + 0.5,
+        ay=row + 0.5,
+        ex=cand.ex.ravel()[pix],
+        ey=cand.ey.ravel()[pix],
+        eid=cand.eid.ravel()[pix],
+        length=cand.length.ravel()[pix],
+        side=cand.side.ravel()[pix],
+        sal=dist_sil.ravel()[pix],
+    )
+
+
+def _fuzzy_picks(
+    px: _Pixels,
+    cand,
+    weights: Weights,
+    previous: LayoutResult | None,
+    n: int,
+    d_s: float,
+    da_px: float,
+    de_px: float,
+    clock: _Stopwatch,
+    t: float,
+) -> tuple[tuple[np.ndarray, ...], float]:
+    """Memberships (Eq. 11, with the coherence terms f6, f7 given ``previous``) and the greedy
+    loop: the area order, each area's pick, feasibility and priority; and the clock."""
+    static = weighted(f2_length(px.length, cand.d_max), weights.w2) * weighted(
+        f3_salience(px.sal, cand.d_max), weights.w3
+    )
+    if previous is not None:
+        prev_a, prev_e, _ = _previous_frame(previous, px.slot, n)
+        static = static * weighted(f_coherence(px.ax, px.ay, prev_a[px.area_of], d_s), weights.w6)
+        static = static * weighted(f_coherence(px.ex, px.ey, prev_e[px.area_of], d_s), weights.w7)
+    t = clock.tick("memberships", t)
+    g = greedy_layout(
+        px.area_of, px.ax, px.ay, px.eid, cand.endpoints, static, n, da_px, de_px, weights.w4, weights.w5
+    )
+    t = clock.tick("greedy", t)
+    return (g.area_order, g.pick, g.feasibility, g.priority), t
+
+
+def _two_step_picks(px: _Pixels, n: int, clock: _Stopwatch, t: float) -> tuple[tuple[np.ndarray, ...], float]:
+    """The classic baseline: the most salient pixel of each area (first in row-major order on
+    ties); no feasibility or priority (NaN)."""
+    t = clock.tick("memberships", t)
+    key = np.lexsort((px.pix, -px.sal, px.area_of))
+    first = np.searchsorted(px.area_of[key], np.arange(n))
+    picks = key[first]
+    t = clock.tick("greedy", t)
+    return (np.arange(n), picks, np.full(n, np.nan), np.full(n, np.nan)), t
+
+
+def _endpoint_threshold(
+    d_e: float | None, d_s: float, style: TextStyle, widths: np.ndarray, layout: str, spacing: Spacing
+) -> float:
+    """``d_e`` of Eq. 6 in pixels; by default the box height (west/east layouts) or the mean box
+    width (others) plus the box gap, as the paper recommends (§7.2)."""
+    if d_e is None:
+        return (style.box_height if is_horizontal(layout) else float(widths.mean())) + spacing.gap
+    return d_e * d_s
+
+
+def _place_labels(
+    px: _Pixels,
+    order: tuple[np.ndarray, ...],
+    widths: np.ndarray,
+    style: TextStyle,
+    ia,
+    image_size: tuple[int, int],
+    spacing: Spacing,
+    previous: LayoutResult | None,
+    layout: str,
+) -> tuple:
+    """Boxes and leaders of the picked candidates (Step 8): each area's rank in the greedy
+    order, anchor and endpoint, its placement (None: left out) and the correction counts."""
+    areas_in_order, picks = order[0], order[1]
+    n = len(widths)
+    rank = np.empty(n, np.int64)
+    rank[areas_in_order] = np.arange(len(areas_in_order))
+    pick_of = np.empty(n, np.int64)
+    pick_of[areas_in_order] = picks
+    anchors = np.column_stack([px.ax[pick_of], px.ay[pick_of]])
+    endpoints = np.column_stack([px.ex[pick_of], px.ey[pick_of]])
+    sides = px.side[pick_of].astype(np.int64)
+    prev_box = None if previous is None else _previous_frame(previous, px.slot, n)[2]
+    placements, stats = place_boxes(
+        anchors,
+        endpoints,
+        sides,
+        widths,
+        style.box_height,
+        ia,
+        image_size,
+        rank,
+        spacing,
+        prev_box,
+        LAYOUTS[layout],
+    )
+    return rank, anchors, endpoints, placements, stats
+
+
+def _view_maps(
+    idbuf: IdBuffer, area: str, margin: float | None, layout: str, clock: _Stopwatch, t: float
+) -> tuple:
+    """The internal area ``A_I`` (stage ``area``), every pixel's leader candidate
+    (``candidates``, Steps 2-3) and the distance to its area's silhouette (``salience``,
+    Step 4); and the clock."""
+    ia = internal_area(idbuf.model_mask, area, margin)
+    t = clock.tick("area", t)
+    cand = leader_candidates(ia, layout)
+    t = clock.tick("candidates", t)
+    dist_sil = silhouette_distance(idbuf.ids)
+    t = clock.tick("salience", t)
+    return ia, cand, dist_sil, t
+
+
+def _layout_result(
+    idbuf: IdBuffer,
+    ia,
+    style: TextStyle,
+    *,
+    labels: list[Label],
+    invisible: list,
+    unplaced: list,
+    skipped: list,
+    layout: str,
+    method: str,
+    params: dict,
+    clock: _Stopwatch,
+) -> LayoutResult:
+    """The result of a laid-out view (metrics not measured yet)."""
+    return LayoutResult(
+        labels=labels,
+        invisible=invisible,
+        unplaced=unplaced,
+        skipped=skipped,
+        image=idbuf.image,
+        ids=idbuf.ids,
+        camera=idbuf.camera,
+        layout=layout,
+        method=method,
+        area_polygon=ia.polygon,
+        font_size=style.font_size,
+        box_height=style.box_height,
+        sphere_diameter=idbuf.sphere_diameter,
+        params=params,
+        metrics={},
+        timings=clock.timings,
+    )
+
+
+def _measure(result: LayoutResult, dist_sil: np.ndarray, clock: _Stopwatch) -> None:
+    """Fill ``result.metrics`` (stage ``metrics``, not part of the layout time)."""
+    t = time.perf_counter()
+    result.metrics = frame_metrics(result, dist_sil)
+    clock.tick("metrics", t)
+
+
+def _collect_labels(
+    idbuf: IdBuffer,
+    texts: Sequence[str],
+    labelled: np.ndarray,
+    order: tuple[np.ndarray, ...],
+    rank: np.ndarray,
+    anchors: np.ndarray,
+    endpoints: np.ndarray,
+    placements: list,
+) -> tuple[list[Label], list[tuple[int, str]]]:
+    """The placed labels in greedy order, and the visible parts left without a box."""
+    names = idbuf.part_names
+    areas_in_order, _, feas, prio = order
+    feas_of = np.full(len(labelled), np.nan)
+    feas_of[areas_in_order] = feas
+    prio_of = np.full(len(labelled), np.nan)
+    prio_of[areas_in_order] = prio
+    anchors_3d = idbuf.surface_points(anchors)
+    labels, unplaced = [], []
+    for s in areas_in_order:
+        p = int(labelled[s])
+        pl = placements[s]
+        if pl is None:
+            unplaced.append((p, names[p]))
+            continue
+        labels.append(
+            Label(
+                part=p,
+                name=names[p],
+                text=texts[p],
+                anchor=anchors[s],
+                anchor_3d=anchors_3d[s],
+                endpoint=endpoints[s],
+                leader=pl.leader,
+                box=pl.box,
+                side=SIDE_NAMES[pl.side],
+                rank=int(rank[s]),
+                feasibility=float(feas_of[s]),
+                priority=float(prio_of[s]),
+                shift=pl.shift,
+                tier=pl.tier,
+            )
+        )
+    return labels, unplaced
+
+
 def solve(
     idbuf: IdBuffer,
     texts: Sequence[str],
@@ -149,201 +498,41 @@ def solve(
     -------
     LayoutResult
     """
-    check_layout(layout)
-    if method not in METHODS:
-        raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
-    if not (np.isfinite(d_a) and d_a >= 0):
-        raise ParameterError(f"d_a must be >= 0, got {d_a}")
-    if d_e is not None and not (np.isfinite(d_e) and d_e >= 0):
-        raise ParameterError(f"d_e must be >= 0, got {d_e}")
+    names = idbuf.part_names
+    _check_arguments(layout, method, d_a, d_e, len(texts), len(names))
     weights = weights or Weights()
     spacing = spacing or Spacing()
-    names = idbuf.part_names
-    if len(texts) != len(names):
-        raise ParameterError(f"{len(texts)} label texts for {len(names)} parts")
-    timings: dict[str, float] = {}
-    h, w = idbuf.shape
-    d_s = idbuf.sphere_diameter
-
-    def tick(key: str, t0: float) -> float:
-        t = time.perf_counter()
-        timings[key] = timings.get(key, 0.0) + t - t0
-        return t
-
+    clock = _Stopwatch()
     t = time.perf_counter()
-    visible = idbuf.visible(min_pixels)
-    invisible = [(int(p), names[p]) for p in idbuf.invisible(min_pixels)]
-    skipped = [(int(p), names[p]) for p in visible if not texts[p]]
-    labelled = np.array([p for p in visible if texts[p]], np.int64)
+    invisible, skipped, labelled = _sort_parts(idbuf, texts, min_pixels)
     if len(labelled) == 0 or not idbuf.model_mask.any():
-        ia = internal_area(idbuf.model_mask, area, margin) if idbuf.model_mask.any() else None
-        return LayoutResult(
-            [],
-            invisible,
-            [],
-            skipped,
-            idbuf.image,
-            idbuf.ids,
-            idbuf.camera,
-            layout,
-            method,
-            ia.polygon if ia is not None else np.zeros((0, 2)),
-            font_size or default_font_size(h),
-            0.0,
-            d_s,
-            {},
-            frame_metrics_empty(),
-            timings,
-        )
-    ia = internal_area(idbuf.model_mask, area, margin)
-    t = tick("area", t)
-    cand = leader_candidates(ia, layout)
-    t = tick("candidates", t)
-    dist_sil = silhouette_distance(idbuf.ids)
-    t = tick("salience", t)
-
-    # candidates of the labelled areas, grouped by area (stable: row-major inside an area)
-    slot = np.full(len(names), -1, np.int64)
-    slot[labelled] = np.arange(len(labelled))
-    ids_flat = idbuf.ids.ravel()
-    pix = np.flatnonzero(ids_flat >= 0)
-    pix = pix[slot[ids_flat[pix]] >= 0]
-    area_of = slot[ids_flat[pix]]
-    order = np.argsort(area_of, kind="stable")
-    pix, area_of = pix[order], area_of[order]
-    row, col = np.divmod(pix, w)
-    ax, ay = col + 0.5, row + 0.5
-    ex, ey = cand.ex.ravel()[pix], cand.ey.ravel()[pix]
-    eid = cand.eid.ravel()[pix]
-    length = cand.length.ravel()[pix]
-    side = cand.side.ravel()[pix]
-    sal = dist_sil.ravel()[pix]
-
+        empty = dict(layout=layout, method=method, area=area, margin=margin, font_size=font_size)
+        return _nothing_to_label(idbuf, invisible, skipped, **empty, timings=clock.timings)
+    ia, cand, dist_sil, t = _view_maps(idbuf, area, margin, layout, clock, t)
+    px = _pixels(idbuf, cand, dist_sil, labelled, len(names))
+    (h, w), d_s = idbuf.shape, idbuf.sphere_diameter
     style = _fit_font(len(labelled), layout, h, int(font_size or default_font_size(h)))
-    label_texts_ = [texts[p] for p in labelled]
-    widths = style.box_widths(label_texts_)
-    if d_e is None:
-        de_px = (style.box_height if is_horizontal(layout) else float(widths.mean())) + spacing.gap
-    else:
-        de_px = d_e * d_s
+    widths = style.box_widths([texts[p] for p in labelled])
+    de_px = _endpoint_threshold(d_e, d_s, style, widths, layout, spacing)
     da_px = d_a * d_s
-
     if method == "fuzzy":
-        static = weighted(f2_length(length, cand.d_max), weights.w2) * weighted(
-            f3_salience(sal, cand.d_max), weights.w3
-        )
-        if previous is not None:
-            prev_a, prev_e, _ = _previous_frame(previous, slot, len(labelled))
-            static = static * weighted(f_coherence(ax, ay, prev_a[area_of], d_s), weights.w6)
-            static = static * weighted(f_coherence(ex, ey, prev_e[area_of], d_s), weights.w7)
-        t = tick("memberships", t)
-        g = greedy_layout(
-            area_of, ax, ay, eid, cand.endpoints, static, len(labelled), da_px, de_px, weights.w4, weights.w5
-        )
-        areas_in_order, picks, feas, prio = g.area_order, g.pick, g.feasibility, g.priority
-        t = tick("greedy", t)
+        order, t = _fuzzy_picks(px, cand, weights, previous, len(labelled), d_s, da_px, de_px, clock, t)
     else:
-        t = tick("memberships", t)
-        # the most salient pixel of each area (first in row-major order on ties)
-        key = np.lexsort((pix, -sal, area_of))
-        first = np.searchsorted(area_of[key], np.arange(len(labelled)))
-        picks_by_area = key[first]
-        areas_in_order = np.arange(len(labelled))
-        picks = picks_by_area
-        feas = np.full(len(labelled), np.nan)
-        prio = np.full(len(labelled), np.nan)
-        t = tick("greedy", t)
-
-    rank = np.empty(len(labelled), np.int64)
-    rank[areas_in_order] = np.arange(len(areas_in_order))
-    pick_of = np.empty(len(labelled), np.int64)
-    pick_of[areas_in_order] = picks
-    anchors = np.column_stack([ax[pick_of], ay[pick_of]])
-    endpoints = np.column_stack([ex[pick_of], ey[pick_of]])
-    sides = side[pick_of].astype(np.int64)
-    prev_box = None if previous is None else _previous_frame(previous, slot, len(labelled))[2]
-    placements, stats = place_boxes(
-        anchors,
-        endpoints,
-        sides,
-        widths,
-        style.box_height,
-        ia,
-        (w, h),
-        rank,
-        spacing,
-        prev_box,
-        LAYOUTS[layout],
+        order, t = _two_step_picks(px, len(labelled), clock, t)
+    rank, anchors, endpoints, placements, stats = _place_labels(
+        px, order, widths, style, ia, (w, h), spacing, previous, layout
     )
-    t = tick("boxes", t)
-
-    feas_of = np.full(len(labelled), np.nan)
-    feas_of[areas_in_order] = feas
-    prio_of = np.full(len(labelled), np.nan)
-    prio_of[areas_in_order] = prio
-    anchors_3d = idbuf.surface_points(anchors)
-    labels, unplaced = [], []
-    for s in areas_in_order:
-        p = int(labelled[s])
-        pl = placements[s]
-        if pl is None:
-            unplaced.append((p, names[p]))
-            continue
-        labels.append(
-            Label(
-                part=p,
-                name=names[p],
-                text=texts[p],
-                anchor=anchors[s],
-                anchor_3d=anchors_3d[s],
-                endpoint=endpoints[s],
-                leader=pl.leader,
-                box=pl.box,
-                side=SIDE_NAMES[pl.side],
-                rank=int(rank[s]),
-                feasibility=float(feas_of[s]),
-                priority=float(prio_of[s]),
-                shift=pl.shift,
-                tier=pl.tier,
-            )
-        )
-    timings["layout_ms"] = 1000.0 * sum(timings.get(k, 0.0) for k in LAYOUT_STAGES)
-    params = {
-        "layout": layout,
-        "area": area,
-        "margin": ia.margin,
-        "method": method,
-        "weights": weights.as_dict(),
-        "d_a": d_a,
-        "d_e": (de_px / d_s) if d_e is None else d_e,
-        "d_a_px": da_px,
-        "d_e_px": de_px,
-        "d_max_px": cand.d_max,
-        "min_pixels": int(min_pixels),
-        "corrections": {"shifted": stats.shifted, "swaps": stats.swaps, "repaired": stats.repaired},
-    }
-    result = LayoutResult(
-        labels,
-        invisible,
-        unplaced,
-        skipped,
-        idbuf.image,
-        idbuf.ids,
-        idbuf.camera,
-        layout,
-        method,
-        ia.polygon,
-        style.font_size,
-        style.box_height,
-        d_s,
-        params,
-        {},
-        timings,
+    t = clock.tick("boxes", t)
+    labels, unplaced = _collect_labels(idbuf, texts, labelled, order, rank, anchors, endpoints, placements)
+    clock.timings["layout_ms"] = 1000.0 * sum(clock.timings.get(k, 0.0) for k in LAYOUT_STAGES)
+    thresholds = _thresholds(d_a, d_e, d_s, da_px, de_px, cand.d_max)
+    params = _params(layout, area, ia.margin, method, weights, thresholds, min_pixels, stats)
+    found = dict(labels=labels, invisible=invisible, unplaced=unplaced, skipped=skipped)
+    result = _layout_result(
+        idbuf, ia, style, **found, layout=layout, method=method, params=params, clock=clock
     )
     if compute_metrics:
-        t = time.perf_counter()
-        result.metrics = frame_metrics(result, dist_sil)
-        tick("metrics", t)
+        _measure(result, dist_sil, clock)
     return result
 
 

@@ -25,8 +25,6 @@ LAYERS = {
     "meshvis.batch": 5,
     "meshvis.labeling": 5,
     "meshvis.eval": 6,
-    "meshvis.labeling.bench": 6,
-    "meshvis.labeling.sweep": 6,
     "meshvis.cli": 7,
     "meshvis.__main__": 7,
     "meshvis": 7,  # the package's __init__: lazy re-exports of the public API

@@ -18,18 +18,19 @@ from meshvis.errors import ParameterError
 #: operations that classify a model and write a result
 OPERATIONS = ("classify", "orient", "remove-interior", "layers")
 
-#: options of the classification, shared by every operation
+#: options of the classification, shared by every operation: keyword arguments of
+#: :func:`meshvis.classify` under their own names, and the hints as lists
 CLASSIFY_DEFAULTS: dict[str, Any] = {
     "seed": 0,
     "rays_per_node": 32,
     "samples_per_face": 4,
-    "no_filter": False,
-    "no_progressive": False,
+    "use_filter": True,
+    "progressive": True,
     "solver": "pymaxflow",
-    "inside_point": [],
-    "outside_point": [],
-    "inside_box": [],
-    "outside_box": [],
+    "inside_points": [],
+    "outside_points": [],
+    "inside_boxes": [],
+    "outside_boxes": [],
 }
 #: options of each operation on top of the classification
 OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
@@ -43,7 +44,28 @@ OUTPUT_KEYS = ("output", "report", "preview", "removed", "graphml")
 
 
 def default_options(op: str) -> dict[str, Any]:
-    """Every option of ``op`` with its default value."""
+    """Every option of ``op`` with its default value.
+
+    Parameters
+    ----------
+    op : str
+        One of :data:`OPERATIONS`.
+
+    Returns
+    -------
+    dict
+        :data:`CLASSIFY_DEFAULTS` and the options of ``op``.
+
+    Raises
+    ------
+    ParameterError
+        When ``op`` is not an operation.
+
+    Examples
+    --------
+    >>> default_options("layers")["max_layers"] is None
+    True
+    """
     if op not in OPERATIONS:
         raise ParameterError(f"unknown operation {op!r}; choose one of {', '.join(OPERATIONS)}")
     return {**CLASSIFY_DEFAULTS, **OPERATION_DEFAULTS[op]}
@@ -59,22 +81,111 @@ def classify_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
 
     o = {**CLASSIFY_DEFAULTS, **_options(options)}
     hints = None
-    if o["inside_point"] or o["outside_point"] or o["inside_box"] or o["outside_box"]:
+    if o["inside_points"] or o["outside_points"] or o["inside_boxes"] or o["outside_boxes"]:
         hints = Hints(
-            inside_points=np.array(o["inside_point"], np.float64).reshape(-1, 3),
-            outside_points=np.array(o["outside_point"], np.float64).reshape(-1, 3),
-            inside_boxes=np.array(o["inside_box"], np.float64).reshape(-1, 2, 3),
-            outside_boxes=np.array(o["outside_box"], np.float64).reshape(-1, 2, 3),
+            inside_points=np.array(o["inside_points"], np.float64).reshape(-1, 3),
+            outside_points=np.array(o["outside_points"], np.float64).reshape(-1, 3),
+            inside_boxes=np.array(o["inside_boxes"], np.float64).reshape(-1, 2, 3),
+            outside_boxes=np.array(o["outside_boxes"], np.float64).reshape(-1, 2, 3),
         )
     return dict(
         rays_per_node=int(o["rays_per_node"]),
         seed=int(o["seed"]),
         samples_per_face=int(o["samples_per_face"]),
-        use_filter=not o["no_filter"],
-        progressive=not o["no_progressive"],
+        use_filter=bool(o["use_filter"]),
+        progressive=bool(o["progressive"]),
         solver=o["solver"],
         hints=hints,
     )
+
+
+def _classify_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
+    """``classify``: the report, the visibility graph (GraphML) and a preview of the sides."""
+    from meshvis.io import atomic_write
+    from meshvis.rays.render import render, save_png
+
+    report = c.report()
+    if o["graphml"]:
+        import networkx as nx
+
+        with atomic_write(o["graphml"], "wb") as fh:
+            nx.write_graphml(c.graph.to_networkx({"area": c.nodes.area}), fh)
+    if o["preview"]:
+        save_png(render(soup, color_by="side", up=up).image, o["preview"])
+    return report
+
+
+def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
+    """``orient``: the oriented model and its preview."""
+    from meshvis.io import save
+    from meshvis.rays.render import render, save_png
+    from meshvis.repair.orient import orient
+
+    r = orient(
+        soup,
+        classification=c,
+        front=o["front"],
+        two_sided=o["two_sided"],
+        semantics=o["semantics"],
+        conflicts=o["conflicts"],
+    )
+    save(r.soup, o["output"])
+    report = r.report()
+    tell(
+        f"flipped {report['flipped']} of {report['input_faces']} faces; "
+        f"{report['status_counts']}; wrote {o['output']} ({r.soup.n_faces} faces)"
+    )
+    if o["preview"]:
+        save_png(render(r.soup, color_by="side", up=up).image, o["preview"])
+    return report
+
+
+def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
+    """``remove-interior``: the kept faces, optionally the removed ones, and a preview."""
+    from meshvis.io import save
+    from meshvis.rays.render import render, save_png
+    from meshvis.repair.remove import remove_interior
+
+    r = remove_interior(soup, classification=c)
+    save(r.kept, o["output"])
+    wrote_removed = bool(o["removed"]) and r.removed.n_faces > 0
+    if wrote_removed:
+        save(r.removed, o["removed"])
+    report = r.report()
+    tell(
+        f"kept {report['kept_faces']}, removed {report['removed_faces']} of {report['input_faces']} faces; "
+        f"wrote {o['output']}" + (f" and {o['removed']}" if wrote_removed else "")
+    )
+    if o["removed"] and not wrote_removed:  # an empty model is no model: say so, write nothing
+        tell(f"nothing was removed: {o['removed']} not written")
+    if o["preview"]:
+        save_png(render(r.kept, color_by="side", up=up).image, o["preview"])
+    return report
+
+
+def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
+    """``layers``: the model with one face group per layer, and a preview coloured by layer."""
+    from meshvis.io import save
+    from meshvis.rays.render import render_layers, save_png
+    from meshvis.repair.layers import layers
+
+    r = layers(soup, classification=c, max_layers=o["max_layers"])
+    names = [f"layer{k}" for k in range(1, int(r.layer.max()) + 1)]
+    save(soup, o["output"], face_groups=r.layer - 1, group_names=names, face_values={"layer": r.layer})
+    report = r.report()
+    tell(f"{r.n_layers} layers, faces per layer {report['faces_per_layer']}; wrote {o['output']}")
+    if o["preview"]:
+        save_png(render_layers(soup, r.layer, up=up), o["preview"])
+    return report
+
+
+#: operation -> the step that applies it to a classified model and writes its outputs
+_OUTPUTS = {
+    "classify": _classify_outputs,
+    "orient": _orient_outputs,
+    "remove-interior": _remove_outputs,
+    "layers": _layers_outputs,
+}
 
 
 def run_operation(
@@ -88,80 +199,33 @@ def run_operation(
 
     Parameters
     ----------
-    op : one of :data:`OPERATIONS`
-    soup : a loaded :class:`~meshvis.soup.Soup`
-    options : operation options (see :func:`default_options`) plus the output paths
-        ``output``, ``preview``, ``removed``, ``graphml`` (the report is the caller's)
-    progress : ``progress(stage, fraction)`` callback of :func:`meshvis.classify`
-    say : where to print one-line summaries (default: nowhere)
+    op : str
+        One of :data:`OPERATIONS`.
+    soup : Soup
+        The loaded model.
+    options : mapping or argparse.Namespace
+        Operation options (keys and defaults of :func:`default_options`) plus the output
+        paths ``output``, ``preview``, ``removed``, ``graphml`` (the report is the caller's).
+    progress : callable, optional
+        ``progress(stage, fraction)`` callback of :func:`meshvis.classify`.
+    say : callable, optional
+        Where to print one-line summaries (default: nowhere).
 
     Returns
     -------
-    dict, the JSON report (per-face arrays, counts, stages, rays, nodes, edges, timings, seed)
+    dict
+        The JSON report (per-face arrays, counts, stages, rays, nodes, edges, timings, seed).
     """
     from meshvis.graphcut.classify import classify
-    from meshvis.io import atomic_write, save
     from meshvis.io.report import with_schema
     from meshvis.rays.camera import up_axis
-    from meshvis.rays.render import render, render_layers, save_png
-    from meshvis.repair.layers import layers
-    from meshvis.repair.orient import orient
-    from meshvis.repair.remove import remove_interior
 
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
     tell = say or (lambda text: None)
     up = up_axis(o.get("up") or "auto", [soup.path] if soup.path else [])  # of the preview
     c = classify(soup, progress=progress, **classify_kwargs(o))
     tell(c.summary())
-    if op == "classify":
-        report = c.report()
-        if o["graphml"]:
-            import networkx as nx
-
-            with atomic_write(o["graphml"], "wb") as fh:
-                nx.write_graphml(c.graph.to_networkx({"area": c.nodes.area}), fh)
-        if o["preview"]:
-            save_png(render(soup, color_by="side", up=up).image, o["preview"])
-    elif op == "orient":
-        r = orient(
-            soup,
-            classification=c,
-            front=o["front"],
-            two_sided=o["two_sided"],
-            semantics=o["semantics"],
-            conflicts=o["conflicts"],
-        )
-        save(r.soup, o["output"])
-        report = r.report()
-        tell(
-            f"flipped {report['flipped']} of {report['input_faces']} faces; "
-            f"{report['status_counts']}; wrote {o['output']} ({r.soup.n_faces} faces)"
-        )
-        if o["preview"]:
-            save_png(render(r.soup, color_by="side", up=up).image, o["preview"])
-    elif op == "remove-interior":
-        r = remove_interior(soup, classification=c)
-        save(r.kept, o["output"])
-        wrote_removed = bool(o["removed"]) and r.removed.n_faces > 0
-        if wrote_removed:
-            save(r.removed, o["removed"])
-        report = r.report()
-        tell(
-            f"kept {report['kept_faces']}, removed {report['removed_faces']} of {report['input_faces']} faces; "
-            f"wrote {o['output']}" + (f" and {o['removed']}" if wrote_removed else "")
-        )
-        if o["removed"] and not wrote_removed:  # an empty model is no model: say so, write nothing
-            tell(f"nothing was removed: {o['removed']} not written")
-        if o["preview"]:
-            save_png(render(r.kept, color_by="side", up=up).image, o["preview"])
-    else:  # layers
-        r = layers(soup, classification=c, max_layers=o["max_layers"])
-        names = [f"layer{k}" for k in range(1, int(r.layer.max()) + 1)]
-        save(soup, o["output"], face_groups=r.layer - 1, group_names=names, face_values={"layer": r.layer})
-        report = r.report()
-        tell(f"{r.n_layers} layers, faces per layer {report['faces_per_layer']}; wrote {o['output']}")
-        if o["preview"]:
-            save_png(render_layers(soup, r.layer, up=up), o["preview"])
+    report = _OUTPUTS[op](soup, c, o, tell, up)
     report["operation"] = op
     report["seed"] = o["seed"]
     return with_schema(report)

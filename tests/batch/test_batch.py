@@ -1,4 +1,4 @@
-"""Tests of meshvis.batch.runner and ``meshvis batch``: discovery, output names, per-file tasks,
+"""Tests of meshvis.batch and ``meshvis batch``: discovery, output names, per-file tasks,
 worker processes with time limit and crash recovery, resume, Ctrl-C, and Dask."""
 
 from __future__ import annotations
@@ -17,7 +17,8 @@ import time
 import numpy as np
 import pytest
 
-import meshvis.batch.runner as mb
+import meshvis.batch as mb
+import meshvis.batch.cluster
 import meshvis.io as mio
 from meshvis.cli.main import main
 from meshvis.errors import ParameterError
@@ -467,7 +468,7 @@ def test_usage_errors(tmp_path, capsys, monkeypatch):
         main(["batch", src, "--op", "orient", "--out", str(tmp_path / "o"), "--time-limit", "-1"])
     assert exc.value.code == 2
     capsys.readouterr()
-    monkeypatch.setattr(mb, "DASK_CONNECT_TIMEOUT", "1s")
+    monkeypatch.setattr(meshvis.batch.cluster, "DASK_CONNECT_TIMEOUT", "1s")
     one_line(
         [
             "batch",

@@ -18,7 +18,7 @@ import pytest
 
 from meshvis.errors import ModelError, ParameterError
 from meshvis.eval import generators as g
-from meshvis.eval.generators import GroundTruth
+from meshvis.eval.generators import GroundTruth, closed
 from meshvis.geometry.adjacency import weld
 from meshvis.soup import Soup, validate
 
@@ -263,7 +263,7 @@ def test_cracked_box_truth(small):
     sheet = s.subset(box)
     assert not g.is_closed(sheet, oriented=False)
     # the sheet is 6 sides + 3 extra cracks = 9 separate pieces with slits between them
-    labels = g._components(sheet)
+    labels = closed._components(sheet)
     assert labels.max() + 1 == 9
     from scipy.spatial import cKDTree
 
@@ -432,7 +432,7 @@ def test_from_closed_real_model():
 
 def test_skin_and_ribcage():
     try:
-        t = g.skin_and_ribcage()
+        t = g.skin_and_ribcage(ROOT.parent / "shared" / "models" / "real")
     except FileNotFoundError:
         pytest.skip("real models not available")
     s = t.soup
@@ -518,9 +518,9 @@ def test_folded_onto_neighbour_finds_a_surface_stored_twice():
 
     both = np.array([[0, 1, 2], [0, 2, 3], [0, 1, 3], [1, 2, 3]])  # both diagonals
     one = np.array([[0, 1, 2], [0, 2, 3]])
-    assert g._folded_onto_neighbour(Soup(quad(0.0), both)).all()
-    assert not g._folded_onto_neighbour(Soup(quad(0.0), one)).any()
+    assert closed._folded_onto_neighbour(Soup(quad(0.0), both)).all()
+    assert not closed._folded_onto_neighbour(Soup(quad(0.0), one)).any()
     # a slightly skew quad (planes about 1 degree apart) is still one surface stored twice
-    assert g._folded_onto_neighbour(Soup(quad(np.tan(np.radians(0.7))), both)).all()
+    assert closed._folded_onto_neighbour(Soup(quad(np.tan(np.radians(0.7))), both)).all()
     # a real fin, 10 degrees open, is not
-    assert not g._folded_onto_neighbour(Soup(quad(np.tan(np.radians(10))), both)).any()
+    assert not closed._folded_onto_neighbour(Soup(quad(np.tan(np.radians(10))), both)).any()

@@ -11,6 +11,8 @@ from meshvis.cli.main import main as cli_main
 from meshvis.errors import ModelError
 from meshvis.eval import generators
 from meshvis.eval.bench import stability as st
+from meshvis.eval.bench import stability_cases as cases
+from meshvis.eval.bench import stability_models as stressed
 from meshvis.graphcut.classify import classify
 from meshvis.graphcut.mincut import min_cut, rounding_bound
 
@@ -29,7 +31,7 @@ def test_quick_run_passes_through_the_command_line(tmp_path, capsys):
 
 def test_main_returns_1_when_a_case_fails(monkeypatch, capsys):
     def fake_run(quick, seed, rays_per_node, progress):
-        bad = st.CaseResult("tiny", "broken on purpose", False, "figure 0")
+        bad = cases.CaseResult("tiny", "broken on purpose", False, "figure 0")
         progress(bad)
         return {"quick": quick, "passed": 0, "failed": 1, "seconds": 0.0, "cases": [bad.__dict__]}
 
@@ -41,24 +43,24 @@ def test_main_returns_1_when_a_case_fails(monkeypatch, capsys):
 def test_area_agreement_weights_faces_by_area():
     ref = np.array([[True, False], [True, False], [False, False]])
     other = np.array([[True, False], [True, True], [False, False]])
-    assert st.area_agreement(ref, other, np.array([1.0, 3.0, 6.0])) == pytest.approx(0.7)
-    assert st.area_agreement(ref, ref, np.zeros(3)) == 1.0
+    assert cases.area_agreement(ref, other, np.array([1.0, 3.0, 6.0])) == pytest.approx(0.7)
+    assert cases.area_agreement(ref, ref, np.zeros(3)) == 1.0
 
 
 def test_nonfinite_finds_a_nan_in_the_weights_and_the_report():
     c = classify(trimesh.creation.icosphere(1), rays_per_node=4, seed=0)
-    assert st.nonfinite(c) == []
+    assert cases.nonfinite(c) == []
     c.graph.weights.cap_in[0] = np.nan
     c.outside[0, 0] = np.inf
-    bad = st.nonfinite(c)
+    bad = cases.nonfinite(c)
     assert any(b.startswith("weights.cap_in") for b in bad)
     assert any(b.startswith("report.per_face.outside_front") for b in bad)
 
 
 def test_slivers_reach_the_requested_aspect_ratio_and_keep_area_and_normals():
     soup = generators.nested_shells(1, subdivisions=2).soup
-    s, parent = st.split_into_slivers(soup, fraction=0.3, t_min=1e-6, seed=1)
-    assert st.aspect_ratios(s).max() > 5e5
+    s, parent = stressed.split_into_slivers(soup, fraction=0.3, t_min=1e-6, seed=1)
+    assert cases.aspect_ratios(s).max() > 5e5
     assert np.bincount(parent, s.areas, minlength=soup.n_faces) == pytest.approx(soup.areas, rel=1e-9)
     assert np.allclose(s.normals, soup.normals[parent], atol=1e-6)
 
@@ -66,13 +68,17 @@ def test_slivers_reach_the_requested_aspect_ratio_and_keep_area_and_normals():
 def test_stressed_copies_keep_the_original_faces_first():
     soup = generators.nested_shells(1, subdivisions=1).soup
     m = soup.n_faces
-    for s in (st.add_zero_area(soup), st.add_duplicates(soup), st.add_near_coplanar(soup, 1e-7)):
+    for s in (
+        stressed.add_zero_area(soup),
+        stressed.add_duplicates(soup),
+        stressed.add_near_coplanar(soup, 1e-7),
+    ):
         assert s.n_faces > m
         assert np.array_equal(s.triangles[:m], soup.triangles)
     assert (
-        st.add_zero_area(soup).areas[m:] < 1e-15 * soup.diagonal**2
+        stressed.add_zero_area(soup).areas[m:] < 1e-15 * soup.diagonal**2
     ).all()  # round-off of collinear corners
-    near = st.add_near_coplanar(soup, 1e-7)
+    near = stressed.add_near_coplanar(soup, 1e-7)
     shift = np.abs(
         np.einsum(
             "ij,ij->i",
@@ -92,17 +98,17 @@ def test_far_translation_and_extreme_scales_give_identical_labels():
     soup = generators.cracked_box(cell=0.1, crack_width=1e-3).soup
     ref = classify(soup, rays_per_node=8, seed=3)
     for s in (
-        st.similarity(soup, "translate", 1e6),
-        st.similarity(soup, "scale", 1e-6),
-        st.similarity(soup, "scale", 1e6),
-        st.similarity(soup, "rotate", seed=2),
+        stressed.similarity(soup, "translate", 1e6),
+        stressed.similarity(soup, "scale", 1e-6),
+        stressed.similarity(soup, "scale", 1e6),
+        stressed.similarity(soup, "rotate", seed=2),
     ):
         c = classify(s, rays_per_node=8, seed=3)
-        assert st.area_agreement(ref.side_outside, c.side_outside, soup.areas) >= st.AGREEMENT
+        assert cases.area_agreement(ref.side_outside, c.side_outside, soup.areas) >= cases.AGREEMENT
 
 
 def test_crack_leaks_only_above_the_opening_share():
-    rows = st.crack_sweep([3e-2, 1e-4], cell=0.1, rays_per_node=16, seed=0, share_rays=100_000)
+    rows = cases.crack_sweep([3e-2, 1e-4], cell=0.1, rays_per_node=16, seed=0, share_rays=100_000)
     wide, hairline = rows
     # a slit of 3e-2 x size is an opening: its escape share exceeds the opening threshold
     assert wide["share_measured"] > 0.05 and wide["inner_outside"] == 1.0
@@ -115,19 +121,19 @@ def test_crack_leaks_only_above_the_opening_share():
 
 
 def test_float32_scene_closes_slits_of_about_1e_7_of_the_diagonal():
-    rows = st.slit_transmission([1e-5, 1e-8], positions=(0.9,), n_rays=2000)
+    rows = cases.slit_transmission([1e-5, 1e-8], positions=(0.9,), n_rays=2000)
     assert rows[0]["transmitted"] > 0.9
     assert rows[1]["transmitted"] == 0.0
 
 
 def test_solvers_agree_within_the_rounding_bound_on_weights_spanning_12_orders():
-    c = classify(st.tiny_beside_huge(), rays_per_node=8, seed=0)
-    r = st.compare_solvers(c)
+    c = classify(stressed.tiny_beside_huge(), rays_per_node=8, seed=0)
+    r = cases.compare_solvers(c)
     assert r["edge_weight_orders"] >= 12
     assert r["value_pymaxflow"] > 0  # the cracked outer sphere makes the cut non-trivial
     assert r["difference"] <= r["bound"]
     assert r["capacities_rounded_to_zero"] > 0  # the integer solver does lose the tiny ones
-    assert r["agreement"] >= st.AGREEMENT and r["area_differing"] < 1e-8
+    assert r["agreement"] >= cases.AGREEMENT and r["area_differing"] < 1e-8
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
@@ -172,7 +178,7 @@ def test_empty_and_degenerate_files_fail_cleanly_naming_the_file(tmp_path, capsy
 
 
 def test_lone_sheets_are_seen_from_both_sides():
-    results = st.tiny_cases(rays_per_node=4, seed=0)
+    results = cases.tiny_cases(rays_per_node=4, seed=0)
     assert [r.name for r in results if not r.passed] == []
     assert {r.name for r in results} >= {"one triangle", "one quad", "empty file", "one zero-area triangle"}
 

@@ -14,6 +14,9 @@ from meshvis import labeling
 from meshvis.errors import MeshvisError, ParameterError
 from meshvis.labeling import boxes, geometry2d, membership
 from meshvis.labeling.baselines import adjust_text, two_step
+from meshvis.labeling.boxes import context as box_context
+from meshvis.labeling.boxes import search as box_search
+from meshvis.labeling.boxes import silhouette as box_silhouette
 from meshvis.labeling.candidates import EAST, NORTH, RADIAL, SOUTH, WEST, leader_candidates
 from meshvis.labeling.frames import layout_frames, orbit, read_camera_path
 from meshvis.labeling.greedy import greedy_layout
@@ -511,7 +514,7 @@ def test_cli(tmp_path, scene):
 
 
 def test_bench_runs_small(scene):
-    from meshvis.labeling import bench
+    from meshvis.eval.bench import labeling as bench
 
     r = bench.run(
         scene,
@@ -547,7 +550,7 @@ def test_bench_runs_small(scene):
 
 
 def test_sweep_runs_small(scene):
-    from meshvis.labeling import sweep
+    from meshvis.eval.bench import labeling_sweep as sweep
 
     r = sweep.run(
         [("scene", scene, (0, 0, 1))],
@@ -689,13 +692,15 @@ def test_silhouette_crowded_run_is_placed_from_both_ends(monkeypatch):
 
     tiers, total = place()
     assert tiers == tiers[::-1] and tiers[0] == 0 and max(tiers) == tiers[n // 2]  # stairs up to the middle
-    monkeypatch.setattr(boxes, "_run_order", lambda ctx, ring: [int(k) for k in ring])  # one end only
+    monkeypatch.setattr(
+        box_silhouette, "_run_order", lambda ctx, ring: [int(k) for k in ring]
+    )  # one end only
     plain_tiers, plain_total = place()
     assert max(tiers) < max(plain_tiers) and total < plain_total
     # labels far apart are no run: the order along the boundary stays
     monkeypatch.undo()
     wide = np.column_stack([np.linspace(70.0, 230.0, 4), np.full(4, y0)])
-    ctx = boxes._Context(
+    ctx = box_context.Context(
         wide + [0.5, 15.5],
         wide,
         np.full(4, RADIAL),
@@ -707,7 +712,7 @@ def test_silhouette_crowded_run_is_placed_from_both_ends(monkeypatch):
         np.arange(4),
     )
     ctx.ray_direction(0)
-    assert boxes._run_order(ctx, np.arange(4)) == [0, 1, 2, 3]
+    assert box_silhouette._run_order(ctx, np.arange(4)) == [0, 1, 2, 3]
 
 
 @pytest.mark.parametrize("azimuth, elevation", [(225, 45), (225, 10), (270, 10), (0, 45), (135, 80)])
@@ -748,8 +753,8 @@ def test_endpoint_towards_each_side_of_a_rectangle():
     mask[30:70, 20:100] = True
     ia = internal_area(mask, "rectangle", margin=2.0)
     x0, y0, x1, y1 = ia.bbox
-    ctx = boxes._Context(
+    ctx = box_context.Context(
         [[50.5, 40.5]], [[50.5, y0]], [NORTH], [20.0], 8.0, ia, (120, 100), boxes.Spacing(), [0]
     )
     for side, want in ((WEST, (x0, 40.5)), (EAST, (x1, 40.5)), (NORTH, (50.5, y0)), (SOUTH, (50.5, y1))):
-        assert np.allclose(boxes._endpoint_towards(ctx, 0, side), want, atol=1.0)
+        assert np.allclose(box_search._endpoint_towards(ctx, 0, side), want, atol=1.0)

@@ -35,6 +35,7 @@ import numpy as np
 from meshvis.errors import OutputError
 from meshvis.eval.baselines import BASELINES
 from meshvis.eval.bench import cases as C
+from meshvis.eval.bench.real import DEFAULT_MODELS, add_models_argument
 
 #: meshvis sweeps (rays per node)
 RAYS_FULL = (1, 2, 4, 8, 16, 32, 64)
@@ -54,9 +55,15 @@ OUTPUTS = ("accuracy.csv", "accuracy.md") + tuple(f"accuracy_{t}.png" for t in T
 
 # ====================================================================== the sweep
 def sweep(
-    cases: Iterable[C.Case], *, quick: bool = False, seed: int = 0, peel_timeout: float = 300.0, log=print
+    cases: Iterable[C.Case],
+    *,
+    quick: bool = False,
+    seed: int = 0,
+    peel_timeout: float = 300.0,
+    log=print,
+    models_dir: str | os.PathLike = DEFAULT_MODELS,
 ) -> tuple[list[C.Point], list[str]]:
-    """Measure every method at every budget on every case.
+    """Measure every method at every budget on every case (real ones read from ``models_dir``).
 
     Returns
     -------
@@ -66,7 +73,7 @@ def sweep(
     points: list[C.Point] = []
     skipped: list[str] = []
     C.warm_up()
-    for case, truth in C.built_cases(cases, skipped, log):
+    for case, truth in C.built_cases(cases, skipped, log, models_dir):
         settings = [
             (r, dict(rays_per_node=r, progressive=False), False) for r in (RAYS_QUICK if quick else RAYS_FULL)
         ]
@@ -75,14 +82,14 @@ def sweep(
             res = C.meshvis_run(truth, TASKS, seed=seed, **kw)
             for task, (sec, values, info) in res.items():
                 p = C.Point(
-                    case.name,
-                    truth.n_faces,
-                    task,
-                    "meshvis_default" if default else "meshvis",
-                    "meshvis default (progressive)" if default else "meshvis",
-                    "rays_per_node",
-                    r,
-                    sec,
+                    case=case.name,
+                    faces=truth.n_faces,
+                    task=task,
+                    method="meshvis_default" if default else "meshvis",
+                    label="meshvis default (progressive)" if default else "meshvis",
+                    knob="rays_per_node",
+                    value=r,
+                    seconds=sec,
                     load1=C.load1(),
                     default=default,
                     extra=info,
@@ -345,6 +352,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--force", action="store_true", help="overwrite earlier results in DIR")
     p.add_argument("--quiet", action="store_true")
+    add_models_argument(p)
 
 
 def prepare_out(out: str, names: tuple[str, ...], force: bool) -> None:
@@ -369,6 +377,7 @@ def main(args: argparse.Namespace) -> int:
         seed=args.seed,
         peel_timeout=min(args.peel_timeout, 60.0) if args.quick else args.peel_timeout,
         log=log,
+        models_dir=args.models_dir,
     )
     total = time.perf_counter() - t0
     write_csv(os.path.join(args.out, "accuracy.csv"), points)
@@ -380,6 +389,7 @@ def main(args: argparse.Namespace) -> int:
             "--quick" if args.quick else "",
             f"--cases {args.cases}" if args.cases else "",
             f"--seed {args.seed}" if args.seed else "",
+            f"--models {args.models_dir}" if args.models_dir != DEFAULT_MODELS else "",
             f"--out {args.out}",
         ]
         if x

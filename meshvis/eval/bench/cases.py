@@ -18,11 +18,13 @@ import sys
 import time
 from collections.abc import Callable
 from dataclasses import asdict, dataclass, field
+from pathlib import Path
 
 import numpy as np
 
 from meshvis.eval import generators as gen
 from meshvis.eval.baselines import BASELINES, Baseline, BaselineResult
+from meshvis.eval.bench.real import DEFAULT_MODELS, models_folder
 from meshvis.eval.generators import GroundTruth
 from meshvis.eval.metrics import layer_error, orientation_error, removal_scores
 
@@ -53,17 +55,18 @@ class Case:
     """A named input: how to build its truth, and what it tests."""
 
     name: str
-    build: Callable[[], GroundTruth]
+    #: called with no argument, or for a real case with the folder of the real models
+    build: Callable[..., GroundTruth]
     note: str
     real: bool = False
 
 
-def _soup(make: Callable[[], GroundTruth], seed: int = 0) -> Callable[[], GroundTruth]:
-    return lambda: gen.soupify(make(), flip=0.5, seed=seed)
+def _soup(make: Callable[..., GroundTruth], seed: int = 0) -> Callable[..., GroundTruth]:
+    return lambda *folder: gen.soupify(make(*folder), flip=0.5, seed=seed)
 
 
-def _real(file: str) -> Callable[[], GroundTruth]:
-    return lambda: gen.from_closed_mesh(os.fspath(gen.real_models_dir() / file))
+def _real(file: str) -> Callable[[Path], GroundTruth]:
+    return lambda folder: gen.from_closed_mesh(os.fspath(folder / file))
 
 
 #: every case, in report order
@@ -115,11 +118,16 @@ def select_cases(names: str | None, default: tuple[str, ...]) -> list[Case]:
     return [CASES[n] for n in wanted]
 
 
-def built_cases(cases, skipped: list[str], log):
+def built_cases(cases, skipped: list[str], log, models_dir: str | os.PathLike = DEFAULT_MODELS):
     """Yield ``(case, truth)`` for every case that can be built; the others are logged and
-    appended to ``skipped`` (a missing real model is not an error of the benchmark)."""
+    appended to ``skipped`` (a missing real model is not an error of the benchmark, a
+    missing folder of real models is: :class:`~meshvis.errors.ParameterError` before the
+    first case, when any case is real)."""
+    cases = list(cases)
+    if any(case.real for case in cases):
+        models_folder(models_dir)
     for case in cases:
-        truth, why = load_case(case)
+        truth, why = load_case(case, models_dir)
         if truth is None:
             skipped.append(f"{case.name}: {why}")
             log(f"{case.name}: {why}")
@@ -128,10 +136,11 @@ def built_cases(cases, skipped: list[str], log):
         yield case, truth
 
 
-def load_case(case: Case) -> tuple[GroundTruth | None, str]:
-    """Build a case's truth; ``(None, reason)`` when a real model is missing or unusable."""
+def load_case(case: Case, models_dir: str | os.PathLike = DEFAULT_MODELS) -> tuple[GroundTruth | None, str]:
+    """Build a case's truth (a real one from ``models_dir``); ``(None, reason)`` when a real
+    model is missing or unusable."""
     try:
-        return case.build(), ""
+        return (case.build(models_folder(models_dir)) if case.real else case.build()), ""
     except FileNotFoundError as exc:
         return None, f"skipped: {exc}"
     except Exception as exc:  # a real model whose truth cannot be built
@@ -258,14 +267,14 @@ def baseline_point(
     s = score(truth, b.task, r.values if r.ok else None)
     shown = b.default if value is None else value
     return Point(
-        case,
-        truth.n_faces,
-        b.task,
-        name,
-        b.label,
-        (b.knob + (" per face" if b.per_face else "")) if b.knob else "",
-        float("nan") if shown is None else float(shown),
-        r.seconds,
+        case=case,
+        faces=truth.n_faces,
+        task=b.task,
+        method=name,
+        label=b.label,
+        knob=(b.knob + (" per face" if b.per_face else "")) if b.knob else "",
+        value=float("nan") if shown is None else float(shown),
+        seconds=r.seconds,
         ok=r.ok,
         message=r.message,
         load1=load1(),

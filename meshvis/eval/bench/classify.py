@@ -11,13 +11,15 @@ import os
 import time
 from typing import Any
 
-from meshvis.eval.generators import real_models_dir, skin_and_ribcage
+from meshvis.eval.bench.real import DEFAULT_MODELS, models_folder
+from meshvis.eval.generators import skin_and_ribcage
 from meshvis.graphcut.classify import classify
 from meshvis.io import load
 
 
-def default_models() -> list[tuple[str, Any]]:
-    folder = real_models_dir()
+def default_models(models_dir: str | os.PathLike = DEFAULT_MODELS) -> list[tuple[str, Any]]:
+    """The monastery and the skin + rib cage, read from ``models_dir`` (checked to exist)."""
+    folder = models_folder(models_dir)
     return [
         (
             "pybullet__samurai_monastry.obj",
@@ -27,9 +29,14 @@ def default_models() -> list[tuple[str, Any]]:
     ]
 
 
-def run(models: list[str] | None = None, rays_per_node: int = 32, seed: int = 0) -> list[dict]:
-    """Classify each model once and return one result dict per model."""
-    todo = default_models() if not models else [(m, lambda m=m: load(m)) for m in models]
+def run(
+    models: list[str] | None = None,
+    rays_per_node: int = 32,
+    seed: int = 0,
+    models_dir: str | os.PathLike = DEFAULT_MODELS,
+) -> list[dict]:
+    """Classify each model once and return one result dict per model (default models from ``models_dir``)."""
+    todo = default_models(models_dir) if not models else [(m, lambda m=m: load(m)) for m in models]
     out = []
     for name, make in todo:
         soup = make()

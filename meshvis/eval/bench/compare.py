@@ -29,6 +29,7 @@ import numpy as np
 from meshvis.eval.baselines import BASELINES
 from meshvis.eval.bench import cases as C
 from meshvis.eval.bench.accuracy import prepare_out
+from meshvis.eval.bench.real import DEFAULT_MODELS, add_models_argument
 
 #: inputs of the full and the quick comparison
 FULL = ("sphere_pair", "skin_ribcage", "cow", "spot", "dog_skin")
@@ -60,14 +61,14 @@ def compare_case(
         def run_meshvis(task=task):
             sec, values, info = C.meshvis_run(truth, (task,), seed=seed, share=False)[task]
             return C.Point(
-                case,
-                truth.n_faces,
-                task,
-                "meshvis",
-                "meshvis (defaults)",
-                "rays_per_node",
-                32,
-                sec,
+                case=case,
+                faces=truth.n_faces,
+                task=task,
+                method="meshvis",
+                label="meshvis (defaults)",
+                knob="rays_per_node",
+                value=32,
+                seconds=sec,
                 load1=C.load1(),
                 default=True,
                 extra=info,
@@ -177,6 +178,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--peel-timeout", type=float, default=300.0, metavar="S")
     p.add_argument("--force", action="store_true", help="overwrite earlier results in DIR")
     p.add_argument("--quiet", action="store_true")
+    add_models_argument(p)
 
 
 def main(args: argparse.Namespace) -> int:
@@ -189,7 +191,7 @@ def main(args: argparse.Namespace) -> int:
     C.warm_up()
     points: list[C.Point] = []
     skipped: list[str] = []
-    for case, truth in C.built_cases(chosen, skipped, log):
+    for case, truth in C.built_cases(chosen, skipped, log, args.models_dir):
         points += compare_case(
             truth, case.name, seed=args.seed, repeat=args.repeat, peel_timeout=args.peel_timeout, log=log
         )
@@ -200,6 +202,7 @@ def main(args: argparse.Namespace) -> int:
             f"--cases {args.cases}" if args.cases else "",
             f"--repeat {args.repeat}" if args.repeat != 1 else "",
             f"--seed {args.seed}" if args.seed else "",
+            f"--models {args.models_dir}" if args.models_dir != DEFAULT_MODELS else "",
             f"--out {args.out}" if args.out else "",
         ]
         if x

@@ -1,6 +1,6 @@
 """Guarantee sweep of the label layout: many views, sizes and models, every layout, both methods.
 
-The layout benchmark (:mod:`labeling.bench`) measures one model closely; this sweep checks
+The layout benchmark (:mod:`meshvis.eval.bench.labeling`) measures one model closely; this sweep checks
 the promises everywhere it can reach in a minute or two: for every (model, view, image
 size, layout, method) it lays the labels out once and records whether the layout is
 clean (no box overlap, no leader crossing, no box over the model, no bad anchor, no
@@ -21,14 +21,15 @@ from typing import Any
 
 import numpy as np
 
-from meshvis.eval.generators import real_models_dir
+from meshvis.eval.bench.real import DEFAULT_MODELS, add_models_argument, models_folder
+from meshvis.labeling.candidates import LAYOUTS
+from meshvis.labeling.idbuffer import id_buffer
+from meshvis.labeling.inputs import label_texts, load_models
+from meshvis.labeling.metrics import is_clean
+from meshvis.labeling.pipeline import METHODS, fit_camera, solve, warm_up
 from meshvis.rays.caster import RayCaster
 
-from .candidates import LAYOUTS
-from .idbuffer import id_buffer
-from .inputs import label_texts, load_models
-from .metrics import is_clean
-from .pipeline import METHODS, fit_camera, solve, warm_up
+from .labeling import default_model, report
 
 #: (name, files, up axis) of the real models the sweep uses when they are present
 REAL = (
@@ -42,14 +43,20 @@ REAL = (
 )
 
 
-def default_models() -> list[tuple[str, Any, tuple[float, float, float]]]:
-    """The generated engine assembly and the real multi-part models that are available."""
-    from .bench import default_model
+def default_models(
+    models_dir: str | os.PathLike = DEFAULT_MODELS,
+) -> list[tuple[str, Any, tuple[float, float, float]]]:
+    """The generated engine assembly and the real multi-part models of ``models_dir`` that are there.
 
+    Raises
+    ------
+    ParameterError
+        When ``models_dir`` is not a folder.
+    """
     out: list[tuple[str, Any, tuple[float, float, float]]] = [
         ("assembly", default_model()[0], (0.0, 0.0, 1.0))
     ]
-    folder = real_models_dir()
+    folder = models_folder(models_dir)
     for name, files, up in REAL:
         paths = [os.path.join(folder, f) for f in files]
         if all(os.path.exists(p) for p in paths):
@@ -66,6 +73,7 @@ def run(
     layouts: Sequence[str] = tuple(LAYOUTS),
     methods: Sequence[str] = METHODS,
     progress: Callable[[str], None] | None = None,
+    models_dir: str | os.PathLike = DEFAULT_MODELS,
 ) -> dict[str, Any]:
     """Lay out every case once and summarise.
 
@@ -77,6 +85,7 @@ def run(
     sizes : image widths = heights (pixels)
     layouts, methods : what to run
     progress : called with a line of text after each model
+    models_dir : folder of the real models of the default ``models``
 
     Returns
     -------
@@ -88,7 +97,7 @@ def run(
     say = progress or (lambda s: None)
     warm_up()  # one-time imports are not a layout's time
     cases: dict[str, dict[str, Any]] = {}
-    for name, model, up in models if models is not None else default_models():
+    for name, model, up in models if models is not None else default_models(models_dir):
         soup = load_models(model)
         caster = RayCaster(soup)
         texts = label_texts(soup.part_names)
@@ -179,17 +188,17 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     )
     parser.add_argument("--layouts", nargs="+", choices=tuple(LAYOUTS), default=list(LAYOUTS))
     parser.add_argument("--json", metavar="FILE", help="also write every case and the summary as JSON")
+    add_models_argument(parser)
 
 
 def main(args: argparse.Namespace) -> int:
     """Entry point of ``meshvis bench labeling-sweep``."""
-    from .bench import report
-
     result = run(
         azimuths=args.azimuths,
         elevations=args.elevations,
         sizes=args.sizes,
         layouts=args.layouts,
         progress=lambda s: print(s, flush=True),
+        models_dir=args.models_dir,
     )
     return report(result, format(result), args.json)

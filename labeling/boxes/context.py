@@ -1,0 +1,168 @@
+"""The state the placement of one frame shares: labels, sides, ``A_I``, what is placed."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..candidates import EAST, NORTH, SOUTH, WEST
+from ..internal_area import resample_boundary
+from .spacing import BoxStats, Placement
+
+#: spacing (pixels) of the points along the boundary of ``A_I`` that the silhouette layout
+#: moves endpoints between and takes its push-out normals from
+BOUNDARY_STEP = 2.0
+#: the farthest push-out the searches consider: 1.2 image sizes, or the height of a stack of
+#: three boxes per label when there are many labels
+REACH_IMAGE = 1.2
+REACH_STACK = 3.0
+#: the nearer search before the farthest one, as a fraction of the image size: most labels
+#: find their place there, and its candidate lists are much shorter
+NEAR_REACH = 0.4
+#: length of a push-out ray in the tests against boxes, in reaches (plus the widest box):
+#: beyond any push-out a search may choose
+RAY_REACHES = 2.0
+#: floor of a tangent length (pixels) where boundary points coincide
+_TINY = 1e-12
+
+
+class Context:
+    """Everything the placement of one frame shares."""
+
+    def __init__(
+        self,
+        anchors,
+        endpoints,
+        sides,
+        widths,
+        height,
+        area,
+        image_size,
+        spacing,
+        rank,
+        previous=None,
+        directions=None,
+    ):
+        self.anchors = np.asarray(anchors, np.float64).reshape(-1, 2)
+        # per label: its box centre along each side in the previous frame (NaN: elsewhere)
+        self.previous = (
+            np.full((len(self.anchors), 4), np.nan) if previous is None else np.asarray(previous, np.float64)
+        )
+        self.endpoints = np.array(endpoints, np.float64).reshape(-1, 2)  # a copy: parting moves them
+        self.sides = np.array(sides, np.int64)  # a copy: a label may change side
+        # the layout's principal directions (a label may move to another one of them)
+        self.directions = tuple(sorted(set(self.sides.tolist()))) if directions is None else tuple(directions)
+        self.widths = np.asarray(widths, np.float64)
+        self.height = float(height)
+        self.area = area
+        self.W, self.H = (float(s) for s in image_size)
+        self.sp = spacing
+        self.rank = np.asarray(rank, np.int64)
+        self.placed: list[Placement | None] = [None] * len(self.anchors)
+        x0, y0, x1, y1 = area.bbox
+        self.col_x = {
+            WEST: float(np.nanmin(area.left)) - spacing.clearance,
+            EAST: float(np.nanmax(area.right)) + spacing.clearance,
+        }
+        self.row_y = {
+            NORTH: float(np.nanmin(area.top)) - spacing.clearance,
+            SOUTH: float(np.nanmax(area.bottom)) + spacing.clearance,
+        }
+        self.center = area.centroid
+        self.stats = BoxStats()
+        self._boundary = None
+        self._rays = None
+        self._cache = None
+
+    # geometry of one label in a column / row
+    def column_box(self, k: int, side: int, y: np.ndarray) -> np.ndarray:
+        x = self.col_x[side]
+        w, h = self.widths[k], self.height
+        y = np.asarray(y, np.float64)
+        x0 = np.full_like(y, x - w if side == WEST else x)
+        return np.stack([x0, y - h / 2, x0 + w, y + h / 2], axis=-1)
+
+    def row_box(self, k: int, side: int, x: np.ndarray, tier: np.ndarray) -> np.ndarray:
+        """Flag box of label k whose leader port is at ``x``, in ``tier``."""
+        w, h, sp = self.widths[k], self.height, self.sp
+        x = np.asarray(x, np.float64)
+        tier = np.asarray(tier, np.float64)
+        left_flag = x < self.center[0]
+        x0 = np.where(left_flag, x + sp.inset - w, x - sp.inset)
+        step = h + sp.gap
+        if side == NORTH:
+            y1 = self.row_y[NORTH] - tier * step
+            y0 = y1 - h
+        else:
+            y0 = self.row_y[SOUTH] + tier * step
+            y1 = y0 + h
+        x0, y0, y1 = np.broadcast_arrays(x0, y0, y1)
+        return np.stack([x0, y0, x0 + w, y1], axis=-1)
+
+    def row_leader(self, k: int, side: int, x: float, tier: int) -> np.ndarray:
+        box = self.row_box(k, side, np.array(x), np.array(tier))
+        port = (x, self.row_y[side])
+        pts = [self.anchors[k], port]
+        if tier > 0:
+            pts.append((x, box[3] if side == NORTH else box[1]))
+        return np.array(pts, np.float64)
+
+    boundary_step = BOUNDARY_STEP
+    future: tuple = ()
+
+    def ray_direction(self, k: int) -> np.ndarray:
+        """Outward unit normal of ``A_I`` at label k's endpoint: the direction of its push-out.
+
+        Normals of a convex boundary turn monotonically, so these rays never meet.
+        """
+        if self._rays is None:
+            pts, normals = self.boundary
+            d2 = ((self.endpoints[:, None, :] - pts[None, :, :]) ** 2).sum(axis=2)
+            self._nearest = np.argmin(d2, axis=1)
+            self._rays = normals[self._nearest]
+        return self._rays[k]
+
+    def boundary_index(self, k: int) -> int:
+        """Index of the boundary point (:attr:`boundary`) nearest to label k's endpoint."""
+        self.ray_direction(k)
+        return int(self._nearest[k])
+
+    def future_rays(self, k: int) -> np.ndarray:
+        """Rays (m, 2, 2) of the radial labels not placed yet (other than k)."""
+        js = np.array([j for j in self.future if j != k], np.int64)
+        if len(js) == 0:
+            return np.zeros((0, 2, 2))
+        self.ray_direction(0)
+        e = self.endpoints[js]
+        return np.stack([e, e + self.ray_length * self._rays[js]], axis=1)
+
+    @property
+    def reach(self) -> float:
+        """Farthest push-out of a box (pixels) the candidate searches consider."""
+        size = max(self.W, self.H)
+        return max(REACH_IMAGE * size, REACH_STACK * len(self.anchors) * (self.height + self.sp.gap))
+
+    @property
+    def ray_length(self) -> float:
+        """Length of a label's push-out ray in the tests against boxes: longer than any
+        push-out the search may choose plus the widest box (a box beyond a ray's end
+        would count as leaving it free)."""
+        return RAY_REACHES * self.reach + float(self.widths.max()) + self.height
+
+    def future_insides(self, k: int) -> np.ndarray:
+        """Inside parts (m, 2, 2), anchor to endpoint, of the radial labels not placed yet (other than k)."""
+        js = np.array([j for j in self.future if j != k], np.int64)
+        return np.stack([self.anchors[js], self.endpoints[js]], axis=1).reshape(-1, 2, 2)
+
+    @property
+    def boundary(self) -> tuple[np.ndarray, np.ndarray]:
+        """Points every :data:`BOUNDARY_STEP` px along the boundary of ``A_I`` and their outward unit normals."""
+        if self._boundary is None:
+            pts, arc = resample_boundary(self.area.polygon, BOUNDARY_STEP)
+            self.boundary_step = float(arc[1] - arc[0])
+            tangent = np.roll(pts, -1, axis=0) - np.roll(pts, 1, axis=0)
+            normal = np.column_stack([tangent[:, 1], -tangent[:, 0]])
+            normal /= np.maximum(np.hypot(normal[:, 0], normal[:, 1]), _TINY)[:, None]
+            outward = np.einsum("ij,ij->i", normal, pts - self.center) >= 0
+            normal[~outward] *= -1  # convex area: outward = away from the centre
+            self._boundary = (pts, normal)
+        return self._boundary

@@ -1,0 +1,122 @@
+"""The box layout of one frame: columns, rows and the ring, then the repair of conflicting pairs."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..candidates import EAST, NORTH, RADIAL, SOUTH, WEST
+from ..geometry2d import boxes_overlap, segment_hits_box, segments_intersect
+from ..internal_area import InternalArea
+from .context import Context
+from .search import _search
+from .silhouette import _place_ring
+from .spacing import BoxStats, Placement, Spacing
+from .stacking import _place_column, _place_row
+
+#: rounds of the last pass (re-place the later label of every conflicting pair); what still
+#: conflicts after them is left out and reported
+REPAIR_ROUNDS = 4
+
+
+def _conflicting(ctx: Context) -> list[int]:
+    """Labels to re-place: the later-ranked member of every conflicting pair."""
+    ids = [i for i, p in enumerate(ctx.placed) if p is not None]
+    if len(ids) < 2:
+        return []
+    boxes = np.array([ctx.placed[i].box for i in ids])
+    segs, owner = [], []
+    for n, i in enumerate(ids):
+        pts = ctx.placed[i].leader
+        s = np.stack([pts[:-1], pts[1:]], axis=1)
+        segs.extend(s)
+        owner.extend([n] * len(s))
+    segs = np.array(segs)
+    owner = np.array(owner)
+    m = len(ids)
+    one_hot = np.zeros((len(segs), m), np.int64)
+    one_hot[np.arange(len(segs)), owner] = 1
+    bad = boxes_overlap(boxes, boxes, 0.0)
+    bad |= (one_hot.T @ segments_intersect(segs, segs).astype(np.int64) @ one_hot) > 0
+    through = (one_hot.T @ segment_hits_box(segs, boxes).astype(np.int64)) > 0
+    bad |= through | through.T
+    np.fill_diagonal(bad, False)
+    over = ctx.area.boxes_hit(boxes) > 0
+    redo = set(np.array(ids)[over].tolist())
+    ii, jj = np.nonzero(np.triu(bad, 1))
+    for a, b in zip(ii, jj):
+        i, j = ids[a], ids[b]
+        redo.add(i if ctx.rank[i] > ctx.rank[j] else j)
+    return sorted(redo, key=lambda i: (ctx.rank[i], i))
+
+
+def place_boxes(
+    anchors: np.ndarray,
+    endpoints: np.ndarray,
+    sides: np.ndarray,
+    widths: np.ndarray,
+    height: float,
+    area: InternalArea,
+    image_size: tuple[int, int],
+    rank: np.ndarray | None = None,
+    spacing: Spacing | None = None,
+    previous: np.ndarray | None = None,
+    directions: tuple[int, ...] | None = None,
+) -> tuple[list[Placement | None], BoxStats]:
+    """Lay out the boxes and leaders of all labels of one frame.
+
+    Parameters
+    ----------
+    anchors, endpoints : (n, 2) float, the anchors and candidate endpoints (pixels)
+    sides : (n,) int, side code of each label
+    widths : (n,) float, box widths; ``height`` : box height
+    area : InternalArea
+    image_size : (width, height)
+    rank : (n,) int, greedy placement order (lower = placed first); default 0..n-1
+    spacing : Spacing
+    previous : (n, 4) float, optional: each label's box centre along the west, east,
+        north and south side in the previous frame (y for west/east, x for north/south;
+        NaN where it was not on that side), for :func:`coherent_order`
+    directions : side codes of the layout (default: those in ``sides``); a label with no
+        room on its side may move to another one of them
+
+    Returns
+    -------
+    placements : list of Placement or None (no valid place found)
+    stats : BoxStats
+    """
+    n = len(anchors)
+    rank = np.arange(n) if rank is None else np.asarray(rank)
+    ctx = Context(
+        anchors,
+        endpoints,
+        sides,
+        widths,
+        height,
+        area,
+        image_size,
+        spacing or Spacing(),
+        rank,
+        previous,
+        directions,
+    )
+    for side in (WEST, EAST):
+        _place_column(ctx, np.flatnonzero(ctx.sides == side), side)
+    for side in (NORTH, SOUTH):
+        _place_row(ctx, np.flatnonzero(ctx.sides == side), side)
+    _place_ring(ctx, np.flatnonzero(ctx.sides == RADIAL))
+    for _ in range(REPAIR_ROUNDS):
+        redo = _conflicting(ctx)
+        if not redo:
+            break
+        for k in redo:
+            ctx.placed[k] = None
+        for k in redo:
+            ctx.stats.repaired += 1
+            if not _search(ctx, k) and k not in ctx.stats.unplaced:
+                ctx.stats.unplaced.append(int(k))
+    else:
+        for k in _conflicting(ctx):
+            ctx.placed[k] = None
+            if k not in ctx.stats.unplaced:
+                ctx.stats.unplaced.append(int(k))
+    return ctx.placed, ctx.stats
