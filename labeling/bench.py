@@ -30,6 +30,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis._extras import import_extra
 from meshvis.rays.caster import RayCaster
 
 from .baselines import adjust_text
@@ -130,6 +131,8 @@ def run(
         :func:`compare_views`).
     """
     say = progress or (lambda s: None)
+    if adjusttext:  # fail before the first layout, not in the middle of the run
+        import_extra("adjustText", "meshvis bench labeling without --no-adjusttext")
     spacing = Spacing() if rotate is None else Spacing(rotate=float(rotate))
     if model is None:
         soup, name = default_model()

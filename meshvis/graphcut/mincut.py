@@ -171,8 +171,9 @@ class VisibilityGraph:
 
         Edges carry ``weight`` (unfiltered w) and ``capacity`` (filtered, directed).
         """
-        import networkx as nx
+        from meshvis._extras import import_extra
 
+        nx = import_extra("networkx", "GraphML export (--graphml)")
         w = self.weights
         g = nx.DiGraph()
         attrs = node_attributes or {}

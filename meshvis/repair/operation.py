@@ -107,14 +107,17 @@ def run_operation(
     from meshvis.repair.remove import remove_interior
 
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
+    if op == "classify" and o["graphml"]:  # fail before the classification, not after
+        from meshvis._extras import import_extra
+
+        import_extra("networkx", "GraphML export (--graphml)")
     tell = say or (lambda text: None)
     c = classify(soup, progress=progress, **classify_kwargs(o))
     tell(c.summary())
     if op == "classify":
         report = c.report()
         if o["graphml"]:
-            import networkx as nx
-
+            nx = import_extra("networkx", "GraphML export (--graphml)")
             with atomic_write(o["graphml"], "wb") as fh:
                 nx.write_graphml(c.graph.to_networkx({"area": c.nodes.area}), fh)
         if o["preview"]:

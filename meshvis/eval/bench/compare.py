@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-from meshvis.eval.baselines import BASELINES
+from meshvis.eval.baselines import BASELINES, require_baselines
 from meshvis.eval.bench import cases as C
 from meshvis.eval.bench.accuracy import prepare_out
 
@@ -180,6 +180,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    require_baselines()
     chosen = C.select_cases(args.cases, QUICK if args.quick else FULL)
     if args.out:
         prepare_out(args.out, OUTPUTS, args.force)
