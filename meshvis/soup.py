@@ -67,10 +67,11 @@ class Soup:
 
     vertices: np.ndarray
     faces: np.ndarray
-    part_id: np.ndarray | None = None
+    # None in the constructor means "the default"; __post_init__ always fills an array
+    part_id: np.ndarray = None  # type: ignore[assignment]
     part_names: list[str] = field(default_factory=list)
-    source_face: np.ndarray | None = None
-    material_id: np.ndarray | None = None
+    source_face: np.ndarray = None  # type: ignore[assignment]
+    material_id: np.ndarray = None  # type: ignore[assignment]
     materials: list[Material] = field(default_factory=list)
     uv: np.ndarray | None = None
     colors: np.ndarray | None = None

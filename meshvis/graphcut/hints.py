@@ -46,10 +46,10 @@ class Hints:
                 raise ParameterError(f"{name.replace('_', ' ')} must be finite")
             setattr(self, name, a)
         for name in ("inside_boxes", "outside_boxes"):
-            a = np.asarray(getattr(self, name), np.float64).reshape(-1, 2, 3)
-            if not np.isfinite(a).all() or np.any(a[:, 1] < a[:, 0]):
+            boxes = np.asarray(getattr(self, name), np.float64).reshape(-1, 2, 3)
+            if not np.isfinite(boxes).all() or np.any(boxes[:, 1] < boxes[:, 0]):
                 raise ParameterError(f"{name.replace('_', ' ')} must be finite (min, max) corner pairs")
-            setattr(self, name, a)
+            setattr(self, name, boxes)
         if self.rays < 1:
             raise ParameterError("hint rays must be at least 1")
 
@@ -93,7 +93,7 @@ def hint_weights(
         (hints.inside_points, hints.inside_boxes),
     ):
         origins = _hint_origins(points, boxes, hints.rays, rng)
-        w = np.zeros(nodes.n)
+        w: np.ndarray = np.zeros(nodes.n)
         if len(origins):
             dirs = uniform_sphere(len(origins), rng)
             h = caster.intersect(origins, dirs)
@@ -103,6 +103,7 @@ def hint_weights(
             dst = nodes.side_node[f, s]
             flag = dst < 0
             if flag.any():
+                assert h.bary is not None  # intersect always fills it
                 dst[flag] = nodes.point_node(snap_to_points(nodes, f[flag], h.bary[hit][flag]), s[flag])
             w = np.bincount(dst, minlength=nodes.n) * (hints.strength * total_area / max(len(dst), 1))
         out.append(w)

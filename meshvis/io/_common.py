@@ -13,7 +13,7 @@ import stat
 import struct
 import tempfile
 from collections.abc import Iterator
-from typing import IO
+from typing import IO, Any
 
 import numpy as np
 
@@ -75,7 +75,8 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
     except OSError as exc:
         raise OutputError(f"cannot write: {one_line(exc.strerror or exc)}", path) from None
     try:
-        with os.fdopen(fd, mode, **({"encoding": encoding, "newline": "\n"} if mode == "w" else {})) as fh:
+        text: dict[str, Any] = {"encoding": encoding, "newline": "\n"} if mode == "w" else {}
+        with os.fdopen(fd, mode, **text) as fh:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())

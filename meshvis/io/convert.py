@@ -25,11 +25,9 @@ def as_soup(model: Any, *, name: str | None = None) -> Soup:
         return model
     if isinstance(model, (str, os.PathLike)):
         return load(model)
-    try:
-        import trimesh
-    except ImportError:  # pragma: no cover - trimesh is a dependency
-        trimesh = None
-    if trimesh is not None and isinstance(model, trimesh.Scene):
+    import trimesh  # a dependency
+
+    if isinstance(model, trimesh.Scene):
         return soup_from_scene(model, path=name)
     if trimesh is not None and isinstance(model, trimesh.Trimesh):
         validate(model.vertices, model.faces, name)

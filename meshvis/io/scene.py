@@ -5,6 +5,8 @@ visual (UVs, colours, material).  Used by the glTF and 3MF readers and by
 
 from __future__ import annotations
 
+from typing import Any
+
 import numpy as np
 
 from meshvis.errors import ModelError
@@ -50,10 +52,10 @@ def soup_from_scene(scene, path: str | None = None) -> Soup:
     return soup
 
 
-def mesh_soup(geom, name: str, material_index: int) -> Soup:
+def mesh_soup(geom: Any, name: str, material_index: int) -> Soup:
     """One trimesh mesh as a single-part soup with per-corner UVs / colours."""
     faces = np.asarray(geom.faces, np.int64)
-    vis = getattr(geom, "visual", None)
+    vis: Any = getattr(geom, "visual", None)
     uv = colors = None
     kind = getattr(vis, "kind", None)
     if kind == "texture" and getattr(vis, "uv", None) is not None and len(vis.uv) == len(geom.vertices):

@@ -66,7 +66,7 @@ def _face_outside_any(c: Classification, node_outside: np.ndarray) -> tuple[np.n
         & ~((frac[:, 0] == 1) & (frac[:, 1] == 1))
     )
     side[partial] = np.where(frac[partial, 0] >= frac[partial, 1], 0, 1)
-    return out.any(axis=1), side.astype(np.int8)
+    return np.any(out, axis=1), side.astype(np.int8)
 
 
 def face_nodes_mask(c: Classification, faces: np.ndarray) -> np.ndarray:

@@ -114,6 +114,7 @@ def run_operation(
     tell = say or (lambda text: None)
     c = classify(soup, progress=progress, **classify_kwargs(o))
     tell(c.summary())
+    r: Any  # the repair's result: OrientResult, RemovalResult or LayerResult
     if op == "classify":
         report = c.report()
         if o["graphml"]:
