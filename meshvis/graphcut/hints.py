@@ -25,11 +25,19 @@ class Hints:
 
     Parameters
     ----------
-    inside_points, outside_points : (k, 3) arrays
-    inside_boxes, outside_boxes : (k, 2, 3) arrays of (min corner, max corner)
-    rays : rays cast per hint point (boxes: in total, from random points in the box)
-    strength : multiplier of the hint links (default 10: a hint should win over the
-        ray evidence of a side that escapes freely, whose outside link is at most its area)
+    inside_points : (k, 3) float array
+        Points known to be inside.
+    outside_points : (k, 3) float array
+        Points known to be outside.
+    inside_boxes : (k, 2, 3) float array
+        Boxes known to be inside, as (min corner, max corner).
+    outside_boxes : (k, 2, 3) float array
+        Boxes known to be outside.
+    rays : int
+        Rays cast per hint point (boxes: in total, from random points in the box).
+    strength : float
+        Multiplier of the hint links (default 10: a hint should win over the ray evidence
+        of a side that escapes freely, whose outside link is at most its area).
     """
 
     inside_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
@@ -64,6 +72,7 @@ class Hints:
 
     @property
     def empty(self) -> bool:
+        """True when no point or box is given."""
         return not (
             len(self.inside_points)
             or len(self.outside_points)

@@ -1,5 +1,7 @@
-"""What users have, as a :class:`~meshvis.soup.Soup`: the one coercion every entry point of
-the library goes through."""
+"""What users have, as a :class:`~meshvis.soup.Soup`.
+
+The one coercion every entry point of the library goes through.
+"""
 
 from __future__ import annotations
 

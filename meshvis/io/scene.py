@@ -1,6 +1,7 @@
-"""trimesh objects as soups: a ``trimesh.Scene`` (instancing applied) or one mesh with its
-visual (UVs, colours, material).  Used by the glTF and 3MF readers and by
-:func:`meshvis.io.as_soup`.
+"""trimesh objects as soups.
+
+A ``trimesh.Scene`` (instancing applied) or one mesh with its visual (UVs, colours,
+material).  Used by the glTF and 3MF readers and by :func:`meshvis.io.as_soup`.
 """
 
 from __future__ import annotations
@@ -26,12 +27,14 @@ def soup_from_scene(scene, path: str | None = None) -> Soup:
     Parameters
     ----------
     scene : trimesh.Scene
+        The scene to flatten.
     path : str, optional
         Name for messages.
 
     Returns
     -------
     Soup
+        One part per geometry node.
     """
     parts: list[Soup] = []
     materials: dict[int, int] = {}

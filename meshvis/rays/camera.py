@@ -19,8 +19,23 @@ AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 
 
 def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, float, float]:
-    """The up vector for an axis name, or for ``"auto"``: +y when every file is glTF/GLB
-    (the format fixes y up), +z otherwise (the CAD and scanning convention)."""
+    """The up vector for an axis name, or for ``"auto"``.
+
+    ``"auto"`` gives +y when every file is glTF/GLB (the format fixes y up), +z otherwise
+    (the CAD and scanning convention).
+
+    Parameters
+    ----------
+    name : {"auto", "x", "y", "z"}
+        The axis name.
+    paths : sequence of str
+        The model files, read by ``"auto"``.
+
+    Returns
+    -------
+    tuple of 3 float
+        The unit up vector.
+    """
     if name != "auto":
         return AXES[name]
     gltf = bool(paths) and all(os.path.splitext(str(p))[1].lower() in (".gltf", ".glb") for p in paths)
@@ -40,11 +55,18 @@ class Camera:
 
     Parameters
     ----------
-    position, target : (3,) float
-    up : (3,) float, approximate up direction (default +y, as in glTF and most OBJ files)
-    fov : float, vertical field of view in degrees (perspective)
+    position : (3,) float array
+        Where the camera is.
+    target : (3,) float array
+        The point it looks at.
+    up : (3,) float array
+        Approximate up direction (default +y, as in glTF and most OBJ files).
+    fov : float
+        Vertical field of view in degrees (perspective).
     orthographic : bool
-    ortho_height : float, height of the view in model units (orthographic)
+        Parallel projection instead of perspective.
+    ortho_height : float
+        Height of the view in model units (orthographic).
 
     Examples
     --------
@@ -91,9 +113,19 @@ class Camera:
     def rays(self, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
         """Primary rays through every pixel centre, row-major from the top-left pixel.
 
+        Parameters
+        ----------
+        width : int
+            Image width in pixels.
+        height : int
+            Image height in pixels.
+
         Returns
         -------
-        origins, directions : (height*width, 3) float64 (directions are unit vectors)
+        origins : (height*width, 3) float64 array
+            Ray origins.
+        directions : (height*width, 3) float64 array
+            Unit ray directions.
         """
         row, col = np.divmod(np.arange(width * height), width)
         return self.pixel_rays(col, row, width, height)
@@ -103,9 +135,23 @@ class Camera:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Primary rays through the centres of the given pixels of a ``width`` x ``height`` image.
 
+        Parameters
+        ----------
+        col : (n,) int array
+            Pixel columns.
+        row : (n,) int array
+            Pixel rows, 0 at the top.
+        width : int
+            Image width in pixels.
+        height : int
+            Image height in pixels.
+
         Returns
         -------
-        origins, directions : (n, 3) float64 (directions are unit vectors)
+        origins : (n, 3) float64 array
+            Ray origins.
+        directions : (n, 3) float64 array
+            Unit ray directions.
         """
         right, up, forward = self.basis()
         hh = self._half_height()
@@ -183,6 +229,7 @@ class Camera:
         ]
 
     def to_json(self) -> dict:
+        """The camera as a dict of plain floats and bools (inverse of :meth:`from_json`)."""
         d = asdict(self)
         for k in ("position", "target", "up"):
             d[k] = [float(x) for x in getattr(self, k)]
@@ -190,6 +237,13 @@ class Camera:
 
     @classmethod
     def from_json(cls, d: dict) -> Camera:
+        """The camera written by :meth:`to_json`.
+
+        Raises
+        ------
+        ParameterError
+            ``d`` has a key that is not a camera field.
+        """
         known = {"position", "target", "up", "fov", "orthographic", "ortho_height"}
         unknown = set(d) - known
         if unknown:
