@@ -90,7 +90,7 @@ class RayCaster:
     --------
     >>> import numpy as np, trimesh
     >>> rc = RayCaster(trimesh.creation.box())
-    >>> h = rc.intersect(np.array([[0., 0, 5]]), np.array([[0., 0, -1]]))
+    >>> h = rc.intersect(np.array([[0., 0, 5]]), np.array([[0., 0, -1]]), exact_distance=True)
     >>> int(h.side[0]), float(h.distance[0])
     (0, 4.5)
     """
