@@ -29,6 +29,8 @@ def _modules() -> list[str]:
 
 MODULES = _modules()
 FLAGS = doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE
+#: examples that take more than about half a second
+SLOW = {"meshvis.eval.reference"}
 
 
 def _examples() -> list:
@@ -38,7 +40,8 @@ def _examples() -> list:
         module = importlib.import_module(name)
         for test in finder.find(module, name):
             if test.examples and test.name.startswith(name):
-                found.append(pytest.param(test, id=test.name))
+                marks = [pytest.mark.slow] if test.name in SLOW else []
+                found.append(pytest.param(test, id=test.name, marks=marks))
     return found
 
 

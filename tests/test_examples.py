@@ -26,6 +26,7 @@ def test_every_example_is_tested():
     assert {p.name for p in EXAMPLES.glob("*.py") if not p.name.startswith("_")} == set(OUTPUTS)
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("script", sorted(OUTPUTS))
 def test_example_writes_its_outputs(script, tmp_path):
     out = tmp_path / "out"

@@ -259,6 +259,7 @@ def _rows(folder) -> dict[str, dict]:
         return {os.path.basename(r["input"]): r for r in csv.DictReader(fh)}
 
 
+@pytest.mark.slow
 def test_batch_command_local_and_resume(tmp_path, capsys):
     src = tmp_path / "in"
     src.mkdir()
@@ -331,6 +332,7 @@ def test_batch_command_local_and_resume(tmp_path, capsys):
     assert mb.completed_row(task) is None
 
 
+@pytest.mark.slow
 def test_time_limit_and_crashed_workers_do_not_stop_the_batch(tmp_path):
     src = _triangle(tmp_path / "tri.obj")
     out = str(tmp_path / "out")
@@ -354,6 +356,7 @@ def test_time_limit_and_crashed_workers_do_not_stop_the_batch(tmp_path):
     assert mio.load(good.output).n_faces == 1
 
 
+@pytest.mark.slow
 def test_run_file_isolated_kills_a_hung_file(tmp_path):
     task = mb.plan([_triangle(tmp_path / "tri.obj")], "orient", str(tmp_path / "out"))[0]
     task.runner = f"{__name__}:hang"
@@ -364,6 +367,7 @@ def test_run_file_isolated_kills_a_hung_file(tmp_path):
     assert mb.run_file_isolated(task, time_limit=60.0)["status"] == "ok"
 
 
+@pytest.mark.slow
 def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
     src = tmp_path / "in"
     src.mkdir()
@@ -427,6 +431,7 @@ def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
 
 
 # ---------------------------------------------------------------- usage errors
+@pytest.mark.slow
 def test_usage_errors(tmp_path, capsys, monkeypatch):
     src = _triangle(tmp_path / "tri.obj")
 
@@ -484,6 +489,7 @@ def test_usage_errors(tmp_path, capsys, monkeypatch):
 
 
 # ---------------------------------------------------------------- Dask
+@pytest.mark.slow
 def test_dask_local_cluster_gives_the_same_outputs(tmp_path, capsys):
     distributed = pytest.importorskip("distributed")
     src = tmp_path / "in"

@@ -477,6 +477,7 @@ def _run_cli(*args: str, cwd: str) -> subprocess.CompletedProcess:
     )
 
 
+@pytest.mark.slow
 def test_real_stderr_has_one_line_and_no_traceback(tmp_path):
     _write(tmp_path / "noise.ply", np.random.default_rng(0).integers(0, 256, 999, dtype=np.uint8).tobytes())
     _write(tmp_path / "short.obj", _text_model("obj", ["0 0 0", "1 0 0", "0 1 0"], [[0, 1]]))
