@@ -44,6 +44,19 @@ def test_help_works_next_to_a_local_cli_py(shadowed_folder, how):
     assert "usage: meshvis" in run.stdout and "orient" in run.stdout
 
 
+def _source_modules() -> list[str]:
+    """Every .py file of the package as the wheel names it (package-dir applied)."""
+    found = []
+    for folder, installed in (
+        ("meshvis", "meshvis"),
+        ("labeling", "meshvis/labeling"),
+        ("cli", "meshvis/cli"),
+    ):
+        for path in (ROOT / folder).rglob("*.py"):
+            found.append(f"{installed}/{path.relative_to(ROOT / folder).as_posix()}")
+    return found
+
+
 @pytest.mark.slow
 def test_wheel_has_one_top_level_name(tmp_path):
     """Build the wheel (pip wheel, build isolation) and read what it would install."""
@@ -62,4 +75,6 @@ def test_wheel_has_one_top_level_name(tmp_path):
     assert {n.split("/")[0] for n in names if not n.split("/")[0].endswith(".dist-info")} == {"meshvis"}
     for needed in ("meshvis/py.typed", "meshvis/labeling/__init__.py", "meshvis/cli/main.py"):
         assert needed in names
+    # every module of the source tree is in the wheel (a new subpackage needs its pyproject entry)
+    assert {n for n in names if n.endswith(".py")} >= set(_source_modules())
     assert any(n.endswith(".dist-info/licenses/LICENSE") for n in names)
