@@ -6,9 +6,17 @@ convex internal area, fuzzy membership functions aggregated per candidate, a gre
 placement order, label-box stacking with shift-and-swap corrections, frame-to-frame
 coherence, and the measures and baselines to judge the result.
 
->>> import meshvis.labeling
->>> result = meshvis.labeling.layout("model.glb", layout="left-right")      # doctest: +SKIP
->>> meshvis.labeling.write(result, "labels.svg")                             # doctest: +SKIP
+>>> import meshvis, meshvis.labeling, trimesh
+>>> box, ball = trimesh.creation.box(), trimesh.creation.icosphere()
+>>> ball = ball.apply_translation((1.5, 0, 0))
+>>> parts = meshvis.Soup.concatenate([meshvis.Soup(box.vertices, box.faces, part_names=["box"]),
+...                                   meshvis.Soup(ball.vertices, ball.faces, part_names=["ball"])])
+>>> meshvis.save(parts, "parts.obj")
+>>> result = meshvis.labeling.layout("parts.obj", layout="left-right")
+>>> sorted(label.text for label in result.labels)
+['ball', 'box']
+>>> meshvis.labeling.write(result, "labels.svg")
+['labels.svg']
 """
 
 from __future__ import annotations

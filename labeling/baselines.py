@@ -129,7 +129,9 @@ def adjust_text(reference: LayoutResult, *, iterations: int = 300, obstacle_cell
     -------
     LayoutResult with ``method="adjusttext"``; ``timings["boxes"]`` is adjustText's time.
     """
-    import adjustText
+    from meshvis._extras import import_extra
+
+    adjustText = import_extra("adjustText", "the adjustText labeling baseline")
     from matplotlib.transforms import Bbox
 
     t0 = time.perf_counter()

@@ -613,7 +613,7 @@ def layout(
     >>> import trimesh
     >>> from meshvis.soup import Soup
     >>> a, b = trimesh.creation.box(), trimesh.creation.icosphere()
-    >>> b.apply_translation((1.5, 0, 0))
+    >>> b = b.apply_translation((1.5, 0, 0))
     >>> soup = Soup.concatenate([Soup(a.vertices, a.faces, part_names=["box"]),
     ...                          Soup(b.vertices, b.faces, part_names=["ball"])])
     >>> r = layout(soup, size=(128, 128))

@@ -48,3 +48,27 @@ class OutputError(MeshvisError, OSError):
 
 class ParameterError(MeshvisError, ValueError):
     """An argument is out of its documented range."""
+
+
+class MissingExtraError(MeshvisError, ImportError):
+    """A feature needs an optional dependency that is not installed.
+
+    Parameters
+    ----------
+    feature : str
+        What the user asked for, e.g. ``"meshvis bench compare"``.
+    module : str
+        The module that could not be imported.
+    extra : str
+        The ``meshvis`` extra that installs it.
+    """
+
+    def __init__(self, feature: str, module: str, extra: str):
+        self.feature = feature
+        self.extra = extra
+        message = f'{feature} needs {module}, which is not installed: pip install "meshvis[{extra}]"'
+        ImportError.__init__(self, message, name=module)
+        self.args = (message,)
+
+    def __str__(self) -> str:  # ImportError keeps its own message handling
+        return self.args[0]

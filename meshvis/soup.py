@@ -72,19 +72,32 @@ class Soup:
 
     Parameters
     ----------
-    vertices : (n, 3) float64
-    faces : (m, 3) int64, indices into ``vertices``
-    part_id : (m,) int64, index into ``part_names``; defaults to 0
-    part_names : list of str
-    source_face : (m,) int64, index of the polygon of the source file each triangle came from
-    material_id : (m,) int64, index into ``materials`` or -1
-    materials : list of :class:`Material`
-    uv : (m, 3, 2) float64 or None, per-corner texture coordinates
-    colors : (m, 3, 4) uint8 or None, per-corner RGBA vertex colours
-    path : str or None, the file the soup was read from (for messages)
-    origin : (m,) int64, index of each face in the soup as it was read (follows subsets and flips)
-    source : :class:`SourceRecord` or None, what the reader kept of the file so that a writer
-        of the same format can edit the file instead of rebuilding it
+    vertices : (n, 3) float64 array
+        Vertex coordinates.
+    faces : (m, 3) int64 array
+        Indices into ``vertices``, counter-clockwise seen from side 0.
+    part_id : (m,) int64 array, optional
+        Index into ``part_names`` of each face; all 0 by default.
+    part_names : list of str, optional
+        Name of each part; ``part0``, ``part1``, ... by default.
+    source_face : (m,) int64 array, optional
+        Index of the polygon of the source file each triangle came from; ``arange(m)`` by
+        default.
+    material_id : (m,) int64 array, optional
+        Index into ``materials`` of each face, or -1; all -1 by default.
+    materials : list of Material, optional
+        The materials the faces refer to.
+    uv : (m, 3, 2) float64 array or None
+        Per-corner texture coordinates.
+    colors : (m, 3, 4) uint8 array or None
+        Per-corner RGBA vertex colours.
+    path : str or None
+        The file the soup was read from (for messages).
+    origin : (m,) int64 array, optional
+        Index of each face in the soup as it was read (follows subsets and flips).
+    source : SourceRecord or None
+        What the reader kept of the file, so that a writer of the same format can edit the
+        file instead of rebuilding it.
 
     Examples
     --------
@@ -96,10 +109,11 @@ class Soup:
 
     vertices: np.ndarray
     faces: np.ndarray
-    part_id: np.ndarray | None = None
+    # None in the constructor means "the default"; __post_init__ always fills an array
+    part_id: np.ndarray = None  # type: ignore[assignment]
     part_names: list[str] = field(default_factory=list)
-    source_face: np.ndarray | None = None
-    material_id: np.ndarray | None = None
+    source_face: np.ndarray = None  # type: ignore[assignment]
+    material_id: np.ndarray = None  # type: ignore[assignment]
     materials: list[Material] = field(default_factory=list)
     uv: np.ndarray | None = None
     colors: np.ndarray | None = None
@@ -134,14 +148,17 @@ class Soup:
     # ------------------------------------------------------------------ basic sizes
     @property
     def n_faces(self) -> int:
+        """Number of faces ``m``."""
         return len(self.faces)
 
     @property
     def n_vertices(self) -> int:
+        """Number of stored vertices ``n`` (used or not)."""
         return len(self.vertices)
 
     @property
     def n_parts(self) -> int:
+        """Number of parts (``len(part_names)``)."""
         return len(self.part_names)
 
     # ------------------------------------------------------------------ geometry (cached)
@@ -185,13 +202,24 @@ class Soup:
 
     @property
     def total_area(self) -> float:
+        """Sum of the face areas."""
         return float(self.areas.sum())
 
     # ------------------------------------------------------------------ derived soups
     def subset(self, index: np.ndarray) -> Soup:
-        """The soup made of the faces ``index`` (boolean mask or integer array), attributes kept.
+        """The soup made of the faces ``index``, attributes kept.
 
         Vertices are not compacted: the new soup shares the vertex array.
+
+        Parameters
+        ----------
+        index : (m,) bool array or (k,) int array
+            A face mask or face indices.
+
+        Returns
+        -------
+        Soup
+            The selected faces, in the order of ``index``.
         """
         index = np.asarray(index)
         if index.dtype == bool:
@@ -208,7 +236,18 @@ class Soup:
         )
 
     def flipped(self, flip: np.ndarray) -> Soup:
-        """The soup with the faces where ``flip`` is True turned over (corners 1 and 2 swapped)."""
+        """The soup with the faces where ``flip`` is True turned over (corners 1 and 2 swapped).
+
+        Parameters
+        ----------
+        flip : (m,) bool array
+            Faces to turn over; per-corner UVs and colours follow their corners.
+
+        Returns
+        -------
+        Soup
+            The same faces in the same order.
+        """
         flip = np.asarray(flip, bool).reshape(self.n_faces)
         order = np.where(flip[:, None], [0, 2, 1], [0, 1, 2])
         rows = np.arange(self.n_faces)[:, None]
@@ -228,6 +267,16 @@ class Soup:
 
         A transform with negative determinant would turn every face over, so the faces are
         flipped back to keep each side's meaning.
+
+        Parameters
+        ----------
+        matrix : (4, 4) float array
+            Homogeneous transform applied to column vectors.
+
+        Returns
+        -------
+        Soup
+            The transformed copy.
         """
         matrix = np.asarray(matrix, np.float64)
         v = self.vertices @ matrix[:3, :3].T + matrix[:3, 3]
@@ -237,6 +286,7 @@ class Soup:
         return out
 
     def copy(self) -> Soup:
+        """A deep copy: every array and list is new."""
         return replace(
             self,
             vertices=self.vertices.copy(),
@@ -253,7 +303,24 @@ class Soup:
 
     @classmethod
     def concatenate(cls, soups: Sequence[Soup]) -> Soup:
-        """One soup from several; part and material indices are shifted, names kept."""
+        """One soup from several; part and material indices are shifted, names kept.
+
+        Parameters
+        ----------
+        soups : sequence of Soup
+            At least one soup.
+
+        Returns
+        -------
+        Soup
+            The faces of every soup in order; UVs or colours missing in some of them are
+            filled with zeros or opaque white.
+
+        Raises
+        ------
+        ModelError
+            ``soups`` is empty.
+        """
         soups = list(soups)
         if not soups:
             raise ModelError("nothing to concatenate")
@@ -321,8 +388,21 @@ class Soup:
 def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -> None:
     """Raise :class:`ModelError` unless (vertices, faces) is a usable triangle soup.
 
-    Checks shape, emptiness, finite coordinates and index range.  ``path`` names the file
-    in the message.
+    Checks shape, emptiness, finite coordinates and index range.
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+        Vertex coordinates.
+    faces : (m, 3) int array
+        Vertex indices of each triangle.
+    path : str or None
+        The file the arrays came from; it leads the error message.
+
+    Raises
+    ------
+    ModelError
+        The first problem found, in one line.
     """
     vertices = np.asarray(vertices)
     faces = np.asarray(faces)

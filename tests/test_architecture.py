@@ -15,6 +15,7 @@ FOLDERS = {"meshvis": "meshvis", "labeling": "meshvis.labeling", "cli": "meshvis
 LAYERS = {
     "meshvis._version": 0,
     "meshvis.errors": 0,
+    "meshvis._extras": 0,
     "meshvis.soup": 0,
     "meshvis.io": 1,
     "meshvis.rays": 2,

@@ -27,10 +27,10 @@ def _run_dask(
     on_done: Callable,
 ) -> bool:
     """Submit the tasks to the Dask scheduler at ``address``; return True if interrupted."""
-    try:
-        from distributed import Client, as_completed
-    except ImportError:
-        raise ParameterError("--dask-scheduler needs dask.distributed: pip install 'meshvis[dask]'") from None
+    from meshvis._extras import import_extra
+
+    distributed = import_extra("distributed", "meshvis batch --dask-scheduler")
+    Client, as_completed = distributed.Client, distributed.as_completed
     try:
         client = Client(address, timeout=DASK_CONNECT_TIMEOUT, set_as_default=False)
     except (OSError, TimeoutError, ValueError) as exc:

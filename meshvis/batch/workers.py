@@ -265,7 +265,10 @@ def run_file_isolated(task: FileTask, time_limit: float, threads: int | None = N
     )
     if threads:
         env.setdefault("MESHVIS_THREADS", str(threads))
-    cmd = [sys.executable, "-c", "from meshvis.batch.workers import _task_main; _task_main()"]
+    # the child drops the working folder ('') from sys.path first: a meshvis/ folder there
+    # (a source checkout) must not shadow the installed package
+    code = "import sys; sys.path[:] = [p for p in sys.path if p]; from meshvis.batch.workers import _task_main; _task_main()"
+    cmd = [sys.executable, "-c", code]
     proc = subprocess.Popen(
         cmd, stdin=subprocess.PIPE, stdout=subprocess.PIPE, stderr=subprocess.DEVNULL, env=env, bufsize=0
     )

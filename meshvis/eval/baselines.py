@@ -39,6 +39,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis._extras import import_extra
 from meshvis.geometry.adjacency import weld
 from meshvis.io import as_soup
 
@@ -177,9 +178,19 @@ def trimesh_fix_normals(model: Any, *, multibody: bool = True) -> BaselineResult
     return BaselineResult("trimesh_fix_normals", "orient", values, time.perf_counter() - t0, params=params)
 
 
-def _meshlab(V: np.ndarray, F: np.ndarray):
-    import pymeshlab
+def require_baselines() -> None:
+    """Raise MissingExtraError unless every baseline's library is installed.
 
+    Raises
+    ------
+    MissingExtraError
+        pymeshlab (the ``bench`` extra) is missing.
+    """
+    import_extra("pymeshlab", "the MeshLab baseline")
+
+
+def _meshlab(V: np.ndarray, F: np.ndarray):
+    pymeshlab = import_extra("pymeshlab", "the MeshLab baseline")
     ms = pymeshlab.MeshSet()
     ms.add_mesh(pymeshlab.Mesh(vertex_matrix=V, face_matrix=F))
     return ms
@@ -194,6 +205,7 @@ def pymeshlab_reorient(model: Any, *, rays: int = 64, parity_sampling: bool = Fa
     BaselineResult with ``values`` = flipped (m,) bool
     """
     params = {"rays": rays, "parity_sampling": parity_sampling}
+    require_baselines()  # a missing library is the user's to fix, not a failed run
     t0 = time.perf_counter()
     try:
         V, F = welded(model)
@@ -225,6 +237,7 @@ def pymeshlab_ao(model: Any, *, rays: int = 64, both_sides: bool = False) -> Bas
     """
     params = {"rays": rays, "both_sides": both_sides}
     method = "pymeshlab_ao_2sided" if both_sides else "pymeshlab_ao"
+    require_baselines()
     t0 = time.perf_counter()
     try:
         V, F = welded(model)

@@ -38,7 +38,9 @@ def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tupl
     Parameters
     ----------
     vertices : (n, 3) float array
+        Vertex coordinates.
     faces : (m, 3) int array
+        Vertex indices of each triangle.
     tol : float
         Weld distance as a fraction of the diagonal of the used vertices' bounding box
         (default :data:`WELD_TOL` = 1e-7).  ``0`` merges exact duplicates only.
@@ -99,12 +101,18 @@ class EdgeTable:
 
     Attributes
     ----------
-    vertices : (k, 2) int64, welded end points of each edge, smaller id first
-    count : (k,) int64, number of face sides on the edge (1 boundary, 2 manifold, >2 non-manifold)
-    face_edge : (m, 3) int64, edge of each face side; -1 for collapsed faces
-    half_face : (h,) int64, face of each half-edge (face side), sorted by edge
-    half_edge : (h,) int64, edge of each half-edge, non-decreasing
-    half_forward : (h,) bool, the face traverses its edge from the smaller to the larger id
+    vertices : (k, 2) int64 array
+        Welded end points of each edge, smaller id first.
+    count : (k,) int64 array
+        Number of face sides on the edge (1 boundary, 2 manifold, >2 non-manifold).
+    face_edge : (m, 3) int64 array
+        Edge of each face side; -1 for collapsed faces.
+    half_face : (h,) int64 array
+        Face of each half-edge (face side), sorted by edge.
+    half_edge : (h,) int64 array
+        Edge of each half-edge, non-decreasing.
+    half_forward : (h,) bool array
+        The face traverses its edge from the smaller to the larger id.
     """
 
     vertices: np.ndarray
@@ -150,11 +158,13 @@ def edges(faces_welded: np.ndarray) -> EdgeTable:
 
     Parameters
     ----------
-    faces_welded : (m, 3) int array, the ``faces_welded`` output of :func:`weld`
+    faces_welded : (m, 3) int array
+        The ``faces_welded`` output of :func:`weld`.
 
     Returns
     -------
     EdgeTable
+        The edges, the face side of every half-edge and their directions.
     """
     f = np.asarray(faces_welded, np.int64).reshape(-1, 3)
     m = len(f)
@@ -188,14 +198,16 @@ def face_adjacency(table: EdgeTable, manifold_only: bool = True) -> np.ndarray:
 
     Parameters
     ----------
-    table : EdgeTable, from :func:`edges`
+    table : EdgeTable
+        From :func:`edges`.
     manifold_only : bool
         ``True``: one pair per manifold edge.  ``False``: also link the faces around every
         non-manifold edge (as a chain, enough for connectivity).
 
     Returns
     -------
-    (p, 2) int64, face pairs with the smaller index first
+    (p, 2) int64 array
+        Face pairs, the smaller index first.
     """
     he, hf = table.half_edge, table.half_face
     same = he[1:] == he[:-1]  # consecutive half-edges on one edge
@@ -210,10 +222,19 @@ def face_adjacency(table: EdgeTable, manifold_only: bool = True) -> np.ndarray:
 def components(n_faces: int, pairs: np.ndarray) -> tuple[int, np.ndarray]:
     """Connected components of faces linked by ``pairs``.
 
+    Parameters
+    ----------
+    n_faces : int
+        Number of faces.
+    pairs : (p, 2) int array
+        Linked faces, e.g. from :func:`face_adjacency`.
+
     Returns
     -------
     n_components : int
-    label : (n_faces,) int64, component of each face (numbered by smallest face index)
+        Number of components.
+    label : (n_faces,) int64 array
+        Component of each face (numbered by smallest face index).
     """
     pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
     g = sp.coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n_faces, n_faces))
@@ -234,9 +255,19 @@ def degenerate_faces(
 
     Parameters
     ----------
-    vertices, faces : the soup
-    tol : float, fraction of the bounding-box diagonal (default :data:`WELD_TOL`)
-    faces_welded : optional output of :func:`weld`, to also flag collapsed faces
+    vertices : (n, 3) float array
+        Vertex coordinates.
+    faces : (m, 3) int array
+        Vertex indices of each triangle.
+    tol : float
+        Fraction of the bounding-box diagonal (default :data:`WELD_TOL`).
+    faces_welded : (m, 3) int array, optional
+        The ``faces_welded`` output of :func:`weld`, to also flag collapsed faces.
+
+    Returns
+    -------
+    (m,) bool array
+        True for the degenerate faces.
     """
     v = np.asarray(vertices, np.float64)
     f = np.asarray(faces, np.int64).reshape(-1, 3)
@@ -256,6 +287,11 @@ def degenerate_faces(
 
 def duplicate_faces(faces_welded: np.ndarray) -> np.ndarray:
     """Index of the first face with the same welded vertex set, whatever the winding.
+
+    Parameters
+    ----------
+    faces_welded : (m, 3) int array
+        The ``faces_welded`` output of :func:`weld`.
 
     Returns
     -------

@@ -95,12 +95,12 @@ class Classification:
     @property
     def hidden(self) -> np.ndarray:
         """(m,) bool: no side outside."""
-        return ~self.side_outside.any(axis=1)
+        return ~np.any(self.side_outside, axis=1)
 
     @property
     def two_sided(self) -> np.ndarray:
         """(m,) bool: both sides outside."""
-        return self.side_outside.all(axis=1)
+        return np.all(self.side_outside, axis=1)
 
     def face_labels_from(self, node_outside: np.ndarray) -> np.ndarray:
         """(m, 2) outside fractions for a node labelling (e.g. from a later cut)."""
@@ -349,7 +349,7 @@ def classify(
         labels = face_labels(nodes, cut.outside, soup.n_faces, pre.degenerate)
         t_cut += time.perf_counter() - t
 
-        changed = (
+        changed: float | None = (
             None
             if prev is None
             else float(

@@ -32,13 +32,19 @@ class Clustering:
 
     Attributes
     ----------
-    side_node : (m, 2) int64, half-space node of (face, side); -1 for faces not clustered
-        (flagged faces, which get point nodes instead)
-    n_nodes : int, number of cluster half-space nodes (ids 0 .. n_nodes-1)
-    opposite : (n_nodes,) int64, the node on the other side of the same cluster
-    cluster : (m,) int64, cluster id per face (-1 for faces not clustered)
+    side_node : (m, 2) int64 array
+        Half-space node of (face, side); -1 for faces not clustered (flagged faces, which get point
+        nodes instead).
+    n_nodes : int
+        Number of cluster half-space nodes (ids 0 .. n_nodes-1).
+    opposite : (n_nodes,) int64 array
+        The node on the other side of the same cluster.
+    cluster : (m,) int64 array
+        Cluster id per face (-1 for faces not clustered).
     n_clusters : int
-    n_split_nonorientable : int, faces split out of non-orientable clusters
+        Number of clusters.
+    n_split_nonorientable : int
+        Faces split out of non-orientable clusters.
     """
 
     side_node: np.ndarray
@@ -54,12 +60,17 @@ def manifold_face_pairs(table: EdgeTable) -> tuple[np.ndarray, np.ndarray, np.nd
 
     Parameters
     ----------
-    table : EdgeTable of the welded faces (:func:`meshvis.geometry.adjacency.edges`)
+    table : EdgeTable
+        Edges of the welded faces (:func:`meshvis.geometry.adjacency.edges`).
 
     Returns
     -------
-    f, g : (k,) int64 face indices
-    consistent : (k,) bool, True when the two faces traverse the edge in opposite directions
+    f : (k,) int64 array
+        First face of each pair.
+    g : (k,) int64 array
+        Second face.
+    consistent : (k,) bool array
+        True when the two faces traverse the edge in opposite directions.
     """
     start = np.searchsorted(table.half_edge, np.flatnonzero(table.manifold))
     f, g = table.half_face[start], table.half_face[start + 1]
@@ -75,14 +86,18 @@ def cluster_sides(
 
     Parameters
     ----------
-    table : EdgeTable of the welded faces (adjacency only; the model is not changed)
-    clusterable : (m,) bool, faces that get cluster nodes (not flagged, not degenerate)
-    joinable : (m,) bool, faces that may be joined to others across an edge (default: all
-        clusterable ones); a clusterable face that is not joinable is a single-face cluster
+    table : EdgeTable
+        Edges of the welded faces (adjacency only; the model is not changed).
+    clusterable : (m,) bool array
+        Faces that get cluster nodes (not flagged, not degenerate).
+    joinable : (m,) bool array
+        Faces that may be joined to others across an edge (default: all clusterable ones); a
+        clusterable face that is not joinable is a single-face cluster.
 
     Returns
     -------
     Clustering
+        The half-space nodes of the clusters.
     """
     m = len(clusterable)
     f, g, consistent = manifold_face_pairs(table)

@@ -25,11 +25,19 @@ class Hints:
 
     Parameters
     ----------
-    inside_points, outside_points : (k, 3) arrays
-    inside_boxes, outside_boxes : (k, 2, 3) arrays of (min corner, max corner)
-    rays : rays cast per hint point (boxes: in total, from random points in the box)
-    strength : multiplier of the hint links (default 10: a hint should win over the
-        ray evidence of a side that escapes freely, whose outside link is at most its area)
+    inside_points : (k, 3) float array
+        Points known to be inside.
+    outside_points : (k, 3) float array
+        Points known to be outside.
+    inside_boxes : (k, 2, 3) float array
+        Boxes known to be inside, as (min corner, max corner).
+    outside_boxes : (k, 2, 3) float array
+        Boxes known to be outside.
+    rays : int
+        Rays cast per hint point (boxes: in total, from random points in the box).
+    strength : float
+        Multiplier of the hint links (default 10: a hint should win over the ray evidence
+        of a side that escapes freely, whose outside link is at most its area).
     """
 
     inside_points: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
@@ -46,10 +54,10 @@ class Hints:
                 raise ParameterError(f"{name.replace('_', ' ')} must be finite")
             setattr(self, name, a)
         for name in ("inside_boxes", "outside_boxes"):
-            a = np.asarray(getattr(self, name), np.float64).reshape(-1, 2, 3)
-            if not np.isfinite(a).all() or np.any(a[:, 1] < a[:, 0]):
+            boxes = np.asarray(getattr(self, name), np.float64).reshape(-1, 2, 3)
+            if not np.isfinite(boxes).all() or np.any(boxes[:, 1] < boxes[:, 0]):
                 raise ParameterError(f"{name.replace('_', ' ')} must be finite (min, max) corner pairs")
-            setattr(self, name, a)
+            setattr(self, name, boxes)
         if self.rays < 1:
             raise ParameterError("hint rays must be at least 1")
 
@@ -64,6 +72,7 @@ class Hints:
 
     @property
     def empty(self) -> bool:
+        """True when no point or box is given."""
         return not (
             len(self.inside_points)
             or len(self.outside_points)
@@ -93,7 +102,7 @@ def hint_weights(
         (hints.inside_points, hints.inside_boxes),
     ):
         origins = _hint_origins(points, boxes, hints.rays, rng)
-        w = np.zeros(nodes.n)
+        w: np.ndarray = np.zeros(nodes.n)
         if len(origins):
             dirs = uniform_sphere(len(origins), rng)
             h = caster.intersect(origins, dirs)
@@ -103,6 +112,7 @@ def hint_weights(
             dst = nodes.side_node[f, s]
             flag = dst < 0
             if flag.any():
+                assert h.bary is not None  # intersect always fills it
                 dst[flag] = nodes.point_node(snap_to_points(nodes, f[flag], h.bary[hit][flag]), s[flag])
             w = np.bincount(dst, minlength=nodes.n) * (hints.strength * total_area / max(len(dst), 1))
         out.append(w)

@@ -171,8 +171,9 @@ class VisibilityGraph:
 
         Edges carry ``weight`` (unfiltered w) and ``capacity`` (filtered, directed).
         """
-        import networkx as nx
+        from meshvis._extras import import_extra
 
+        nx = import_extra("networkx", "GraphML export (--graphml)")
         w = self.weights
         g = nx.DiGraph()
         attrs = node_attributes or {}
@@ -188,10 +189,10 @@ class VisibilityGraph:
             (int(b), int(a), {"weight": float(x), "capacity": float(c)})
             for a, b, x, c in zip(w.edges_i, w.edges_j, w.w, w.cap_ji)
         )
-        for v in np.flatnonzero(w.w_out > 0):
-            g.add_edge("OUTSIDE", int(v), weight=float(w.w_out[v]), capacity=float(w.cap_out[v]))
-        for v in np.flatnonzero(w.w_in > 0):
-            g.add_edge(int(v), "INSIDE", weight=float(w.w_in[v]), capacity=float(w.cap_in[v]))
+        for u in np.flatnonzero(w.w_out > 0):
+            g.add_edge("OUTSIDE", int(u), weight=float(w.w_out[u]), capacity=float(w.cap_out[u]))
+        for u in np.flatnonzero(w.w_in > 0):
+            g.add_edge(int(u), "INSIDE", weight=float(w.w_in[u]), capacity=float(w.cap_in[u]))
         return g
 
 

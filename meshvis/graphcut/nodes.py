@@ -30,26 +30,48 @@ class NodeSet:
 
     Attributes
     ----------
-    n : int, number of nodes
-    n_cluster : int, number of cluster nodes (they come first)
-    area : (n,) float64, A_i: sum of the node's triangle areas, or triangle area / samples
-    opposite : (n,) int64, the node on the other side of the same geometry
-    n_faces : (n,) int64, triangles in a cluster node (1 for point nodes)
-    side_node : (m, 2) int64, cluster node of each (face, side), -1 for flagged faces
-    entry_node, entry_face, entry_side, entry_cumarea : the (node, face, side) entries of
-        the cluster nodes sorted by node, with cumulative area for area-weighted picking
-    node_start : (n_cluster+1,) offsets of each cluster node's entries
-    flagged : (k,) int64, the flagged faces; sample points of flagged face q are
-        ``q*samples .. q*samples+samples-1``
-    samples : int, sample points per flagged face
-    point_face : (P,) int64, face of each sample point
-    point_pos : (P, 3) float64, sample point on its face
-    point_origin : (P, 2, 3) float64, ray origin of each side, pushed off the surface
-    flagged_index : (m,) int64, position of a face in ``flagged`` or -1
-    sample_bary : (samples, 3) barycentric pattern of the sample points (same on every face)
-    flagged_metric : (k, 3) float64, per flagged face ``(e1·e1, e1·e2, e2·e2)`` with
-        ``e1 = b - a``, ``e2 = c - a``: the metric of its barycentric coordinates
-    tangents : two (m, 3) arrays, a tangent frame of every face normal (for ray directions)
+    n : int
+        Number of nodes.
+    n_cluster : int
+        Number of cluster nodes (they come first).
+    area : (n,) float64 array
+        A_i: sum of the node's triangle areas, or triangle area / samples.
+    opposite : (n,) int64 array
+        The node on the other side of the same geometry.
+    n_faces : (n,) int64 array
+        Triangles in a cluster node (1 for point nodes).
+    side_node : (m, 2) int64 array
+        Cluster node of each (face, side), -1 for flagged faces.
+    entry_node : (e,) int64 array
+        Node of each (node, face, side) entry of the cluster nodes, sorted by node.
+    entry_face : (e,) int64 array
+        Face of each entry.
+    entry_side : (e,) int8 array
+        Side of each entry.
+    entry_cumarea : (e,) float64 array
+        Cumulative area of the entries within their node, for area-weighted picking.
+    node_start : (n_cluster + 1,) int64 array
+        Offsets of each cluster node's entries.
+    flagged : (k,) int64 array
+        The flagged faces; sample points of flagged face q are ``q*samples ..
+        q*samples+samples-1``.
+    samples : int
+        Sample points per flagged face.
+    point_face : (P,) int64 array
+        Face of each sample point.
+    point_pos : (P, 3) float64 array
+        Sample point on its face.
+    point_origin : (P, 2, 3) float64 array
+        Ray origin of each side, pushed off the surface.
+    flagged_index : (m,) int64 array
+        Position of a face in ``flagged`` or -1.
+    sample_bary : (samples, 3) float64 array
+        Barycentric pattern of the sample points (the same on every face).
+    flagged_metric : (k, 3) float64 array
+        Per flagged face ``(e1·e1, e1·e2, e2·e2)`` with ``e1 = b - a``, ``e2 = c - a``: the metric
+        of its barycentric coordinates.
+    tangents : tuple of two (m, 3) float64 arrays
+        A tangent frame of every face normal (for ray directions).
     """
 
     n: int
@@ -75,15 +97,18 @@ class NodeSet:
 
     @property
     def n_points(self) -> int:
+        """Number of sample points ``P``."""
         return len(self.point_face)
 
     @property
     def is_point(self) -> np.ndarray:
+        """(n,) bool: the node is a sample-point node."""
         out = np.zeros(self.n, bool)
         out[self.n_cluster :] = True
         return out
 
     def point_node(self, p: np.ndarray, side: np.ndarray) -> np.ndarray:
+        """Node id of side ``side`` of sample point ``p`` (both int arrays of one shape)."""
         return self.n_cluster + 2 * np.asarray(p, np.int64) + np.asarray(side, np.int64)
 
 
@@ -109,15 +134,34 @@ def build_nodes(
 
     Parameters
     ----------
-    triangles, normals, areas : per-face geometry (float64)
-    clustering : from :func:`meshvis.graphcut.clusters.cluster_sides`
-    flagged : (m,) bool, faces that get sample-point nodes
-    partner_pairs : (k, 2) int64, pairs of faces flagged together (intersecting, coplanar,
-        too close); used by the proximity adjustment of the sample points
-    samples : sample points per flagged face; scheme : 1 or 2 (appendix H §3.1)
-    offset : push of ray origins off their surface (absolute, model units)
-    proximity : a sample point closer than this to a partner's plane, and inside it,
-        is moved past that partner (appendix H Fig. 6)
+    triangles : (m, 3, 3) float64 array
+        Corner coordinates.
+    normals : (m, 3) float64 array
+        Unit normals of side 0.
+    areas : (m,) float64 array
+        Face areas.
+    clustering : Clustering
+        From :func:`meshvis.graphcut.clusters.cluster_sides`.
+    flagged : (m,) bool array
+        Faces that get sample-point nodes.
+    partner_pairs : (k, 2) int64 array
+        Pairs of faces flagged together (intersecting, coplanar, too close); used by the proximity
+        adjustment of the sample points.
+    samples : int
+        Sample points per flagged face.
+    scheme : {1, 2}
+        Sample placement scheme (appendix H §3.1, see
+        :func:`meshvis.rays.samples.sample_scheme_barycentric`).
+    offset : float
+        Push of ray origins off their surface (absolute, model units).
+    proximity : float
+        A sample point closer than this to a partner's plane, and inside it, is moved past
+        that partner (appendix H Fig. 6).
+
+    Returns
+    -------
+    NodeSet
+        Cluster nodes first, then two nodes per sample point.
     """
     m = len(triangles)
     side_node = clustering.side_node
@@ -272,9 +316,29 @@ def node_rays(
     along the side normal (appendix H §3.2.2).  Point nodes: rays start at the (pushed)
     sample point.
 
+    Parameters
+    ----------
+    nodes : NodeSet
+        The nodes.
+    normals : (m, 3) float64 array
+        Unit normals of side 0.
+    triangles : (m, 3, 3) float64 array
+        Corner coordinates.
+    counts : (nodes.n,) int array
+        Rays to cast from each node.
+    rng : numpy.random.Generator
+        The random generator.
+    offset : float
+        Push of ray origins off their surface (absolute, model units).
+
     Returns
     -------
-    source : (n,) node id of each ray; origins, directions : (n, 3)
+    source : (r,) int64 array
+        Node id of each ray.
+    origins : (r, 3) float64 array
+        Ray origins.
+    directions : (r, 3) float64 array
+        Unit ray directions.
     """
     counts = np.asarray(counts, np.int64)
     source = np.repeat(np.arange(nodes.n, dtype=np.int64), counts)

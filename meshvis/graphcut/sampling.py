@@ -25,10 +25,11 @@ class VisibilityCounts:
     """Accumulated ray statistics of all rounds so far."""
 
     n: int
+    # filled by the first round
     hits: sp.csr_matrix = None
-    cast: np.ndarray = None
-    escaped: np.ndarray = None
-    discarded: np.ndarray = None
+    cast: np.ndarray = None  # type: ignore[assignment]
+    escaped: np.ndarray = None  # type: ignore[assignment]
+    discarded: np.ndarray = None  # type: ignore[assignment]
     rays: int = 0
     reverse_rays: int = 0
     time_embree: float = 0.0
@@ -113,6 +114,7 @@ def sample_round(
         idx = np.flatnonzero(dst < 0)  # hits on flagged faces: snap, then check the way back
         if len(idx):
             hit_idx = np.flatnonzero(hit)[idx]
+            assert h.bary is not None  # intersect always fills it
             p = snap_to_points(nodes, f[idx], h.bary[hit_idx])
             t0 = time.perf_counter()
             blocked = caster.occluded(nodes.point_origin[p, s[idx]], origins[hit_idx])

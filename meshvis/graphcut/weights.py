@@ -24,12 +24,24 @@ class Weights:
 
     Attributes
     ----------
-    edges_i, edges_j : (k,) int64, each undirected edge once (i < j)
-    w : (k,) float64, edge weight w(i, j) (Eq. 5)
-    w_out : (n,) float64, link to OUTSIDE (Eq. 7)
-    w_in : (n,) float64, link to INSIDE (``w_in(opp(i)) = w_o(i)`` plus hints)
-    cap_ij, cap_ji : (k,) float64, directed capacities after the cosine filter (Eq. 8–9)
-    cap_out, cap_in : (n,) float64, filtered terminal capacities
+    edges_i : (k,) int64 array
+        First end of each undirected edge.
+    edges_j : (k,) int64 array
+        Second end (``edges_i < edges_j``; each edge once).
+    w : (k,) float64 array
+        Edge weight w(i, j) (Eq. 5).
+    w_out : (n,) float64 array
+        Link to OUTSIDE (Eq. 7).
+    w_in : (n,) float64 array
+        Link to INSIDE (``w_in(opp(i)) = w_o(i)`` plus hints).
+    cap_ij : (k,) float64 array
+        Capacity ``i → j`` after the cosine filter (Eq. 8–9).
+    cap_ji : (k,) float64 array
+        Capacity ``j → i`` after the cosine filter.
+    cap_out : (n,) float64 array
+        Filtered OUTSIDE link.
+    cap_in : (n,) float64 array
+        Filtered INSIDE link.
     """
 
     edges_i: np.ndarray
@@ -53,9 +65,25 @@ def edge_weights(
     used: those rays start uniformly over their node, whereas a point node's rays all
     start at one point (appendix H §3.2.2).  Self-links are dropped.
 
+    Parameters
+    ----------
+    hits : (n, n) scipy.sparse matrix
+        ``n_ij``: rays from node i that hit node j.
+    counted : (n,) float array
+        ``n_i``: rays counted for node i.
+    area : (n,) float array
+        ``A_i``: node area.
+    is_point : (n,) bool array
+        Sample-point nodes.
+
     Returns
     -------
-    i, j, w : each undirected edge once, with i < j
+    i : (k,) int64 array
+        First end of each undirected edge.
+    j : (k,) int64 array
+        Second end, ``i < j``; each edge once.
+    w : (k,) float64 array
+        Edge weight.
     """
     coo = sp.coo_matrix(hits)
     r, c, n_ij = coo.row.astype(np.int64), coo.col.astype(np.int64), coo.data
@@ -85,8 +113,9 @@ def inside_prior(
     opposite: np.ndarray,
     opening: float | None = DEFAULT_OPENING,
 ) -> np.ndarray:
-    """Inside links without hints: ``w_in(opp(i)) = w_o(i)`` (appendix H §3.2.1), faded by
-    the node's own escape share.
+    """Inside links without hints: ``w_in(opp(i)) = w_o(i)``, faded by the own escape share.
+
+    The prior is appendix H §3.2.1.
 
     The paper's prior says "if the other side of this geometry escapes, this side is the
     inside of a thin object".  That is right for closed shells and for shells with small
@@ -136,18 +165,38 @@ def graph_weights(
 ) -> Weights:
     """All weights of the graph: Eq. 5, Eq. 7, ``w_in(opp(i)) = w_o(i)``, and the filter.
 
-    Parameters
-    ----------
-    hits : (n, n) sparse n_ij; counted : (n,) n_i; escaped : (n,) misses per node
-    area : (n,) A_i; opposite : (n,) opp(i); is_point : (n,) bool
-    hint_out, hint_in : (n,) extra terminal weights from user hints (appendix H §3.2.1)
-    use_filter : apply the directed cosine filter of Eq. 8–9
-    opening : escape share above which a side counts as open (see :func:`inside_prior`);
-        None applies the paper's ``w_in(opp(i)) = w_o(i)`` unchanged
-
     The filter is directed: node *i* scales every link it has by its own
     ``w_max(i) = max(max_j w(i,j), w_o(i), w_in(i))`` (Eq. 8), so ``cap(i→j)`` and
     ``cap(j→i)`` may differ.  Terminal links are filtered with the same ``w_max(i)``.
+
+    Parameters
+    ----------
+    hits : (n, n) scipy.sparse matrix
+        ``n_ij``: rays from node i that hit node j.
+    counted : (n,) float array
+        ``n_i``: rays counted for node i.
+    escaped : (n,) float array
+        Rays from node i that hit nothing.
+    area : (n,) float array
+        ``A_i``: node area.
+    opposite : (n,) int array
+        ``opp(i)``: the node on the other side of the same geometry.
+    is_point : (n,) bool array
+        Sample-point nodes.
+    hint_out : (n,) float array, optional
+        Extra OUTSIDE weights from user hints (appendix H §3.2.1).
+    hint_in : (n,) float array, optional
+        Extra INSIDE weights from user hints.
+    use_filter : bool
+        Apply the directed cosine filter of Eq. 8–9.
+    opening : float or None
+        Escape share above which a side counts as open (see :func:`inside_prior`); None
+        applies the paper's ``w_in(opp(i)) = w_o(i)`` unchanged.
+
+    Returns
+    -------
+    Weights
+        The weights before and after the filter.
     """
     i, j, w = edge_weights(hits, counted, area, is_point)
     w_out = outside_weights(escaped, counted, area)

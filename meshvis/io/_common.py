@@ -1,5 +1,7 @@
-"""Helpers every format shares: one-line messages, atomic writes, output checks, welding
-corners into output vertices, unique names, float text.
+"""Helpers every format shares.
+
+One-line messages, atomic writes, output checks, welding corners into output vertices,
+unique names, float text.
 
 Format modules import from here and never from :mod:`meshvis.io.reading` or
 :mod:`meshvis.io.writing`, which import them: the dependency runs one way.
@@ -13,7 +15,7 @@ import stat
 import struct
 import tempfile
 from collections.abc import Iterator
-from typing import IO
+from typing import IO, Any
 
 import numpy as np
 
@@ -51,9 +53,17 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
 
     Parameters
     ----------
-    path : str or path-like
-    mode : ``"w"`` (text) or ``"wb"`` (binary)
-    encoding : text encoding for ``"w"``
+    path : str or os.PathLike
+        The file to write.
+    mode : {"w", "wb"}
+        Text or binary.
+    encoding : str
+        Text encoding for ``"w"``.
+
+    Yields
+    ------
+    file object
+        The open temporary file.
 
     Raises
     ------
@@ -75,7 +85,8 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
     except OSError as exc:
         raise OutputError(f"cannot write: {one_line(exc.strerror or exc)}", path) from None
     try:
-        with os.fdopen(fd, mode, **({"encoding": encoding, "newline": "\n"} if mode == "w" else {})) as fh:
+        text: dict[str, Any] = {"encoding": encoding, "newline": "\n"} if mode == "w" else {}
+        with os.fdopen(fd, mode, **text) as fh:
             yield fh
             fh.flush()
             os.fsync(fh.fileno())
@@ -101,15 +112,18 @@ def weld_corners(soup: Soup, use_uv: bool = True, use_colors: bool = True) -> tu
     Parameters
     ----------
     soup : Soup
-    use_uv, use_colors : bool
-        Whether UVs / colours (when the soup has them) take part in the key.
+        The model to write.
+    use_uv : bool
+        Whether UVs (when the soup has them) take part in the key.
+    use_colors : bool
+        Whether colours (when the soup has them) take part in the key.
 
     Returns
     -------
-    corner_vertex : (k,) int64
+    corner_vertex : (k,) int64 array
         For each output vertex, the flat corner index (into ``faces.ravel()``) it is
         taken from: gather positions, UVs and colours with it.
-    faces : (m, 3) int64
+    faces : (m, 3) int64 array
         Faces indexing the output vertices.
 
     Notes
@@ -150,8 +164,23 @@ def unique_names(names: list[str], fallback: str) -> list[str]:
 
 
 def check_output(path: str, inputs: list[str], force: bool) -> None:
-    """Refuse an output path that is an input, a folder, in a missing or unwritable folder,
-    or that exists while ``force`` is False (raises :class:`OutputError`)."""
+    """Refuse an output path that cannot or must not be written.
+
+    Parameters
+    ----------
+    path : str
+        The output path.
+    inputs : list of str
+        The input files, which are never overwritten.
+    force : bool
+        Allow replacing an existing file.
+
+    Raises
+    ------
+    OutputError
+        ``path`` is an input or a folder, its folder is missing or unwritable, or it exists
+        while ``force`` is False.
+    """
     for inp in inputs:
         if os.path.exists(path) and os.path.exists(inp) and os.path.samefile(path, inp):
             raise OutputError("output path is the input file; choose another path", path)

@@ -1,5 +1,7 @@
-"""What users have, as a :class:`~meshvis.soup.Soup`: the one coercion every entry point of
-the library goes through."""
+"""What users have, as a :class:`~meshvis.soup.Soup`.
+
+The one coercion every entry point of the library goes through.
+"""
 
 from __future__ import annotations
 
@@ -25,11 +27,9 @@ def as_soup(model: Any, *, name: str | None = None) -> Soup:
         return model
     if isinstance(model, (str, os.PathLike)):
         return load(model)
-    try:
-        import trimesh
-    except ImportError:  # pragma: no cover - trimesh is a dependency
-        trimesh = None
-    if trimesh is not None and isinstance(model, trimesh.Scene):
+    import trimesh  # a dependency
+
+    if isinstance(model, trimesh.Scene):
         return soup_from_scene(model, path=name)
     if trimesh is not None and isinstance(model, trimesh.Trimesh):
         return soup_from_mesh(model, path=name)

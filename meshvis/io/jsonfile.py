@@ -1,5 +1,7 @@
-"""Reports as standard JSON: numpy values converted, non-finite floats written as null,
-files written atomically."""
+"""Reports as standard JSON.
+
+Numpy values are converted, non-finite floats written as null, files written atomically.
+"""
 
 from __future__ import annotations
 
@@ -35,7 +37,6 @@ def to_builtin(obj: Any) -> Any:
 
 def write_json(path: str | os.PathLike, data: Any) -> None:
     """Write ``data`` as indented standard JSON, atomically (temp file, then rename)."""
-
     text = json.dumps(to_builtin(data), indent=1, allow_nan=False, default=str)
     with atomic_write(path, "w") as fh:
         fh.write(text + "\n")

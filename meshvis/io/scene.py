@@ -1,6 +1,7 @@
-"""trimesh objects as soups: a ``trimesh.Scene`` (instancing applied) or one mesh with its
-visual (UVs, colours, material).  Used by the glTF and 3MF readers and by
-:func:`meshvis.io.as_soup`.
+"""trimesh objects as soups.
+
+A ``trimesh.Scene`` (instancing applied) or one mesh with its visual (UVs, colours,
+material).  Used by the glTF and 3MF readers and by :func:`meshvis.io.as_soup`.
 """
 
 from __future__ import annotations
@@ -28,12 +29,14 @@ def soup_from_scene(scene, path: str | None = None) -> Soup:
     Parameters
     ----------
     scene : trimesh.Scene
+        The scene to flatten.
     path : str, optional
         Name for messages.
 
     Returns
     -------
     Soup
+        One part per geometry node.
     """
     parts: list[Soup] = []
     materials: dict[int, int] = {}
@@ -165,10 +168,10 @@ def _edited(mesh, faces: np.ndarray, origin: np.ndarray):
     return out
 
 
-def mesh_soup(geom, name: str, material_index: int) -> Soup:
+def mesh_soup(geom: Any, name: str, material_index: int) -> Soup:
     """One trimesh mesh as a single-part soup with per-corner UVs / colours."""
     faces = np.asarray(geom.faces, np.int64)
-    vis = getattr(geom, "visual", None)
+    vis: Any = getattr(geom, "visual", None)
     uv = colors = None
     kind = getattr(vis, "kind", None)
     if kind == "texture" and getattr(vis, "uv", None) is not None and len(vis.uv) == len(geom.vertices):

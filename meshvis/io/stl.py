@@ -83,7 +83,9 @@ def _read_ascii(text: str, label: str, stem: str) -> Soup:
     if not starts:
         starts = [(0, stem)]
     bounds = [s for s, _ in starts[1:]] + [len(text)]
-    chunks, part_ids, names = [], [], []
+    chunks: list[np.ndarray] = []
+    part_ids: list[np.ndarray] = []
+    names: list[str] = []
     for k, ((a, name), b) in enumerate(zip(starts, bounds)):
         found = _VERTEX.findall(text, a, b)
         if not found:

@@ -132,8 +132,8 @@ def ear_clip(pts: np.ndarray) -> np.ndarray:
     normal = _newell_normal(pts[None])[0]
     length = np.linalg.norm(normal)
     if k == 3 or length == 0:
-        i = np.arange(1, k - 1)
-        return np.stack([np.zeros(k - 2, np.int64), i, i + 1], axis=1)
+        fan = np.arange(1, k - 1)
+        return np.stack([np.zeros(k - 2, np.int64), fan, fan + 1], axis=1)
     normal = normal / length
     # orthonormal basis (u, v) with u x v = normal: the projection is counter-clockwise
     helper = np.eye(3)[np.argmin(np.abs(normal))]
@@ -152,11 +152,11 @@ def ear_clip(pts: np.ndarray) -> np.ndarray:
         a, b, c = xy[prev[i]], xy[i], xy[nxt[i]]
         return float((b[0] - a[0]) * (c[1] - b[1]) - (b[1] - a[1]) * (c[0] - b[0]))
 
-    turns = np.array([turn(i) for i in range(k)])
+    turns = np.array([turn(j) for j in range(k)])
     out = np.empty((k - 2, 3), np.int64)
     n_out = 0
     remaining = k
-    i = 0
+    i: int = 0
     misses = 0
     while remaining > 3:
         if misses > remaining:
@@ -165,9 +165,9 @@ def ear_clip(pts: np.ndarray) -> np.ndarray:
             i = int(live[np.argmax(turns[live])])
             is_ear = True
         else:
-            is_ear = turns[i] > eps and _no_reflex_inside(xy, turns, alive, prev[i], i, nxt[i], eps)
+            is_ear = bool(turns[i] > eps) and _no_reflex_inside(xy, turns, alive, prev[i], i, nxt[i], eps)
         if is_ear:
-            a, c = prev[i], nxt[i]
+            a, c = int(prev[i]), int(nxt[i])
             out[n_out] = (a, i, c)
             n_out += 1
             alive[i] = False

@@ -27,8 +27,22 @@ FALLBACK_UP = "z"
 
 
 def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, float, float]:
-    """The up vector for an axis name, or for ``"auto"`` the up axis of the files' format
-    (:data:`FORMAT_UP`); files of formats that disagree, or no file, give :data:`FALLBACK_UP`.
+    """The up vector for an axis name, or for ``"auto"`` the up axis of the files' format.
+
+    ``"auto"`` looks the files' extensions up in :data:`FORMAT_UP`; files of formats that
+    disagree, or no file, give :data:`FALLBACK_UP`.
+
+    Parameters
+    ----------
+    name : {"auto", "x", "y", "z"}
+        The axis name.
+    paths : sequence of str
+        The model files, read by ``"auto"``.
+
+    Returns
+    -------
+    tuple of 3 float
+        The unit up vector.
 
     Examples
     --------
@@ -69,11 +83,18 @@ class Camera:
 
     Parameters
     ----------
-    position, target : (3,) float
-    up : (3,) float, approximate up direction (default +y, as in glTF and most OBJ files)
-    fov : float, vertical field of view in degrees (perspective)
+    position : (3,) float array
+        Where the camera is.
+    target : (3,) float array
+        The point it looks at.
+    up : (3,) float array
+        Approximate up direction (default +y, as in glTF and most OBJ files).
+    fov : float
+        Vertical field of view in degrees (perspective).
     orthographic : bool
-    ortho_height : float, height of the view in model units (orthographic)
+        Parallel projection instead of perspective.
+    ortho_height : float
+        Height of the view in model units (orthographic).
 
     Examples
     --------
@@ -120,9 +141,19 @@ class Camera:
     def rays(self, width: int, height: int) -> tuple[np.ndarray, np.ndarray]:
         """Primary rays through every pixel centre, row-major from the top-left pixel.
 
+        Parameters
+        ----------
+        width : int
+            Image width in pixels.
+        height : int
+            Image height in pixels.
+
         Returns
         -------
-        origins, directions : (height*width, 3) float64 (directions are unit vectors)
+        origins : (height*width, 3) float64 array
+            Ray origins.
+        directions : (height*width, 3) float64 array
+            Unit ray directions.
         """
         row, col = np.divmod(np.arange(width * height), width)
         return self.pixel_rays(col, row, width, height)
@@ -132,9 +163,23 @@ class Camera:
     ) -> tuple[np.ndarray, np.ndarray]:
         """Primary rays through the centres of the given pixels of a ``width`` x ``height`` image.
 
+        Parameters
+        ----------
+        col : (n,) int array
+            Pixel columns.
+        row : (n,) int array
+            Pixel rows, 0 at the top.
+        width : int
+            Image width in pixels.
+        height : int
+            Image height in pixels.
+
         Returns
         -------
-        origins, directions : (n, 3) float64 (directions are unit vectors)
+        origins : (n, 3) float64 array
+            Ray origins.
+        directions : (n, 3) float64 array
+            Unit ray directions.
         """
         right, up, forward = self.basis()
         hh = self._half_height()
@@ -213,6 +258,7 @@ class Camera:
         ]
 
     def to_json(self) -> dict:
+        """The camera as a dict of plain floats and bools (inverse of :meth:`from_json`)."""
         d = asdict(self)
         for k in ("position", "target", "up"):
             d[k] = [float(x) for x in getattr(self, k)]
@@ -220,6 +266,13 @@ class Camera:
 
     @classmethod
     def from_json(cls, d: dict) -> Camera:
+        """The camera written by :meth:`to_json`.
+
+        Raises
+        ------
+        ParameterError
+            ``d`` has a key that is not a camera field.
+        """
         known = {"position", "target", "up", "fov", "orthographic", "ortho_height"}
         unknown = set(d) - known
         if unknown:

@@ -47,11 +47,15 @@ class Hits:
 
     Attributes
     ----------
-    face : (n,) int64, index of the face hit, -1 for a miss
-    distance : (n,) float64, distance along the (unit) direction, ``inf`` for a miss
-    side : (n,) int8, 0 when the ray hit the front (counter-clockwise) side, 1 the back, -1 miss
-    bary : (n, 2) float32, barycentric coordinates (u, v) of the hit on its face: the point
-        is ``(1-u-v) a + u b + v c`` for the face's corners (a, b, c)
+    face : (n,) int64 array
+        Index of the face hit, -1 for a miss.
+    distance : (n,) float64 array
+        Distance along the (unit) direction, ``inf`` for a miss.
+    side : (n,) int8 array
+        0 when the ray hit the front (counter-clockwise) side, 1 the back, -1 miss.
+    bary : (n, 2) float32 array
+        Barycentric coordinates (u, v) of the hit on its face: the point is ``(1-u-v) a + u b + v
+        c`` for the face's corners (a, b, c).
     """
 
     face: np.ndarray
@@ -61,6 +65,7 @@ class Hits:
 
     @property
     def hit(self) -> np.ndarray:
+        """(n,) bool: the ray hit a face."""
         return self.face >= 0
 
     def points(self, origins: np.ndarray, directions: np.ndarray) -> np.ndarray:
@@ -74,7 +79,7 @@ class RayCaster:
 
     Parameters
     ----------
-    model : Soup, trimesh.Trimesh or (vertices, faces)
+    model : Soup, trimesh.Trimesh or tuple of (vertices, faces)
         The geometry.  Degenerate faces are kept (Embree skips them).
     offset : float
         Push of surface origins off their surface, relative to the bounding-box diagonal.
@@ -85,7 +90,7 @@ class RayCaster:
     --------
     >>> import numpy as np, trimesh
     >>> rc = RayCaster(trimesh.creation.box())
-    >>> h = rc.intersect(np.array([[0., 0, 5]]), np.array([[0., 0, -1]]))
+    >>> h = rc.intersect(np.array([[0., 0, 5]]), np.array([[0., 0, -1]]), exact_distance=True)
     >>> int(h.side[0]), float(h.distance[0])
     (0, 4.5)
     """
@@ -177,10 +182,15 @@ class RayCaster:
 
         Parameters
         ----------
-        origins, directions : (n, 3) float arrays in input coordinates (directions need not be unit)
-        max_distance : optional float or (n,) array, in input units
-        exact_distance : recompute each distance in float64 on the hit triangle's plane
-            (otherwise it carries float32 round-off, about 1e-7 of the diagonal)
+        origins : (n, 3) float array
+            Ray origins in input coordinates.
+        directions : (n, 3) float array
+            Ray directions (need not be unit).
+        max_distance : float or (n,) float array, optional
+            Longest hit distance, in input units.
+        exact_distance : bool
+            Recompute each distance in float64 on the hit triangle's plane (otherwise it
+            carries float32 round-off, about 1e-7 of the diagonal).
 
         Returns
         -------

@@ -35,12 +35,18 @@ class Rendering:
 
     Attributes
     ----------
-    image : (h, w, 3) uint8
-    face : (h, w) int64, face index per pixel, -1 for background
-    part : (h, w) int64, part id per pixel, -1 for background
-    side : (h, w) int8, side seen (0 front, 1 back, -1 background)
-    depth : (h, w) float64, distance along the ray, inf for background
+    image : (h, w, 3) uint8 array
+        The picture.
+    face : (h, w) int64 array
+        Face index per pixel, -1 for background.
+    part : (h, w) int64 array
+        Part id per pixel, -1 for background.
+    side : (h, w) int8 array
+        Side seen (0 front, 1 back, -1 background).
+    depth : (h, w) float64 array
+        Distance along the ray, inf for background.
     camera : Camera
+        The view the image was taken from.
     """
 
     image: np.ndarray
@@ -73,17 +79,29 @@ def render(
     Parameters
     ----------
     model : Soup, trimesh.Trimesh, (vertices, faces) or path
-    camera : Camera, optional; fitted to the model from ``azimuth``/``elevation`` when omitted
-    size : (width, height)
-    color_by : "side" (front blue, back orange), "part", "layer" (uses ``face_values``), or None (grey)
-    face_values : (m,) int, per-face values coloured by ``color_by="layer"`` (e.g. layer index)
-    caster : a prebuilt RayCaster to reuse
-    up : (3,) float, optional; the model's up axis for the fitted camera (default: the rule of
-        :func:`meshvis.rays.camera.model_up`, y for glTF and OBJ files, z otherwise)
+        The model.
+    camera : Camera, optional
+        The view; fitted to the model from ``azimuth`` and ``elevation`` when omitted.
+    size : tuple of 2 int
+        ``(width, height)`` in pixels.
+    color_by : {"side", "part", "layer"} or None
+        Front blue and back orange, a colour per part, a colour per ``face_values``, or grey.
+    face_values : (m,) int array
+        Per-face values coloured by ``color_by="layer"`` (e.g. layer index).
+    caster : RayCaster, optional
+        A prebuilt caster of the same model to reuse.
+    azimuth : float
+        Degrees around the up axis of the fitted camera.
+    elevation : float
+        Degrees above the horizon of the fitted camera.
+    up : (3,) float, optional
+        The model's up axis for the fitted camera (default: the rule of
+        :func:`meshvis.rays.camera.model_up`, y for glTF and OBJ files, z otherwise).
 
     Returns
     -------
     Rendering
+        The image and its per-pixel buffers.
 
     Examples
     --------
@@ -160,9 +178,29 @@ def render_layers(
     Layer ``k`` of ``K`` gets opacity ``0.15 + 0.85 (k-1)/(K-1)``: the outer shell is a
     faint veil, the deepest layer is solid.
 
+    Parameters
+    ----------
+    model : Soup, trimesh.Trimesh, tuple of (vertices, faces) or path
+        The model.
+    layer : (m,) int array
+        Layer of every face, 1 = outer (:attr:`meshvis.repair.layers.LayerResult.layer`).
+    camera : Camera, optional
+        The view; fitted to the model from ``azimuth`` and ``elevation`` when omitted.
+    size : tuple of 2 int
+        ``(width, height)`` in pixels.
+    caster : RayCaster, optional
+        A prebuilt caster of the same model to reuse.
+    max_peel : int
+        Most surfaces followed per pixel.
+    azimuth : float
+        Degrees around the up axis of the fitted camera.
+    elevation : float
+        Degrees above the horizon of the fitted camera.
+
     Returns
     -------
-    (h, w, 3) uint8 image
+    (h, w, 3) uint8 array
+        The picture.
     """
     soup = as_soup(model)
     layer = np.asarray(layer, np.int64)

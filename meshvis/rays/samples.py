@@ -14,12 +14,15 @@ def uniform_in_triangles(triangles: np.ndarray, rng: np.random.Generator) -> np.
 
     Parameters
     ----------
-    triangles : (n, 3, 3) corner coordinates
-    rng : numpy Generator
+    triangles : (n, 3, 3) float array
+        Corner coordinates.
+    rng : numpy.random.Generator
+        The random generator.
 
     Returns
     -------
-    (n, 3) points.  Uses the square-root warp: ``p = (1-√u) a + √u (1-v) b + √u v c``.
+    (n, 3) float64 array
+        The points, by the square-root warp ``p = (1-√u) a + √u (1-v) b + √u v c``.
     """
     n = len(triangles)
     u = np.sqrt(rng.random(n))
@@ -39,14 +42,18 @@ def cosine_hemisphere(
 
     Parameters
     ----------
-    normals : (n, 3) unit vectors
-    rng : numpy Generator
-    frames : optional precomputed tangents ``(t1, t2)`` of the normals (any orthonormal
-        pair orthogonal to the normal; see :func:`tangent_frames`)
+    normals : (n, 3) float array
+        Unit normals.
+    rng : numpy.random.Generator
+        The random generator.
+    frames : tuple of two (n, 3) float arrays, optional
+        Precomputed tangents ``(t1, t2)`` of the normals (any orthonormal pair orthogonal
+        to the normal; see :func:`tangent_frames`).
 
     Returns
     -------
-    (n, 3) unit directions with ``dot(d, normal) > 0``.
+    (n, 3) float64 array
+        Unit directions with ``dot(d, normal) > 0``.
     """
     n = len(normals)
     xi1, xi2 = rng.random(n), rng.random(n)
@@ -94,9 +101,19 @@ def sample_scheme_barycentric(
     The pattern is the same for every triangle (deterministic, stratified), which keeps
     the sample points of adjacent triangles apart from each other.
 
+    Parameters
+    ----------
+    n_samples : int
+        Sample points per triangle.
+    scheme : {1, 2}
+        The placement scheme.
+    rng : numpy.random.Generator, optional
+        Unused: the pattern is deterministic.
+
     Returns
     -------
-    (n_samples, 3) barycentric weights, each row summing to 1.
+    (n_samples, 3) float64 array
+        Barycentric weights, each row summing to 1.
     """
     if n_samples < 1:
         raise ValueError("n_samples must be at least 1")

@@ -24,12 +24,22 @@ class LayerResult:
 
     Attributes
     ----------
-    layer : (m,) int64, layer index per input face (1 = outer); faces that no cut reached
-        (never seen by any ray: sealed off) get ``n_layers + 1`` and are counted in
-        ``unreached``
-    outer_side : (m,) int8, the side that is outside at the face's layer (0 front, 1
-        back, 2 both, -1 for unreached faces)
-    n_layers : int, number of layers found
+    layer : (m,) int64 array
+        Layer index per input face (1 = outer); faces that no cut reached (never seen by any ray:
+        sealed off) get ``n_layers + 1`` and are counted in ``unreached``.
+    outer_side : (m,) int8 array
+        The side that is outside at the face's layer (0 front, 1 back, 2 both, -1 for unreached
+        faces).
+    n_layers : int
+        Number of layers found.
+    soup : Soup
+        The model the layers are of.
+    unreached : int
+        Faces that no cut reached.
+    classification : Classification
+        The classification the layers were peeled from.
+    seconds : float
+        Time of the peeling (the classification not included).
     """
 
     soup: Soup
@@ -41,6 +51,7 @@ class LayerResult:
     seconds: float
 
     def report(self, per_face: bool = True) -> dict:
+        """The JSON report: layer counts, timings, and per face ``layer`` when ``per_face``."""
         d = {
             "layers": self.n_layers,
             "faces_per_layer": np.bincount(self.layer, minlength=self.n_layers + 2)[1:].tolist(),
@@ -66,7 +77,7 @@ def _face_outside_any(c: Classification, node_outside: np.ndarray) -> tuple[np.n
         & ~((frac[:, 0] == 1) & (frac[:, 1] == 1))
     )
     side[partial] = np.where(frac[partial, 0] >= frac[partial, 1], 0, 1)
-    return out.any(axis=1), side.astype(np.int8)
+    return np.any(out, axis=1), side.astype(np.int8)
 
 
 def face_nodes_mask(c: Classification, faces: np.ndarray) -> np.ndarray:
@@ -96,14 +107,21 @@ def layers(
 
     Parameters
     ----------
-    model : anything :func:`meshvis.classify` accepts
-    max_layers : stop after this many layers (the rest get layer ``max_layers + 1``)
-    classification : reuse an existing classification of the same model
-    **classify_kw : passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...)
+    model : Soup, trimesh.Trimesh, tuple of (vertices, faces) or path
+        Anything :func:`meshvis.classify` accepts.
+    max_layers : int, optional
+        Stop after this many layers (the rest get layer ``max_layers + 1``).
+    classification : Classification, optional
+        Reuse an existing classification of the same model.
+    progress : callable, optional
+        Progress callback, passed to :func:`meshvis.classify`.
+    **classify_kw
+        Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...).
 
     Returns
     -------
     LayerResult
+        Layer and outer side of every face.
 
     Examples
     --------

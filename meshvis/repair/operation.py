@@ -101,13 +101,13 @@ def classify_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
 
 def _classify_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     """``classify``: the report, the visibility graph (GraphML) and a preview of the sides."""
+    from meshvis._extras import import_extra
     from meshvis.io import atomic_write
     from meshvis.rays.render import render, save_png
 
     report = c.report()
     if o["graphml"]:
-        import networkx as nx
-
+        nx = import_extra("networkx", "GraphML export (--graphml)")
         with atomic_write(o["graphml"], "wb") as fh:
             nx.write_graphml(c.graph.to_networkx({"area": c.nodes.area}), fh)
     if o["preview"]:
@@ -221,6 +221,10 @@ def run_operation(
     from meshvis.rays.camera import up_axis
 
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
+    if op == "classify" and o["graphml"]:  # fail before the classification, not after
+        from meshvis._extras import import_extra
+
+        import_extra("networkx", "GraphML export (--graphml)")
     tell = say or (lambda text: None)
     up = up_axis(o.get("up") or "auto", [soup.path] if soup.path else [])  # of the preview
     c = classify(soup, progress=progress, **classify_kwargs(o))

@@ -76,5 +76,5 @@ def remove_interior(
     (320, 320)
     """
     c = classification or classify(model, **classify_kw)
-    keep = (c.outside > 0).any(axis=1)
+    keep = np.any(c.outside > 0, axis=1)
     return RemovalResult(c.soup.subset(keep), c.soup.subset(~keep), keep, c)

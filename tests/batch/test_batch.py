@@ -5,7 +5,6 @@ from __future__ import annotations
 
 import csv
 import errno
-import glob
 import json
 import os
 import signal
@@ -80,35 +79,16 @@ def _tmp_files(folder) -> list[str]:
 
 
 # ---------------------------------------------------------------- runners used by the worker tests
-_OPEN: list = []  # keeps the unfinished writes alive (a collected one would clean up after itself)
+#: the folder of stuck_runners.py; worker processes import it by name, and the folder holds
+#: no meshvis/ that could shadow the installed package
+HERE = os.path.dirname(os.path.abspath(__file__))
 
 
-def _partial_write(args) -> None:
-    """Start writing the output (a temporary file appears) and never finish."""
-    from meshvis.io import atomic_write
-
-    writer = atomic_write(args["output"], "w")
-    _OPEN.append(writer)
-    fh = writer.__enter__()
-    fh.write("partial")
-    fh.flush()
-    assert glob.glob(os.path.join(os.path.dirname(args["output"]), ".*.tmp"))
-
-
-def hang(op, soup, args, progress):
-    _partial_write(args)
-    time.sleep(3600)
-
-
-def stubborn(op, soup, args, progress):
-    signal.signal(signal.SIGTERM, signal.SIG_IGN)  # a hung C call would not see SIGTERM either
-    _partial_write(args)
-    time.sleep(3600)
-
-
-def die(op, soup, args, progress):
-    _partial_write(args)
-    os.kill(os.getpid(), signal.SIGKILL)
+@pytest.fixture
+def stuck_runners(monkeypatch):
+    """Make ``stuck_runners`` importable here and in worker processes (they get sys.path)."""
+    monkeypatch.syspath_prepend(HERE)
+    return "stuck_runners"
 
 
 # ---------------------------------------------------------------- discovery and names
@@ -260,6 +240,7 @@ def _rows(folder) -> dict[str, dict]:
         return {os.path.basename(r["input"]): r for r in csv.DictReader(fh)}
 
 
+@pytest.mark.slow
 def test_batch_command_local_and_resume(tmp_path, capsys):
     src = tmp_path / "in"
     src.mkdir()
@@ -332,14 +313,15 @@ def test_batch_command_local_and_resume(tmp_path, capsys):
     assert mb.completed_row(task) is None
 
 
-def test_time_limit_and_crashed_workers_do_not_stop_the_batch(tmp_path):
+@pytest.mark.slow
+def test_time_limit_and_crashed_workers_do_not_stop_the_batch(tmp_path, stuck_runners):
     src = _triangle(tmp_path / "tri.obj")
     out = str(tmp_path / "out")
     good = mb.plan([src], "orient", out)[0]
     bad = []
     for runner in ("hang", "stubborn", "die"):
         t = mb.plan([src], "orient", os.path.join(out, runner))[0]
-        t.runner = f"{__name__}:{runner}"
+        t.runner = f"{stuck_runners}:{runner}"
         bad.append(t)
     tasks = bad + [good]
     seen = []
@@ -355,9 +337,10 @@ def test_time_limit_and_crashed_workers_do_not_stop_the_batch(tmp_path):
     assert mio.load(good.output).n_faces == 1
 
 
-def test_run_file_isolated_kills_a_hung_file(tmp_path):
+@pytest.mark.slow
+def test_run_file_isolated_kills_a_hung_file(tmp_path, stuck_runners):
     task = mb.plan([_triangle(tmp_path / "tri.obj")], "orient", str(tmp_path / "out"))[0]
-    task.runner = f"{__name__}:hang"
+    task.runner = f"{stuck_runners}:hang"
     row = mb.run_file_isolated(task, time_limit=1.0)
     assert row["status"] == "timeout"
     assert not _tmp_files(tmp_path / "out") and not os.path.exists(task.output)
@@ -365,6 +348,7 @@ def test_run_file_isolated_kills_a_hung_file(tmp_path):
     assert mb.run_file_isolated(task, time_limit=60.0)["status"] == "ok"
 
 
+@pytest.mark.slow
 def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
     src = tmp_path / "in"
     src.mkdir()
@@ -372,7 +356,6 @@ def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
     _sphere(src / "b.obj")
     _slow_soup(src / "slow.ply")  # the largest file: started first, still running at Ctrl-C
     out = tmp_path / "out"
-    env = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
     proc = subprocess.Popen(
         [
             sys.executable,
@@ -393,7 +376,7 @@ def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env=env,
+        cwd=tmp_path,  # the installed package, not the repository's meshvis/ folder
         start_new_session=True,
     )
     try:
@@ -428,6 +411,7 @@ def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
 
 
 # ---------------------------------------------------------------- usage errors
+@pytest.mark.slow
 def test_usage_errors(tmp_path, capsys, monkeypatch):
     src = _triangle(tmp_path / "tri.obj")
 
@@ -485,6 +469,7 @@ def test_usage_errors(tmp_path, capsys, monkeypatch):
 
 
 # ---------------------------------------------------------------- Dask
+@pytest.mark.slow
 def test_dask_local_cluster_gives_the_same_outputs(tmp_path, capsys):
     distributed = pytest.importorskip("distributed")
     src = tmp_path / "in"

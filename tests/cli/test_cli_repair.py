@@ -28,6 +28,7 @@ def sphere_pair_soup(tmp_path_factory):
     return truth, str(path)
 
 
+@pytest.mark.slow
 def test_orient_cli_correct_area(sphere_pair_soup, tmp_path):
     truth, path = sphere_pair_soup
     out, rep, png = tmp_path / "o.obj", tmp_path / "o.json", tmp_path / "o.png"
@@ -86,6 +87,7 @@ def test_classify_cli_graphml(tmp_path):
     assert "OUTSIDE" in graph and "INSIDE" in graph
 
 
+@pytest.mark.slow
 @pytest.mark.skipif(not (REAL / "bunny10k_textured.obj").exists(), reason="shared real models not present")
 def test_attributes_survive_remove_interior(tmp_path):
     src = str(REAL / "bunny10k_textured.obj")
@@ -128,6 +130,7 @@ def test_orient_cli_options_two_sided_duplicate(tmp_path):
     assert report["layers"].startswith("skipped") and report["parity_faces"].startswith("skipped")
 
 
+@pytest.mark.slow
 def test_demo_writes_everything(tmp_path):
     from meshvis.eval.demo import DEMO_FILES
 

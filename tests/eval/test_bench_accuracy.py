@@ -154,6 +154,7 @@ def test_ambient_occlusion_front_only_and_both_sides():
     assert not one.values[outer_in].any()
 
 
+@pytest.mark.slow
 def test_peel_gives_layers_and_reports_failures_instead_of_raising():
     t = two_spheres()
     r = B.libigl_peel(t.soup, timeout=60)
@@ -171,6 +172,7 @@ def test_library_exception_is_a_failed_result():
 
 
 # ====================================================================== benchmarks
+@pytest.mark.slow
 def test_compare_one_case_and_its_checks():
     from meshvis.eval.bench import cases as C
     from meshvis.eval.bench import compare
@@ -189,6 +191,7 @@ def test_compare_one_case_and_its_checks():
     assert "| two_spheres |" in text and "## Targets" in text
 
 
+@pytest.mark.slow
 def test_accuracy_quick_writes_finite_errors(tmp_path):
     from meshvis.cli.main import main
 

@@ -85,6 +85,7 @@ def _canonical(tri: np.ndarray) -> np.ndarray:
 
 
 # ============================================================================ basic validity
+@pytest.mark.slow
 @pytest.mark.parametrize("name", list(SMALL))
 def test_valid_soup_and_truth_shapes(small, name):
     t = small[name]
@@ -120,12 +121,14 @@ def test_valid_soup_and_truth_shapes(small, name):
         "sphere_pair",
     ],
 )
+@pytest.mark.slow
 def test_defaults_size(name):
     t = g.GENERATORS[name]()
     assert 1000 <= t.n_faces <= 20000
     assert t.check() == []
 
 
+@pytest.mark.slow
 def test_assembly_default_size_and_parts():
     t = g.assembly()
     s = t.soup
@@ -144,6 +147,7 @@ def test_assembly_default_size_and_parts():
     assert hidden_frac[names.index("air_filter")] < 0.5
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", SEEDED)
 def test_deterministic(name):
     kw = SMALL[name]
@@ -158,6 +162,7 @@ def test_deterministic(name):
 
 
 # ============================================================================ truth against winding numbers
+@pytest.mark.slow
 def test_nested_shells_truth(small):
     t = small["nested_shells"]
     assert g.is_closed(t.soup)
@@ -237,6 +242,7 @@ def test_overlapping_solids_truth(small):
     assert 0.05 < t.hidden[sphere].mean() < 0.5 and 0.05 < t.hidden[box].mean() < 0.5
 
 
+@pytest.mark.slow
 def test_assembly_truth(small):
     t = small["assembly"]
     assert g.is_closed(t.soup)
@@ -405,6 +411,7 @@ def _exact_sides_winding(V, F, faces, eps):
     return w[: len(faces)], w[len(faces) :]
 
 
+@pytest.mark.slow
 def test_from_closed_real_model():
     path = ROOT.parent / "shared" / "models" / "real" / "cow.obj"
     if not path.exists():
@@ -430,6 +437,7 @@ def test_from_closed_real_model():
     assert np.all(np.abs(front) < 0.5) and np.all(np.abs(back - 1) < 0.5)
 
 
+@pytest.mark.slow
 def test_skin_and_ribcage():
     try:
         t = g.skin_and_ribcage(ROOT.parent / "shared" / "models" / "real")

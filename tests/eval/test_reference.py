@@ -3,11 +3,13 @@
 from __future__ import annotations
 
 import numpy as np
+import pytest
 
 from meshvis.eval import generators
 from meshvis.eval.reference import reference
 
 
+@pytest.mark.slow
 def test_nested_shells_outer_seen_from_its_outside_inner_never():
     truth = generators.nested_shells(n=2, subdivisions=1)
     ref = reference(truth.soup, seed=1)
@@ -20,6 +22,7 @@ def test_nested_shells_outer_seen_from_its_outside_inner_never():
     assert ref.orientation_error(np.where(truth.outward, 1, 0)) == 1.0
 
 
+@pytest.mark.slow
 def test_reference_is_deterministic_and_cached(tmp_path):
     soup = generators.nested_shells(n=2, subdivisions=1).soup
     cache = tmp_path / "ref.npz"

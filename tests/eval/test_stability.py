@@ -17,6 +17,7 @@ from meshvis.graphcut.classify import classify
 from meshvis.graphcut.mincut import min_cut, rounding_bound
 
 
+@pytest.mark.slow
 def test_quick_run_passes_through_the_command_line(tmp_path, capsys):
     out = tmp_path / "stability.json"
     assert cli_main(["bench", "stability", "--quick", "--json", str(out)]) == 0
@@ -94,6 +95,7 @@ def test_stressed_copies_keep_the_original_faces_first():
     assert np.allclose(shift, 1e-7 * soup.diagonal, rtol=1e-3)
 
 
+@pytest.mark.slow
 def test_far_translation_and_extreme_scales_give_identical_labels():
     soup = generators.cracked_box(cell=0.1, crack_width=1e-3).soup
     ref = classify(soup, rays_per_node=8, seed=3)
@@ -107,6 +109,7 @@ def test_far_translation_and_extreme_scales_give_identical_labels():
         assert cases.area_agreement(ref.side_outside, c.side_outside, soup.areas) >= cases.AGREEMENT
 
 
+@pytest.mark.slow
 def test_crack_leaks_only_above_the_opening_share():
     rows = cases.crack_sweep([3e-2, 1e-4], cell=0.1, rays_per_node=16, seed=0, share_rays=100_000)
     wide, hairline = rows

@@ -63,6 +63,7 @@ def test_small_crack_keeps_interior_inside():
     assert c.hidden[len(outer.faces) :].all()
 
 
+@pytest.mark.slow
 def test_overlapping_solids_hidden_parts_match_truth():
     a, b = trimesh.creation.icosphere(4), trimesh.creation.icosphere(4)
     b.vertices += [0.8, 0, 0]

@@ -35,6 +35,7 @@ def side_accuracy(truth, c):
     return float((a * right).sum() / a.sum())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", sorted(CASES))
 def test_generator_classified(name):
     truth = CASES[name]()
@@ -62,6 +63,7 @@ def oriented_fraction(truth, seed=0):
     return float((a * right).sum() / a.sum())
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("name", ["cow.obj", "stanford-bunny.obj", "dm_control__SKINbody.stl"])
 def test_soupified_real_model_30_percent_flipped(name):
     path = REAL / name

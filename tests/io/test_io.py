@@ -76,6 +76,7 @@ def _colour_soup() -> Soup:
 
 
 # ---------------------------------------------------------------------------- real models
+@pytest.mark.slow
 @needs_real
 @pytest.mark.parametrize("name,faces", _face_table() or [("missing", 0)])
 def test_face_count_of_every_real_model(name, faces):
@@ -91,6 +92,7 @@ def test_real_table_lists_all_21_models():
     assert len(_face_table()) == 21
 
 
+@pytest.mark.slow
 @needs_real
 def test_monastery_obj_keeps_file_order_and_materials():
     with pytest.warns(UserWarning, match="2 vertices"):
@@ -208,6 +210,7 @@ def test_obj_polygons_source_face(tmp_path):
     assert soup.part_names == ["poly"]
 
 
+@pytest.mark.slow
 def test_obj_polygon_with_many_vertices(tmp_path):
     n = 3000
     ang = np.linspace(0, 2 * np.pi, n, endpoint=False)
@@ -352,6 +355,7 @@ def test_obj_mtl_and_texture_are_written_back(tmp_path):
 
 
 # ---------------------------------------------------------------------------- round trips
+@pytest.mark.slow
 @needs_real
 @pytest.mark.parametrize("name", ["bunny10k_textured.obj", "spot.obj"])
 @pytest.mark.parametrize("ext", [".obj", ".ply", ".glb", ".gltf", ".off", ".stl"])

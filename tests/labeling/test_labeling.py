@@ -102,6 +102,7 @@ def back_buffers(models):
 
 
 # ---------------------------------------------------------------------------- the guarantees
+@pytest.mark.slow
 @pytest.mark.parametrize("layout", list(labeling.LAYOUTS))
 def test_layout_guarantees_on_all_models(buffers, layout):
     """Every layout on every model: no overlap, no crossing, no box over the model, valid anchors."""
@@ -124,6 +125,7 @@ def test_layout_guarantees_on_all_models(buffers, layout):
         assert seen == set(range(soup.n_parts))
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("layout", list(labeling.LAYOUTS))
 @pytest.mark.parametrize("method", ["fuzzy", "two-step"])
 def test_layout_guarantees_second_view(back_buffers, layout, method):
@@ -421,6 +423,7 @@ def test_camera_path_file(tmp_path, scene):
         read_camera_path(bad)
 
 
+@pytest.mark.slow
 def test_baselines(buffers):
     soup, ib = buffers["assembly"]
     texts = label_texts(soup.part_names)
@@ -513,6 +516,7 @@ def test_cli(tmp_path, scene):
     assert main(["label", str(model), "-o", str(tmp_path / "x.svg"), "--weights", "1,2", "-q"]) == 2
 
 
+@pytest.mark.slow
 def test_bench_runs_small(scene):
     from meshvis.eval.bench import labeling as bench
 
@@ -715,6 +719,7 @@ def test_silhouette_crowded_run_is_placed_from_both_ends(monkeypatch):
     assert box_silhouette._run_order(ctx, np.arange(4)) == [0, 1, 2, 3]
 
 
+@pytest.mark.slow
 @pytest.mark.parametrize("azimuth, elevation", [(225, 45), (225, 10), (270, 10), (0, 45), (135, 80)])
 def test_silhouette_crowded_small_views_place_every_label_near(azimuth, elevation):
     """~30 labels around a model 60 px wide: all placed, none sent far off (once up to 7 d_S)."""
@@ -730,6 +735,7 @@ def test_silhouette_crowded_small_views_place_every_label_near(azimuth, elevatio
             assert r.metrics["leader_max_norm"] < 3.0
 
 
+@pytest.mark.slow
 def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
     """top-bottom at azimuth 270: the alternator's leader to the top crosses others; it goes down."""
     import meshvis.labeling.pipeline  # noqa: F401  (makes labeling.pipeline an attribute)

@@ -96,6 +96,7 @@ def test_same_results_under_translation_and_scale(scale, shift):
     assert np.allclose(h.distance[both] / scale, base.distance[both], rtol=1e-4, atol=1e-5)
 
 
+@pytest.mark.slow
 def test_threads_give_identical_hits():
     s = sphere_soup()
     rng = np.random.default_rng(4)

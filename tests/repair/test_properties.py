@@ -101,6 +101,7 @@ def _run(fn, soup: Soup, **kw):
         raise AssertionError(f"unexpected documented error {type(exc).__name__}: {exc}") from exc
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(soups())
 def test_classify_labels_every_side(soup):
@@ -117,6 +118,7 @@ def test_classify_labels_every_side(soup):
     assert c.n_rays == again.n_rays
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(soups())
 def test_remove_interior_accounts_for_every_face(soup):
@@ -134,6 +136,7 @@ def test_remove_interior_accounts_for_every_face(soup):
     assert np.array_equal(r.keep, remove_interior(soup, **KW).keep)
 
 
+@pytest.mark.slow
 @SETTINGS
 @given(soups())
 def test_layers_give_every_face_a_layer(soup):
@@ -154,6 +157,7 @@ def test_layers_give_every_face_a_layer(soup):
 @given(
     soups(), st.sampled_from(["keep", "duplicate", "strongest"]), st.sampled_from(["majority", "duplicate"])
 )
+@pytest.mark.slow
 def test_orient_turns_faces_over_and_nothing_else(soup, two_sided, conflicts):
     r = _run(orient, soup, two_sided=two_sided, conflicts=conflicts, **KW)
     if r is None:

@@ -33,7 +33,7 @@ from collections.abc import Iterable
 import numpy as np
 
 from meshvis.errors import OutputError
-from meshvis.eval.baselines import BASELINES
+from meshvis.eval.baselines import BASELINES, require_baselines
 from meshvis.eval.bench import cases as C
 from meshvis.eval.bench.real import DEFAULT_MODELS, add_models_argument
 
@@ -366,6 +366,7 @@ def prepare_out(out: str, names: tuple[str, ...], force: bool) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    require_baselines()
     chosen = C.select_cases(args.cases, C.QUICK if args.quick else tuple(C.CASES))
     prepare_out(args.out, OUTPUTS, args.force)
     log = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))

@@ -26,7 +26,7 @@ import time
 
 import numpy as np
 
-from meshvis.eval.baselines import BASELINES
+from meshvis.eval.baselines import BASELINES, require_baselines
 from meshvis.eval.bench import cases as C
 from meshvis.eval.bench.accuracy import prepare_out
 from meshvis.eval.bench.real import DEFAULT_MODELS, add_models_argument
@@ -182,6 +182,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    require_baselines()
     chosen = C.select_cases(args.cases, QUICK if args.quick else FULL)
     if args.out:
         prepare_out(args.out, OUTPUTS, args.force)

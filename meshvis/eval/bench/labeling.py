@@ -31,6 +31,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis._extras import import_extra
 from meshvis.labeling.baselines import adjust_text
 from meshvis.labeling.boxes import Spacing
 from meshvis.labeling.candidates import LAYOUTS
@@ -316,6 +317,8 @@ def run(
         :func:`compare_views`).
     """
     say = progress or (lambda s: None)
+    if adjusttext:  # fail before the first layout, not in the middle of the run
+        import_extra("adjustText", "meshvis bench labeling without --no-adjusttext")
     spacing = Spacing() if rotate is None else Spacing(rotate=float(rotate))
     soup, name = _load(model)
     texts = label_texts(soup.part_names)
