@@ -118,7 +118,7 @@ class Soup:
     uv: np.ndarray | None = None
     colors: np.ndarray | None = None
     path: str | None = None
-    origin: np.ndarray | None = None
+    origin: np.ndarray = None  # type: ignore[assignment]  # filled in __post_init__
     source: SourceRecord | None = None
 
     def __post_init__(self) -> None:

@@ -1,5 +1,6 @@
-"""How a soup differs from the file it was read from: which input faces it still has, in
-which order, and which of them are turned over.
+"""How a soup differs from the file it was read from.
+
+Which input faces it still has, in which order, and which of them are turned over.
 
 A reader stores a :class:`~meshvis.soup.SourceRecord` on the soup; every face carries its
 ``origin`` (its index as read) through :meth:`Soup.subset` and :meth:`Soup.flipped`.  A

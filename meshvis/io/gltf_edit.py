@@ -193,7 +193,7 @@ def _compressed(doc: dict, changes: dict) -> bool:
 
 
 def _piece_indices(src: GltfSource, edits: FaceEdits, faces: np.ndarray) -> dict:
-    """node -> {primitive -> (t, 3) local indices} for every piece whose faces changed."""
+    """Map node -> {primitive -> (t, 3) local indices} for every piece whose faces changed."""
     pieces = src.pieces
     first_face = pieces[:, 5]
     n_faces = np.diff(np.append(first_face, len(edits.record.faces)))

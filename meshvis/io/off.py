@@ -276,7 +276,7 @@ def _edited_lines(edits: FaceEdits) -> str:
                 c = c[[0, 2, 1]] if edits.flipped[i] else c
                 out.append(" ".join(["3", corners[c[0]], corners[c[1]], corners[c[2]], *tail]))
             n_out += len(out)
-            lines[no] = "\n".join(out) if out else None
+            lines[no] = "\n".join(out) if out else None  # type: ignore[assignment]  # None: dropped
     head, hash_, comment = lines[src.count_line].partition("#")
     t = head.split()
     at = 1 if t and _KEYWORD.match(t[0]) else 0  # the counts may follow the keyword

@@ -1,5 +1,7 @@
-"""The JSON report of a repair command: its schema version, where it goes, and its per-face
-arrays either inline or in a ``.npz`` file.
+"""The JSON report of a repair command.
+
+Its schema version, where it goes, and its per-face arrays either inline or in a ``.npz``
+file.
 
 The schema is documented as a JSON Schema in ``docs/report.schema.json``; :data:`SCHEMA_VERSION`
 is the ``schema`` field of every report and changes whenever a field changes meaning.

@@ -71,7 +71,8 @@ def soup_from_mesh(mesh, path: str | None = None) -> Soup:
     with the input's visual.
     """
     validate(np.asarray(mesh.vertices), np.asarray(mesh.faces), path)
-    soup = soup_from_trimesh(mesh, "mesh", mats := [], {})
+    mats: list = []
+    soup = soup_from_trimesh(mesh, "mesh", mats, {})
     soup.materials = mats
     soup.path = path
     offsets = np.zeros((1, 3), np.int64)
@@ -83,8 +84,9 @@ def soup_from_mesh(mesh, path: str | None = None) -> Soup:
 
 @dataclass(eq=False)
 class TrimeshSource:
-    """The trimesh object a soup came from, so that :meth:`Soup.to_trimesh` gives the same
-    kind back with its visuals.
+    """The trimesh object a soup came from.
+
+    :meth:`Soup.to_trimesh` uses it to give the same kind back with its visuals.
 
     Parameters
     ----------

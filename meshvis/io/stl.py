@@ -146,6 +146,7 @@ def write_stl(soup: Soup, path: str, groups=None, group_names=None, face_values=
     tri = soup.triangles
     if edits is not None:
         src: StlSource = edits.record.data
+        assert src.records is not None  # a binary STL (the header check above)
         rec = src.records[edits.origin].copy()
         rec["normal"] = np.where(edits.flipped[:, None], -rec["normal"], rec["normal"])
         header = src.header

@@ -58,8 +58,11 @@ def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, 
 
 
 def model_up(model: Any) -> tuple[float, float, float]:
-    """The up vector of a model by :func:`up_axis` ``"auto"``: from its file (a path, a list
-    of paths, or a soup read from a file), else :data:`FALLBACK_UP`."""
+    """The up vector of a model by :func:`up_axis` ``"auto"``.
+
+    Taken from its file (a path, a list of paths, or a soup read from a file), else
+    :data:`FALLBACK_UP`.
+    """
     if isinstance(model, (str, os.PathLike)):
         paths = [os.fspath(model)]
     elif isinstance(model, (list, tuple)) and model and all(isinstance(m, (str, os.PathLike)) for m in model):
