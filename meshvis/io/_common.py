@@ -149,18 +149,33 @@ def unique_names(names: list[str], fallback: str) -> list[str]:
     return out
 
 
+def companions(path: str) -> list[str]:
+    """Files written along with ``path``: the MTL file of an OBJ output."""
+    stem, ext = os.path.splitext(path)
+    return [stem + ".mtl"] if ext.lower() == ".obj" else []
+
+
 def check_output(path: str, inputs: list[str], force: bool) -> None:
     """Refuse an output path that is an input, a folder, in a missing or unwritable folder,
-    or that exists while ``force`` is False (raises :class:`OutputError`)."""
+    or that exists while ``force`` is False (raises :class:`OutputError`); the same for
+    the files written with it (:func:`companions`)."""
+    for extra in companions(path):
+        _check_one(extra, inputs, force, what="the MTL file of the output")
+    _check_one(path, inputs, force)
+
+
+def _check_one(path: str, inputs: list[str], force: bool, what: str = "") -> None:
+    """:func:`check_output` for one path; ``what`` names a companion file in messages."""
+    note = f" ({what})" if what else ""
     for inp in inputs:
         if os.path.exists(path) and os.path.exists(inp) and os.path.samefile(path, inp):
-            raise OutputError("output path is the input file; choose another path", path)
+            raise OutputError(f"output path{note} is the input file; choose another path", path)
         if os.path.abspath(path) == os.path.abspath(inp):
-            raise OutputError("output path is the input file; choose another path", path)
+            raise OutputError(f"output path{note} is the input file; choose another path", path)
     if os.path.isdir(path):
-        raise OutputError("output path is a folder", path)
+        raise OutputError(f"output path{note} is a folder", path)
     if os.path.exists(path) and not force:
-        raise OutputError("exists; use --force to overwrite", path)
+        raise OutputError(f"exists{note}; use --force to overwrite", path)
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise OutputError("output folder does not exist", folder)

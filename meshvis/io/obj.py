@@ -27,7 +27,7 @@ import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
 from meshvis.io._common import atomic_write, fmt_floats, unique_names, weld_corners
-from meshvis.io.mtl import MtlSource, write_mtl
+from meshvis.io.mtl import MtlSource, TextureWarning, inside_folder, remove_created, write_mtl
 from meshvis.io.triangulate import triangulate
 from meshvis.soup import Material, Soup
 
@@ -450,6 +450,9 @@ def _read_mtllibs(mtllibs: list[str], path: str) -> dict[str, MtlSource]:
                 break
         else:
             continue
+        if not inside_folder(mtl_path, folder):
+            warnings.warn(f"{path}: MTL file {lib} is outside the model's folder; skipped", TextureWarning, 2)
+            continue
         try:
             with open(mtl_path, "rb") as fh:
                 raw = fh.read()
@@ -465,7 +468,7 @@ def _read_mtllibs(mtllibs: list[str], path: str) -> dict[str, MtlSource]:
             s = line.strip()
             if s.startswith("newmtl") and (len(s) == 6 or s[6] in " \t"):
                 if name is not None and name not in out:
-                    out[name] = MtlSource("\n".join(block), mtl_folder)
+                    out[name] = MtlSource.checked("\n".join(block), mtl_folder, folder, mtl_path, path)
                 name, block = s[6:].strip(), []
             elif name is not None and s and not s.startswith("#"):
                 block.append(s)
@@ -561,10 +564,16 @@ def write_obj(
         out.append((face_fmt * (b - a)) % tuple(fvals[a * per_face : b * per_face]))
     text = "".join(out)
     del out
-    if mtl_name:
-        write_mtl(soup.materials, mat_names, os.path.join(folder, mtl_name), folder, stem)
-    with atomic_write(path, "w") as fh:
-        fh.write(text)
+    # the OBJ, its MTL and textures are published together: a failure in any leaves none
+    created: list[str] = []
+    try:
+        with atomic_write(path, "w") as fh:
+            fh.write(text)
+            if mtl_name:
+                created = write_mtl(soup.materials, mat_names, os.path.join(folder, mtl_name), folder, stem)
+    except BaseException:
+        remove_created(created)
+        raise
 
 
 #: format name -> reader / writer, collected by :mod:`meshvis.io.reading` and :mod:`meshvis.io.writing`
