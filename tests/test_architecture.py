@@ -16,6 +16,8 @@ LAYERS = {
     "meshvis._version": 0,
     "meshvis.errors": 0,
     "meshvis.soup": 0,
+    "meshvis.limits": 0,
+    "meshvis._validate": 0,
     "meshvis.io": 1,
     "meshvis.rays": 2,
     "meshvis.geometry": 2,

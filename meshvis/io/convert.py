@@ -36,7 +36,7 @@ def as_soup(model: Any, *, name: str | None = None) -> Soup:
         return Soup(np.asarray(model.vertices), np.asarray(model.faces), path=name)
     if isinstance(model, (tuple, list)) and len(model) == 2:
         v, f = model
-        v, f = np.asarray(v), np.asarray(f)
         validate(v, f, name)
+        v, f = np.asarray(v), np.asarray(f)
         return Soup(v, f.astype(np.int64), path=name)
     raise ModelError(f"cannot use a {type(model).__name__} as a model", name)

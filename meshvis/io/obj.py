@@ -64,6 +64,10 @@ def _first_bad_face(f_lines: list[str]) -> int:
     return -1
 
 
+#: numbers on one ``v``/``vt`` line: x y z [w] or x y z r g b [a], with room to spare
+_MAX_ROW_NUMBERS = 16
+
+
 def _parse_rows(
     lines: list[str], keyword: str, width: int, what: str, label: str, line_numbers
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -96,6 +100,8 @@ def _parse_rows(
     counts = np.diff(np.append(starts, len(marked))) - 1
     values = np.delete(marked, starts)
     widest = int(counts.max())
+    if widest > _MAX_ROW_NUMBERS:  # the padded table below would be k x widest
+        raise ModelFormatError(f"a {what} line has {widest} numbers (at most {_MAX_ROW_NUMBERS})", label)
     out = np.zeros((k, widest))
     mask = np.arange(widest) < counts[:, None]
     out[mask] = values

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.io import as_soup
 
 #: default push of an origin off its surface, as a fraction of the bounding-box diagonal
@@ -96,8 +97,8 @@ class RayCaster:
 
         soup = as_soup(model)
         self.soup = soup
-        self.offset = float(offset)
-        self.threads = default_threads() if threads is None else max(1, int(threads))
+        self.offset = _validate.real("offset", offset, 0.0, 0.1)
+        self.threads = default_threads() if threads is None else _validate.integer("threads", threads, 1)
         lo, hi = soup.bounds
         self.center = 0.5 * (lo + hi)
         diag = soup.diagonal
@@ -187,10 +188,11 @@ class RayCaster:
         Hits
             ``side`` is 0 where ``dot(direction, normal) < 0`` (the ray met the front).
         """
-        origins = np.asarray(origins, np.float64).reshape(-1, 3)
-        d = self._unit_dirs(np.asarray(directions).reshape(-1, 3))
+        origins, directions = _validate.ray_arrays(origins, directions)
+        d = self._unit_dirs(directions)
         dists = None
         if max_distance is not None:
+            max_distance = _validate.max_distance(max_distance, len(origins))
             dists = np.broadcast_to(
                 np.asarray(max_distance, np.float64) * self.scale, (len(origins),)
             ).astype(np.float32)
@@ -219,8 +221,7 @@ class RayCaster:
         Both ends are excluded by ``offset`` × diagonal, so a target lying on a surface does
         not occlude itself; push origins off their own surface first (:meth:`push_off`).
         """
-        origins = np.asarray(origins, np.float64).reshape(-1, 3)
-        targets = np.asarray(targets, np.float64).reshape(-1, 3)
+        origins, targets = _validate.ray_arrays(origins, targets, "targets")
         seg = targets - origins
         length = np.linalg.norm(seg, axis=1)
         ok = length > 0
@@ -233,6 +234,7 @@ class RayCaster:
 
     def push_off(self, points: np.ndarray, face: np.ndarray, side: np.ndarray) -> np.ndarray:
         """Move points lying on ``face`` off its surface, towards ``side`` (0 front, 1 back)."""
+        face = _validate.face_indices("face", face, self.soup.n_faces)
         sign = np.where(np.asarray(side) == 0, 1.0, -1.0)
         return points + self.normals[face] * (sign * self.offset * self.diagonal)[:, None]
 
@@ -244,7 +246,7 @@ class RayCaster:
 
     def part_of(self, face: np.ndarray) -> np.ndarray:
         """Part id of each face index (-1 for misses)."""
-        face = np.asarray(face)
+        face = _validate.face_indices("face", face, self.soup.n_faces, allow_miss=True)
         out = np.full(face.shape, -1, np.int64)
         hit = face >= 0
         out[hit] = self.part_id[face[hit]]
