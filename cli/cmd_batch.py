@@ -237,6 +237,8 @@ def run(args: argparse.Namespace) -> int:
                 print(f"{r['status']}: {r['error']}")
         print(f"wrote {csv_path} and {json_path}")
     if result.interrupted:
-        print("meshvis: interrupted", file=sys.stderr)
-        return 130
+        from .signals import TERMINATED_STATUS, terminated
+
+        print(f"meshvis: {'terminated' if terminated() else 'interrupted'}", file=sys.stderr)
+        return TERMINATED_STATUS if terminated() else 130
     return 0 if result.ok else 1

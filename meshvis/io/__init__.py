@@ -18,6 +18,7 @@ from meshvis.io._common import (
     check_output,
     ensure_folder,
     one_line,
+    staged_outputs,
     unique_names,
     weld_corners,
 )
@@ -38,6 +39,7 @@ __all__ = [
     "save",
     "sniff",
     "soup_from_scene",
+    "staged_outputs",
     "unique_names",
     "weld_corners",
 ]

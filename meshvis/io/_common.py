@@ -8,6 +8,7 @@ Format modules import from here and never from :mod:`meshvis.io.reading` or
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 import stat
 import struct
@@ -39,6 +40,85 @@ def describe_exception(exc: BaseException) -> str:
     return text
 
 
+#: room a temporary name needs beyond its prefix: mkstemp's 8 random characters and ".tmp"
+_TEMP_EXTRA = 12
+
+
+def temp_prefix(path: str) -> str:
+    """``.<file name>.`` -- the start of the temporary names of ``path``, shortened so that a
+    temporary name fits the file system's name limit whenever ``path`` itself does."""
+    name = os.path.basename(path)
+    try:
+        limit = os.pathconf(os.path.dirname(os.path.abspath(path)), "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        limit = 255
+    return "." + name[: max(1, limit - _TEMP_EXTRA - 2)] + "."
+
+
+class _Stage:
+    """Outputs of one :func:`staged_outputs` block: renames still to do, files already made."""
+
+    def __init__(self) -> None:
+        self.pending: list[tuple[str, str]] = []
+        self.created: list[str] = []
+
+
+_STAGE: contextvars.ContextVar[_Stage | None] = contextvars.ContextVar("meshvis_stage", default=None)
+
+
+@contextlib.contextmanager
+def staged_outputs() -> Iterator[None]:
+    """Publish every :func:`atomic_write` of the block together when the block succeeds.
+
+    Inside the block each write stays in its temporary file; when the block ends normally
+    all of them are renamed into place (renames need no disk space), with SIGINT and SIGTERM
+    held back meanwhile.  When it raises (an error, Ctrl-C, SIGTERM) every temporary file is
+    removed, and so is every file registered with :func:`register_created` (textures):
+    a command's outputs appear together or not at all.
+    """
+    stage = _Stage()
+    token = _STAGE.set(stage)
+    try:
+        yield
+    except BaseException:
+        for tmp, _ in stage.pending:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        for p in stage.created:
+            with contextlib.suppress(OSError):
+                os.unlink(p)
+        raise
+    finally:
+        _STAGE.reset(token)
+    with _signals_held():
+        for tmp, path in stage.pending:
+            os.replace(tmp, path)
+
+
+def register_created(path: str) -> None:
+    """Note a file made outside :func:`atomic_write`, to be removed if the stage fails."""
+    stage = _STAGE.get()
+    if stage is not None:
+        stage.created.append(path)
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Delay SIGINT/SIGTERM until the block ends (main thread on POSIX; else no effect)."""
+    import signal
+    import threading
+
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held = {signal.SIGINT, signal.SIGTERM}
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-8") -> Iterator[IO]:
     """Open ``path`` for writing so that it is replaced only when writing succeeds.
@@ -46,7 +126,9 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
     The data goes to a temporary file in the same folder; on leaving the ``with`` block
     normally it is flushed, synced to disk and renamed over ``path`` (``os.replace``, atomic
     on POSIX).  On any exception the temporary file is removed and an existing ``path`` is
-    left untouched.  The new file gets the permissions of the file it replaces, or the
+    left untouched.  Inside :func:`staged_outputs` the rename waits for the end of that
+    block.  The temporary name is ``.<file name>.<random>.tmp`` (the file name shortened
+    when needed, see :func:`temp_prefix`).  The new file gets the permissions of the file it replaces, or the
     usual ones for a new file (0666 less the umask).
 
     Parameters
@@ -69,7 +151,7 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
     if not os.path.isdir(folder):
         raise OutputError("output folder does not exist", path)
     try:
-        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
+        fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path), suffix=".tmp", dir=folder)
     except PermissionError:
         raise OutputError("output folder is not writable", path) from None
     except OSError as exc:
@@ -86,7 +168,11 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
             os.umask(umask)
             perm = 0o666 & ~umask
         os.chmod(tmp, perm)
-        os.replace(tmp, path)
+        stage = _STAGE.get()
+        if stage is None:
+            os.replace(tmp, path)
+        else:
+            stage.pending.append((tmp, path))
     except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)

@@ -34,7 +34,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshvis.errors import OutputError
-from meshvis.io._common import atomic_write, one_line
+from meshvis.io._common import atomic_write, one_line, register_created, temp_prefix
 from meshvis.soup import Material
 
 # MTL statements whose last token is a file name (texture maps)
@@ -112,7 +112,7 @@ class MtlSource:
 
 
 def publish_new(
-    data_or_src: bytes | str, folder: str, wanted: str, taken: dict[str, str]
+    data_or_src: bytes | str, folder: str, wanted: str, taken: dict[str, str], prefix: str = ".meshvis-"
 ) -> tuple[str, bool]:
     """Put a texture into ``folder`` under ``wanted`` or a free variant of it, never replacing a file.
 
@@ -125,6 +125,8 @@ def publish_new(
         The preferred file name.
     taken : dict
         Names already used by this writer -> what they hold (updated).
+    prefix : str
+        Start of the temporary file's name (the batch runner removes ``.<output stem>_*.tmp``).
 
     Returns
     -------
@@ -140,7 +142,7 @@ def publish_new(
     """
     key = data_or_src if isinstance(data_or_src, str) else f"<{hash(data_or_src)}>"
     base, ext = os.path.splitext(wanted)
-    fd, tmp = tempfile.mkstemp(prefix=".meshvis-", suffix=".tmp", dir=folder)
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
     try:
         with os.fdopen(fd, "wb") as fh:
             if isinstance(data_or_src, str):
@@ -175,6 +177,7 @@ def publish_new(
                     while chunk := fin.read(1 << 20):
                         fh.write(chunk)
             taken[name] = key
+            register_created(dst)
             return name, True
         raise OutputError(f"no free name for texture {wanted}", folder)
     except OSError as exc:
@@ -348,7 +351,9 @@ def _check_mtl_target(mtl_path: str, materials: list[Material]) -> None:
             )
 
 
-def _mtl_block(src: MtlSource, name: str, out_folder: str, taken: dict, created: list[str]) -> list[str]:
+def _mtl_block(
+    src: MtlSource, name: str, out_folder: str, taken: dict, created: list[str], prefix: str
+) -> list[str]:
     """The lines of an OBJ-sourced block, its textures copied (or skipped) and renamed."""
     lines = [f"newmtl {name}"]
     map_keys = {k.lower() for k, _ in src.textures()}
@@ -365,7 +370,9 @@ def _mtl_block(src: MtlSource, name: str, out_folder: str, taken: dict, created:
             if inside_folder(full, out_folder):  # already in the output's folder: no copy
                 new = os.path.relpath(os.path.realpath(full), os.path.realpath(out_folder))
             else:
-                new, made = publish_new(full, out_folder, _safe_file_name(os.path.basename(fname)), taken)
+                new, made = publish_new(
+                    full, out_folder, _safe_file_name(os.path.basename(fname)), taken, prefix
+                )
                 if made:
                     created.append(os.path.join(out_folder, new))
             line = " ".join(parts[:-1] + [new.replace(os.sep, "/")])
@@ -398,12 +405,13 @@ def write_mtl(
     _check_mtl_target(mtl_path, materials)
     taken: dict[str, str] = {}  # output file name -> what it holds (to avoid collisions)
     created: list[str] = []
+    prefix = temp_prefix(os.path.join(out_folder, stem + "_"))[:-1]  # ".<stem>_", as the batch runner expects
     try:
         blocks = []
         for mat, name in zip(materials, names):
             src = mat.source
             if isinstance(src, MtlSource):
-                lines = _mtl_block(src, name, out_folder, taken, created)
+                lines = _mtl_block(src, name, out_folder, taken, created, prefix)
             else:
                 lines = [f"newmtl {name}"]
                 desc = describe_pbr(mat, name)
@@ -414,7 +422,7 @@ def write_mtl(
                 if desc.image is not None:
                     ext = ".jpg" if desc.mime == "image/jpeg" else ".png"
                     new, made = publish_new(
-                        desc.image, out_folder, _safe_file_name(f"{stem}_{name}") + ext, taken
+                        desc.image, out_folder, _safe_file_name(f"{stem}_{name}") + ext, taken, prefix
                     )
                     if made:
                         created.append(os.path.join(out_folder, new))

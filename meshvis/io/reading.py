@@ -110,6 +110,8 @@ def _check_readable(path: str, label: str) -> str:
         raise ModelError("file not found", label)
     if os.path.isdir(path):
         raise ModelError("is a folder, not a model file", label)
+    if not os.path.isfile(path):  # opening a FIFO would block until something writes to it
+        raise ModelError("is not a regular file (a FIFO, socket or device)", label)
     ext = os.path.splitext(path)[1].lower()
     if ext not in READ_FORMATS:
         known = ", ".join(sorted(READ_FORMATS))
