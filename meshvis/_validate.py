@@ -225,3 +225,28 @@ def names(name: str, value: Any) -> list[str]:
     if isinstance(value, (str, bytes)) or not isinstance(value, (list, tuple)):
         raise ParameterError(f"{name} must be a list of strings, got {type(value).__name__}")
     return [str(v) for v in value]
+
+
+def operation_options(options: Mapping[str, Any]) -> None:
+    """The classification options of a repair operation (``seed``, ``rays_per_node``,
+    ``samples_per_face``), checked once before a batch starts."""
+    seed(options.get("seed", 0))
+    integer(
+        "rays_per_node", options.get("rays_per_node", 32), 1, limits.MAX_RAYS_PER_NODE, "MAX_RAYS_PER_NODE"
+    )
+    integer(
+        "samples_per_face",
+        options.get("samples_per_face", 4),
+        1,
+        limits.MAX_SAMPLES_PER_FACE,
+        "MAX_SAMPLES_PER_FACE",
+    )
+
+
+def ray_budget(total: int, n_nodes: int, rays_per_node: int) -> None:
+    """Refuse a classification whose ray budget exceeds :data:`meshvis.limits.MAX_RAYS`."""
+    if total > limits.MAX_RAYS:
+        raise ParameterError(
+            f"the ray budget is {total} rays ({n_nodes} nodes at rays_per_node={rays_per_node}), more than "
+            f"the cap MAX_RAYS of meshvis.limits ({limits.MAX_RAYS}); lower rays_per_node or samples_per_face"
+        )

@@ -25,10 +25,14 @@ MAX_INSTANCED_FACES = 50_000_000
 MAX_POLYGON_CORNERS = 4_096
 #: rays per node of the graph cut (default 32); memory grows with nodes x rays
 MAX_RAYS_PER_NODE = 65_536
+#: rays of one classification (all rounds; each ray takes about 110 bytes while its round
+#: runs): the monastery (125 k faces) casts 4 M at the defaults
+MAX_RAYS = 100_000_000
 #: sample points per intersecting or coplanar face (default 4)
 MAX_SAMPLES_PER_FACE = 1_024
-#: pixels of one rendered image (one primary ray each, about 100 bytes per pixel)
-MAX_PIXELS = 8192 * 8192
+#: pixels of one rendered image: one primary ray each, about 150 bytes per pixel while
+#: rendering (8192 x 8192 took 10.3 GB and 80 s), so 4096 x 4096 stays near 2.6 GB
+MAX_PIXELS = 4096 * 4096
 #: absolute value of a coordinate: products of up to six coordinates (squared areas of
 #: cross products, squared lengths of Newell normals) must stay below the float64 maximum 1.8e308
 MAX_COORDINATE = 1e50

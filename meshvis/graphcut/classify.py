@@ -323,6 +323,7 @@ def classify(
     is_point = nodes.is_point
     rounds: list[dict] = []
     budget = ray_allocation(nodes, rays_per_node)
+    _validate.ray_budget(int(budget.sum()), nodes.n, rays_per_node)
     cast = np.zeros(nodes.n, np.int64)
     give = ray_allocation(nodes, min(FIRST_ROUND_RAYS, rays_per_node) if progressive else rays_per_node)
     prev = prev_nodes = None

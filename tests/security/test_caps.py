@@ -256,3 +256,24 @@ def test_coordinates_up_to_the_cap_give_the_unit_scale_answer(tmp_path):
         flips.append(r.flipped.tolist())
         assert meshvis.diagnose((TETRA_V * scale, f)) is not None
     assert flips[0] == flips[1] and sum(flips[0]) == 1
+
+
+def test_batch_checks_its_options_once_before_starting(tmp_path, capsys):
+    src = _tetra_obj(tmp_path / "t.obj")
+    out = tmp_path / "out"
+    for extra, needle in [
+        (["--seed", "-1"], "seed must be at least 0"),
+        (["--rays-per-node", "99999999"], "MAX_RAYS"),
+    ]:
+        _one_line_error(capsys, ["batch", src, "--op", "orient", "--out", str(out), *extra], needle)
+    assert not out.exists()
+
+
+def test_total_ray_budget_is_capped(monkeypatch):
+    """Many nodes times an allowed rays_per_node: refused by MAX_RAYS before any ray is cast."""
+    import trimesh
+
+    monkeypatch.setattr(limits, "MAX_RAYS", 10_000)
+    with pytest.raises(ParameterError, match=r"the ray budget is \d+ rays .* more than the cap MAX_RAYS"):
+        meshvis.classify(trimesh.creation.icosphere(2), rays_per_node=4096, progressive=False)
+    assert meshvis.classify(trimesh.creation.icosphere(2), rays_per_node=8).n_rays <= 10_000
