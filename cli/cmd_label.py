@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from .common import check_output, positive_int, say
+from .common import check_output, positive_int, say, staged_outputs
 
 UP_AXES = ("auto", "x", "y", "z")
 
@@ -194,17 +194,18 @@ def run(args: argparse.Namespace) -> int:
         min_pixels=args.min_pixels,
     )
     results = fr.layout_frames(soup, cameras, coherence=not args.no_coherence, **options)
-    if ext == ".gif":
-        out.write_gif(results, args.output, duration_ms=args.duration)
-    else:
-        out.write(results if len(results) > 1 else results[0], args.output, show_area=args.show_area)
-    if args.png:
-        out.write_png(results[0], args.png, show_area=args.show_area)
-    if args.json:
-        data = {"inputs": list(args.inputs), "frames": [r.to_json() for r in results]}
-        if len(results) > 1:
-            data["sequence"] = sequence_metrics(results)
-        out.write_json(data, args.json)
+    with staged_outputs():  # the pictures and the JSON appear together or not at all
+        if ext == ".gif":
+            out.write_gif(results, args.output, duration_ms=args.duration)
+        else:
+            out.write(results if len(results) > 1 else results[0], args.output, show_area=args.show_area)
+        if args.png:
+            out.write_png(results[0], args.png, show_area=args.show_area)
+        if args.json:
+            data = {"inputs": list(args.inputs), "frames": [r.to_json() for r in results]}
+            if len(results) > 1:
+                data["sequence"] = sequence_metrics(results)
+            out.write_json(data, args.json)
     first = results[0]
     m = first.metrics
     say(args, f"wrote {', '.join(paths if len(paths) <= 3 else paths[:2] + ['...', paths[-1]])}")
