@@ -245,9 +245,9 @@ def check_output(path: str, inputs: list[str], force: bool) -> None:
     """Refuse an output path that is an input, a folder, in a missing or unwritable folder,
     or that exists while ``force`` is False (raises :class:`OutputError`); the same for
     the files written with it (:func:`companions`)."""
+    _check_one(path, inputs, force)
     for extra in companions(path):
         _check_one(extra, inputs, force, what="the MTL file of the output")
-    _check_one(path, inputs, force)
 
 
 def _check_one(path: str, inputs: list[str], force: bool, what: str = "") -> None:
