@@ -91,10 +91,8 @@ def render(
     (24, 32, 3)
     """
     width, height = _validate.render_args(size, color_by, face_values, azimuth, elevation)
-    camera, caster = (
-        _validate.instance("camera", camera, Camera, True),
-        _validate.instance("caster", caster, RayCaster, True),
-    )
+    _validate.instance("camera", camera, Camera, optional=True)
+    _validate.instance("caster", caster, RayCaster, optional=True)
     soup = as_soup(model)
     caster = caster or RayCaster(soup)
     camera = camera or Camera.fit(soup, azimuth=azimuth, elevation=elevation)
