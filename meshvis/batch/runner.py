@@ -622,6 +622,19 @@ class _Worker:
         self.stop()
 
 
+def _stopped(task: FileTask, index: int, rows: list[dict], on_done: Callable) -> None:
+    """Row of a task whose worker was stopped: ``ok`` when its output and ``ok`` report were
+    complete (it finished before its message was read), else ``interrupted``, partial files removed."""
+    row = completed_row(task)
+    if row is not None:
+        row["status"] = OK
+        rows[index] = row
+        on_done(index, row)
+        return
+    discard_partial(task)
+    rows[index] = empty_row(task, INTERRUPTED, f"{task.input}: interrupted")
+
+
 def _exit_text(code: int | None) -> str:
     if code is None:
         return "did not stop"
@@ -722,10 +735,7 @@ def _run_local(
             for w in workers:
                 w.stop()
                 if w.index is not None:
-                    discard_partial(tasks[w.index])
-                    rows[w.index] = empty_row(
-                        tasks[w.index], INTERRUPTED, f"{tasks[w.index].input}: interrupted"
-                    )
+                    _stopped(tasks[w.index], w.index, rows, on_done)
             workers.clear()
         return True
     finally:

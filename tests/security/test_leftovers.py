@@ -160,7 +160,7 @@ def test_sigterm_to_a_running_command(tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env=ENV,
+        env=dict(ENV, PYTHONUNBUFFERED="1"),  # the first line arrives when printed
     )
     try:
         first = proc.stdout.readline()
