@@ -105,7 +105,7 @@ def points(name: str, value: Any, shape: tuple[int, ...] = (3,)) -> np.ndarray:
         a = a[None]
     if a.ndim != len(shape) + 1 or a.shape[1:] != shape:
         raise ParameterError(f"{name} must have shape (k, {', '.join(map(str, shape))}), got {a.shape}")
-    if not np.isfinite(a).all():
+    if not np.isfinite(a.sum()) and not np.isfinite(a).all():  # one sum is 4x faster than isfinite
         raise ParameterError(f"{name} must be finite")
     return a
 
@@ -147,14 +147,20 @@ def keywords(given: Mapping[str, Any], function: Callable) -> None:
 
 
 def ray_arrays(origins: Any, directions: Any, name: str = "directions") -> tuple[np.ndarray, np.ndarray]:
-    """(n, 3) finite origins and (n, 3) finite non-zero directions (or targets) of equal length."""
+    """(n, 3) finite origins and (n, 3) finite directions (or targets) of equal length
+    (zero directions are caught after normalising, :func:`unit_directions`)."""
     o = points("origins", origins)
     d = points(name, directions)
     if len(o) != len(d):
         raise ParameterError(f"origins ({len(o)}) and {name} ({len(d)}) differ in length")
-    if name == "directions" and len(d) and not np.einsum("ij,ij->i", d, d).all():
-        raise ParameterError("directions must be non-zero")
     return o, d
+
+
+def unit_directions(d: np.ndarray) -> np.ndarray:
+    """``d`` (directions divided by their lengths) when no direction was zero (a zero one is NaN)."""
+    if len(d) and not np.isfinite(d.sum()):
+        raise ParameterError("directions must be non-zero")
+    return d
 
 
 def face_indices(name: str, value: Any, n_faces: int, allow_miss: bool = False) -> np.ndarray:

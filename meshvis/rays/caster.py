@@ -189,7 +189,7 @@ class RayCaster:
             ``side`` is 0 where ``dot(direction, normal) < 0`` (the ray met the front).
         """
         origins, directions = _validate.ray_arrays(origins, directions)
-        d = self._unit_dirs(directions)
+        d = _validate.unit_directions(self._unit_dirs(directions))
         dists = None
         if max_distance is not None:
             max_distance = _validate.max_distance(max_distance, len(origins))
