@@ -121,7 +121,8 @@ class RayCaster:
     @staticmethod
     def _unit_dirs(directions: np.ndarray) -> np.ndarray:
         d = np.asarray(directions, np.float64)
-        return d / np.sqrt(np.einsum("ij,ij->i", d, d))[:, None]
+        with np.errstate(invalid="ignore", divide="ignore"):  # a zero direction: NaN, refused by the caller
+            return d / np.sqrt(np.einsum("ij,ij->i", d, d))[:, None]
 
     # ------------------------------------------------------------------ raw calls
     def _run(self, o32: np.ndarray, d32: np.ndarray, query: str, dists: np.ndarray | None = None) -> Any:
