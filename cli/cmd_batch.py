@@ -197,6 +197,7 @@ def _summary_table(result, out_dir: str, limit: int = 60):
 
 
 def run(args: argparse.Namespace) -> int:
+    from meshvis import _validate
     from meshvis.batch import default_jobs, plan, run_batch, write_summary
     from meshvis.errors import ParameterError
     from meshvis.io import ensure_folder
@@ -204,6 +205,7 @@ def run(args: argparse.Namespace) -> int:
     if args.dask_scheduler and args.jobs:
         raise ParameterError("--jobs sets local worker processes; with --dask-scheduler the cluster decides")
     options = {dest: getattr(args, dest) for dest in _algorithm_dests()}
+    _validate.operation_options(options)  # a bad --seed fails here once, not in every file
     tasks = plan(args.inputs, args.op, args.out, options)
     ensure_folder(args.out)
     jobs = None if args.dask_scheduler else (args.jobs or default_jobs(len(tasks)))
@@ -237,6 +239,8 @@ def run(args: argparse.Namespace) -> int:
                 print(f"{r['status']}: {r['error']}")
         print(f"wrote {csv_path} and {json_path}")
     if result.interrupted:
-        print("meshvis: interrupted", file=sys.stderr)
-        return 130
+        from .signals import TERMINATED_STATUS, terminated
+
+        print(f"meshvis: {'terminated' if terminated() else 'interrupted'}", file=sys.stderr)
+        return TERMINATED_STATUS if terminated() else 130
     return 0 if result.ok else 1

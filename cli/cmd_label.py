@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from .common import check_output, positive_int, say
+from .common import check_output, positive_int, say, staged_outputs
 
 UP_AXES = ("auto", "x", "y", "z")
 
@@ -184,17 +184,18 @@ def _write_outputs(args: argparse.Namespace, results: list, ext: str) -> None:
     from meshvis.labeling import output as out
     from meshvis.labeling.metrics import sequence_metrics
 
-    if ext == ".gif":
-        out.write_gif(results, args.output, duration_ms=args.duration)
-    else:
-        out.write(results if len(results) > 1 else results[0], args.output, show_area=args.show_area)
-    if args.png:
-        out.write_png(results[0], args.png, show_area=args.show_area)
-    if args.json:
-        data = {"inputs": list(args.inputs), "frames": [r.to_json() for r in results]}
-        if len(results) > 1:
-            data["sequence"] = sequence_metrics(results)
-        out.write_json(data, args.json)
+    with staged_outputs():  # the pictures and the JSON appear together or not at all
+        if ext == ".gif":
+            out.write_gif(results, args.output, duration_ms=args.duration)
+        else:
+            out.write(results if len(results) > 1 else results[0], args.output, show_area=args.show_area)
+        if args.png:
+            out.write_png(results[0], args.png, show_area=args.show_area)
+        if args.json:
+            data = {"inputs": list(args.inputs), "frames": [r.to_json() for r in results]}
+            if len(results) > 1:
+                data["sequence"] = sequence_metrics(results)
+            out.write_json(data, args.json)
 
 
 def _report(args: argparse.Namespace, results: list, paths: list[str]) -> None:

@@ -3,7 +3,8 @@
 Each subcommand lives in its own module of this package with two functions:
 ``add_parser(subparsers)`` and ``run(args) -> int``.  User errors (:class:`MeshvisError`)
 print one line and exit with status 2, as do refused file operations (``OSError``: disk
-full, I/O error); warnings print as one line; Ctrl-C exits with 130.
+full, I/O error); warnings print as one line; Ctrl-C exits with 130 and SIGTERM with 143,
+both after removing temporary files (:mod:`.signals`).
 """
 
 from __future__ import annotations
@@ -60,13 +61,18 @@ def main(argv: list[str] | None = None) -> int:
     if not getattr(args, "func", None):
         parser.print_help()
         return 2
+    from .signals import TERMINATED_STATUS, Terminated, sigterm_stops
+
     try:
-        with warnings.catch_warnings():
+        with warnings.catch_warnings(), sigterm_stops():
             warnings.showwarning = _show_warning
             return int(args.func(args) or 0)
     except MeshvisError as exc:
         print(f"meshvis: error: {exc}", file=sys.stderr)
         return 2
+    except Terminated:
+        print("meshvis: terminated", file=sys.stderr)
+        return TERMINATED_STATUS
     except KeyboardInterrupt:
         print("meshvis: interrupted", file=sys.stderr)
         return 130

@@ -404,8 +404,16 @@ def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -
     ModelError
         The first problem found, in one line.
     """
-    vertices = np.asarray(vertices)
-    faces = np.asarray(faces)
+    try:
+        vertices, faces = np.asarray(vertices), np.asarray(faces)
+    except (TypeError, ValueError) as exc:  # ragged lists, objects numpy cannot hold
+        raise ModelError(f"vertices and faces must be numeric arrays ({exc})", path) from None
+    if np.iscomplexobj(vertices):
+        raise ModelError("vertex coordinates are complex numbers", path)
+    if vertices.dtype.kind not in "iuf":
+        raise ModelError(f"vertex coordinates must be numbers, got dtype {vertices.dtype}", path)
+    if faces.dtype.kind not in "iuf" and not (faces.size == 0 and faces.dtype.kind == "O"):
+        raise ModelError(f"face indices must be integers, got dtype {faces.dtype}", path)
     if vertices.ndim != 2 or vertices.shape[1] != 3:
         raise ModelError(f"vertices must have shape (n, 3), got {vertices.shape}", path)
     if faces.ndim != 2 or faces.shape[1] != 3:
@@ -415,6 +423,9 @@ def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -
     if not np.issubdtype(faces.dtype, np.integer):
         if not np.all(np.isfinite(faces)) or np.any(faces != np.round(faces)):
             raise ModelError("face indices are not integers", path)
+        if np.abs(faces).max() >= 2**62:
+            raise ModelError("face indices are out of range", path)
+        faces = faces.astype(np.int64)
     bad = ~np.isfinite(vertices).all(axis=1)
     if bad.any():
         used_bad = np.intersect1d(np.flatnonzero(bad), faces.ravel())
@@ -430,5 +441,10 @@ def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -
     if hi >= len(vertices):
         raise ModelError(f"vertex index {hi} is out of range (the model has {len(vertices)} vertices)", path)
     used = vertices[np.unique(faces)]
-    if float(np.abs(used).max()) > 1e300:  # compared as a Python float: no float32 overflow
-        raise ModelError("coordinates too large to compute with (above 1e300)", path)
+    from meshvis import limits
+
+    if float(np.abs(used).max()) > limits.MAX_COORDINATE:  # a Python float: no float32 overflow
+        raise ModelError(
+            f"coordinates too large to compute with (above {limits.MAX_COORDINATE:g}, the cap of meshvis.limits)",
+            path,
+        )

@@ -17,6 +17,8 @@ LAYERS = {
     "meshvis.errors": 0,
     "meshvis._extras": 0,
     "meshvis.soup": 0,
+    "meshvis.limits": 0,
+    "meshvis._validate": 0,
     "meshvis.io": 1,
     "meshvis.rays": 2,
     "meshvis.geometry": 2,

@@ -24,8 +24,8 @@ from dataclasses import asdict
 from typing import Any
 
 from .plan import default_jobs
-from .tasks import CRASHED, DEFAULT_RUNNER, INTERRUPTED, TIMEOUT, FileTask, empty_row
-from .work import _fail, _resolve, discard_partial, run_file
+from .tasks import CRASHED, DEFAULT_RUNNER, INTERRUPTED, OK, TIMEOUT, FileTask, empty_row
+from .work import _fail, _resolve, completed_row, discard_partial, run_file
 
 #: seconds a fresh worker process may take to import meshvis before it counts as crashed
 STARTUP_LIMIT = 300.0
@@ -176,14 +176,29 @@ def _lost_row(w: _Worker, task: FileTask, kind: str, time_limit: float | None, n
     return row
 
 
-def _interrupt(workers: list[_Worker], tasks: list[FileTask], rows: list[dict]) -> None:
-    """Ctrl-C: stop every worker, discard the partial outputs of their tasks, mark them interrupted."""
+def _stopped(task: FileTask, index: int, rows: list[dict], on_done: Callable) -> None:
+    """Row of a task whose worker was stopped.
+
+    ``ok`` when its output and ``ok`` report were complete (it finished before its message
+    was read), else ``interrupted``, with the partial files removed.
+    """
+    row = completed_row(task)
+    if row is not None:
+        row["status"] = OK
+        rows[index] = row
+        on_done(index, row)
+        return
+    discard_partial(task)
+    rows[index] = empty_row(task, INTERRUPTED, f"{task.input}: interrupted")
+
+
+def _interrupt(workers: list[_Worker], tasks: list[FileTask], rows: list[dict], on_done: Callable) -> None:
+    """Ctrl-C or SIGTERM: stop every worker; their tasks are done or interrupted (:func:`_stopped`)."""
     with _sigint_ignored():
         for w in workers:
             w.stop()
             if w.index is not None:
-                discard_partial(tasks[w.index])
-                rows[w.index] = empty_row(tasks[w.index], INTERRUPTED, f"{tasks[w.index].input}: interrupted")
+                _stopped(tasks[w.index], w.index, rows, on_done)
         workers.clear()
 
 
@@ -238,7 +253,7 @@ def _run_local(
                             )
         return False
     except KeyboardInterrupt:
-        _interrupt(workers, tasks, rows)
+        _interrupt(workers, tasks, rows, on_done)
         return True
     finally:
         with _sigint_ignored():

@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis._version import __version__
 from meshvis.errors import ModelError, ParameterError
 from meshvis.graphcut.hints import Hints, hint_weights
@@ -250,6 +251,10 @@ def classify(
     >>> bool(c.side_outside[:, 0].all() and not c.side_outside[:, 1].any())
     True
     """
+    _validate.classify_args(
+        rays_per_node, seed, samples_per_face, sampling_scheme, opening, tolerance, solver, offset, progress
+    )
+    _validate.instance("caster", caster, RayCaster, optional=True)
     if rays_per_node < 1:
         raise ParameterError(f"rays_per_node must be at least 1, got {rays_per_node}")
     if samples_per_face < 1:
@@ -318,6 +323,7 @@ def classify(
     is_point = nodes.is_point
     rounds: list[dict] = []
     budget = ray_allocation(nodes, rays_per_node)
+    _validate.ray_budget(int(budget.sum()), nodes.n, rays_per_node)
     cast = np.zeros(nodes.n, np.int64)
     give = ray_allocation(nodes, min(FIRST_ROUND_RAYS, rays_per_node) if progressive else rays_per_node)
     prev = prev_nodes = None

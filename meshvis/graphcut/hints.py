@@ -13,6 +13,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.errors import ParameterError
 from meshvis.graphcut.nodes import NodeSet
 from meshvis.rays.caster import RayCaster
@@ -49,17 +50,14 @@ class Hints:
 
     def __post_init__(self) -> None:
         for name in ("inside_points", "outside_points"):
-            a = np.asarray(getattr(self, name), np.float64).reshape(-1, 3)
-            if not np.isfinite(a).all():
-                raise ParameterError(f"{name.replace('_', ' ')} must be finite")
-            setattr(self, name, a)
+            setattr(self, name, _validate.points(name, getattr(self, name), (3,)))
         for name in ("inside_boxes", "outside_boxes"):
-            boxes = np.asarray(getattr(self, name), np.float64).reshape(-1, 2, 3)
-            if not np.isfinite(boxes).all() or np.any(boxes[:, 1] < boxes[:, 0]):
+            a = _validate.points(name, getattr(self, name), (2, 3))
+            if np.any(a[:, 1] < a[:, 0]):
                 raise ParameterError(f"{name.replace('_', ' ')} must be finite (min, max) corner pairs")
-            setattr(self, name, boxes)
-        if self.rays < 1:
-            raise ParameterError("hint rays must be at least 1")
+            setattr(self, name, a)
+        self.rays = _validate.integer("hint rays", self.rays, 1, 1 << 20)
+        self.strength = _validate.real("hint strength", self.strength, 0.0, open_lo=True)
 
     @classmethod
     def coerce(cls, hints) -> Hints | None:
@@ -67,6 +65,7 @@ class Hints:
         if hints is None or isinstance(hints, Hints):
             return hints
         if isinstance(hints, dict):
+            _validate.keywords(hints, cls)
             return cls(**hints)
         raise ParameterError(f"hints must be a Hints or a dict, got {type(hints).__name__}")
 

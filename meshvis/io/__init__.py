@@ -19,6 +19,7 @@ from meshvis.io._common import (
     check_output,
     ensure_folder,
     one_line,
+    staged_outputs,
     unique_names,
     weld_corners,
 )
@@ -39,6 +40,7 @@ __all__ = [
     "save",
     "sniff",
     "soup_from_scene",
+    "staged_outputs",
     "unique_names",
     "weld_corners",
 ]

@@ -10,6 +10,7 @@ Format modules import from here and never from :mod:`meshvis.io.reading` or
 from __future__ import annotations
 
 import contextlib
+import contextvars
 import os
 import stat
 import struct
@@ -41,6 +42,85 @@ def describe_exception(exc: BaseException) -> str:
     return text
 
 
+#: room a temporary name needs beyond its prefix: mkstemp's 8 random characters and ".tmp"
+_TEMP_EXTRA = 12
+
+
+def temp_prefix(path: str) -> str:
+    """``.<file name>.`` -- the start of the temporary names of ``path``, shortened so that a
+    temporary name fits the file system's name limit whenever ``path`` itself does."""
+    name = os.path.basename(path)
+    try:
+        limit = os.pathconf(os.path.dirname(os.path.abspath(path)), "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        limit = 255
+    return "." + name[: max(1, limit - _TEMP_EXTRA - 2)] + "."
+
+
+class _Stage:
+    """Outputs of one :func:`staged_outputs` block: renames still to do, files already made."""
+
+    def __init__(self) -> None:
+        self.pending: list[tuple[str, str]] = []
+        self.created: list[str] = []
+
+
+_STAGE: contextvars.ContextVar[_Stage | None] = contextvars.ContextVar("meshvis_stage", default=None)
+
+
+@contextlib.contextmanager
+def staged_outputs() -> Iterator[None]:
+    """Publish every :func:`atomic_write` of the block together when the block succeeds.
+
+    Inside the block each write stays in its temporary file; when the block ends normally
+    all of them are renamed into place (renames need no disk space), with SIGINT and SIGTERM
+    held back meanwhile.  When it raises (an error, Ctrl-C, SIGTERM) every temporary file is
+    removed, and so is every file registered with :func:`register_created` (textures):
+    a command's outputs appear together or not at all.
+    """
+    stage = _Stage()
+    token = _STAGE.set(stage)
+    try:
+        yield
+    except BaseException:
+        for tmp, _ in stage.pending:
+            with contextlib.suppress(OSError):
+                os.unlink(tmp)
+        for p in stage.created:
+            with contextlib.suppress(OSError):
+                os.unlink(p)
+        raise
+    finally:
+        _STAGE.reset(token)
+    with _signals_held():
+        for tmp, path in stage.pending:
+            os.replace(tmp, path)
+
+
+def register_created(path: str) -> None:
+    """Note a file made outside :func:`atomic_write`, to be removed if the stage fails."""
+    stage = _STAGE.get()
+    if stage is not None:
+        stage.created.append(path)
+
+
+@contextlib.contextmanager
+def _signals_held() -> Iterator[None]:
+    """Delay SIGINT/SIGTERM until the block ends (main thread on POSIX; else no effect)."""
+    import signal
+    import threading
+
+    if not hasattr(signal, "pthread_sigmask") or threading.current_thread() is not threading.main_thread():
+        yield
+        return
+    held = {signal.SIGINT, signal.SIGTERM}
+    old = signal.pthread_sigmask(signal.SIG_BLOCK, held)
+    try:
+        yield
+    finally:
+        signal.pthread_sigmask(signal.SIG_SETMASK, old)
+
+
 @contextlib.contextmanager
 def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-8") -> Iterator[IO]:
     """Open ``path`` for writing so that it is replaced only when writing succeeds.
@@ -48,7 +128,9 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
     The data goes to a temporary file in the same folder; on leaving the ``with`` block
     normally it is flushed, synced to disk and renamed over ``path`` (``os.replace``, atomic
     on POSIX).  On any exception the temporary file is removed and an existing ``path`` is
-    left untouched.  The new file gets the permissions of the file it replaces, or the
+    left untouched.  Inside :func:`staged_outputs` the rename waits for the end of that
+    block.  The temporary name is ``.<file name>.<random>.tmp`` (the file name shortened
+    when needed, see :func:`temp_prefix`).  The new file gets the permissions of the file it replaces, or the
     usual ones for a new file (0666 less the umask).
 
     Parameters
@@ -79,7 +161,7 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
     if not os.path.isdir(folder):
         raise OutputError("output folder does not exist", path)
     try:
-        fd, tmp = tempfile.mkstemp(prefix="." + os.path.basename(path) + ".", suffix=".tmp", dir=folder)
+        fd, tmp = tempfile.mkstemp(prefix=temp_prefix(path), suffix=".tmp", dir=folder)
     except PermissionError:
         raise OutputError("output folder is not writable", path) from None
     except OSError as exc:
@@ -97,7 +179,11 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
             os.umask(umask)
             perm = 0o666 & ~umask
         os.chmod(tmp, perm)
-        os.replace(tmp, path)
+        stage = _STAGE.get()
+        if stage is None:
+            os.replace(tmp, path)
+        else:
+            stage.pending.append((tmp, path))
     except BaseException as exc:
         with contextlib.suppress(OSError):
             os.unlink(tmp)
@@ -163,8 +249,16 @@ def unique_names(names: list[str], fallback: str) -> list[str]:
     return out
 
 
+def companions(path: str) -> list[str]:
+    """Files written along with ``path``: the MTL file of an OBJ output."""
+    stem, ext = os.path.splitext(path)
+    return [stem + ".mtl"] if ext.lower() == ".obj" else []
+
+
 def check_output(path: str, inputs: list[str], force: bool) -> None:
     """Refuse an output path that cannot or must not be written.
+
+    The same checks apply to the files written with it (:func:`companions`).
 
     Parameters
     ----------
@@ -181,15 +275,23 @@ def check_output(path: str, inputs: list[str], force: bool) -> None:
         ``path`` is an input or a folder, its folder is missing or unwritable, or it exists
         while ``force`` is False.
     """
+    _check_one(path, inputs, force)
+    for extra in companions(path):
+        _check_one(extra, inputs, force, what="the MTL file of the output")
+
+
+def _check_one(path: str, inputs: list[str], force: bool, what: str = "") -> None:
+    """:func:`check_output` for one path; ``what`` names a companion file in messages."""
+    note = f" ({what})" if what else ""
     for inp in inputs:
         if os.path.exists(path) and os.path.exists(inp) and os.path.samefile(path, inp):
-            raise OutputError("output path is the input file; choose another path", path)
+            raise OutputError(f"output path{note} is the input file; choose another path", path)
         if os.path.abspath(path) == os.path.abspath(inp):
-            raise OutputError("output path is the input file; choose another path", path)
+            raise OutputError(f"output path{note} is the input file; choose another path", path)
     if os.path.isdir(path):
-        raise OutputError("output path is a folder", path)
+        raise OutputError(f"output path{note} is a folder", path)
     if os.path.exists(path) and not force:
-        raise OutputError("exists; use --force to overwrite", path)
+        raise OutputError(f"exists{note}; use --force to overwrite", path)
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
         raise OutputError("output folder does not exist", folder)

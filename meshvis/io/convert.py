@@ -35,7 +35,7 @@ def as_soup(model: Any, *, name: str | None = None) -> Soup:
         return soup_from_mesh(model, path=name)
     if isinstance(model, (tuple, list)) and len(model) == 2:
         v, f = model
-        v, f = np.asarray(v), np.asarray(f)
         validate(v, f, name)
+        v, f = np.asarray(v), np.asarray(f)
         return Soup(v, f.astype(np.int64), path=name)
     raise ModelError(f"cannot use a {type(model).__name__} as a model", name)

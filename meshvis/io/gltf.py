@@ -95,12 +95,163 @@ def _instances(doc: dict) -> list[tuple[int, np.ndarray]]:
     return out
 
 
+# ---------------------------------------------------------------------------- checks
+# (before trimesh sees the file: what it may read, how far it may expand, what must index what)
+def check_document(doc: dict, path: str, label: str) -> None:
+    """Refuse a glTF document that reads outside its folder, expands past the caps of
+    :mod:`meshvis.limits`, or whose accessors point at nothing (raises :class:`ModelFormatError`)."""
+    _check_uris(doc, path, label)
+    _check_accessors(doc, label)
+    _check_node_graph(doc, label)
+
+
+def _check_uris(doc: dict, path: str, label: str) -> None:
+    """External buffers and images must be files in the model's folder (or below)."""
+    import os
+    from urllib.parse import unquote
+
+    from meshvis.io.mtl import inside_folder
+
+    folder = os.path.dirname(os.path.abspath(path))
+    for kind in ("buffers", "images"):
+        for i, item in enumerate(_list(doc, kind, label)):
+            uri = item.get("uri") if isinstance(item, dict) else None
+            if not isinstance(uri, str) or uri.startswith("data:"):
+                continue
+            if "://" in uri or not inside_folder(os.path.join(folder, unquote(uri)), folder):
+                raise ModelFormatError(f"{kind[:-1]} {i} refers to {uri}, outside the model's folder", label)
+
+
+def _list(doc: dict, key: str, label: str) -> list:
+    value = doc.get(key, [])
+    if not isinstance(value, list):
+        raise ModelFormatError(f"'{key}' is not a list", label)
+    return value
+
+
+def _index(value, n: int) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and 0 <= value < n
+
+
+def _check_accessors(doc: dict, label: str) -> None:
+    """Every accessor's bufferView exists and holds it; every bufferView lies in its buffer."""
+    buffers, views = _list(doc, "buffers", label), _list(doc, "bufferViews", label)
+    for i, v in enumerate(views):
+        if not isinstance(v, dict) or not _index(v.get("buffer"), len(buffers)):
+            raise ModelFormatError(f"bufferView {i} refers to a buffer that does not exist", label)
+        end = int(v.get("byteOffset", 0)) + int(v.get("byteLength", 0))
+        if min(int(v.get("byteOffset", 0)), int(v.get("byteLength", 0))) < 0 or (
+            "byteLength" in buffers[v["buffer"]] and end > int(buffers[v["buffer"]]["byteLength"])
+        ):
+            raise ModelFormatError(f"bufferView {i} lies outside its buffer", label)
+    sizes = {5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4}
+    widths = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
+    for i, a in enumerate(_list(doc, "accessors", label)):
+        if not isinstance(a, dict):
+            raise ModelFormatError(f"accessor {i} is not an object", label)
+        count = a.get("count", 0)
+        if not isinstance(count, int) or isinstance(count, bool) or count < 0:
+            raise ModelFormatError(f"accessor {i} has an invalid count {count!r}", label)
+        if "bufferView" not in a:
+            continue  # all zeros (or sparse)
+        if not _index(a["bufferView"], len(views)):
+            raise ModelFormatError(
+                f"accessor {i} refers to bufferView {a['bufferView']!r}, which does not exist", label
+            )
+        if a.get("componentType") in sizes and a.get("type") in widths and count:
+            view = views[a["bufferView"]]
+            item = sizes[a["componentType"]] * widths[a["type"]]
+            need = int(a.get("byteOffset", 0)) + (count - 1) * int(view.get("byteStride", item)) + item
+            if need > int(view.get("byteLength", 0)):
+                raise ModelFormatError(
+                    f"accessor {i} reads past the end of bufferView {a['bufferView']}", label
+                )
+
+
+def _check_node_graph(doc: dict, label: str) -> None:
+    """Count node instances and instanced triangles by the paths through the node graph
+    (memoised, so a graph that doubles at every level is counted in linear time)."""
+    from meshvis import limits
+
+    nodes, meshes, accessors = (_list(doc, k, label) for k in ("nodes", "meshes", "accessors"))
+
+    def mesh_faces(mi) -> int:
+        if not _index(mi, len(meshes)) or not isinstance(meshes[mi], dict):
+            return 0
+        total = 0
+        for prim in meshes[mi].get("primitives", []):
+            key = prim.get("indices", prim.get("attributes", {}).get("POSITION"))
+            if _index(key, len(accessors)) and isinstance(accessors[key], dict):
+                total += int(accessors[key].get("count", 0)) // 3
+        return total
+
+    memo: dict[int, tuple[int, int]] = {}
+    for i in _node_order(nodes, label):  # children before parents
+        node = nodes[i]
+        inst, faces = (1, mesh_faces(node["mesh"])) if "mesh" in node else (0, 0)
+        for c in node.get("children", []):
+            inst, faces = inst + memo[c][0], faces + memo[c][1]
+        memo[i] = (min(inst, 1 << 62), min(faces, 1 << 62))
+    scenes = _list(doc, "scenes", label)
+    if scenes:
+        s = doc.get("scene", 0)
+        roots = scenes[s if _index(s, len(scenes)) else 0].get("nodes", [])
+    else:
+        children = {c for n in nodes for c in n.get("children", [])}
+        roots = [i for i in range(len(nodes)) if i not in children]
+    inst = sum(memo[r][0] for r in roots if r in memo)
+    faces = sum(memo[r][1] for r in roots if r in memo)
+    if inst > limits.MAX_INSTANCES:
+        raise ModelFormatError(
+            f"the scene places {inst} mesh instances, more than the cap of {limits.MAX_INSTANCES}", label
+        )
+    if faces > limits.MAX_INSTANCED_FACES:
+        raise ModelFormatError(
+            f"the scene instances {faces} triangles, more than the cap of {limits.MAX_INSTANCED_FACES}", label
+        )
+
+
+def _node_order(nodes: list, label: str) -> list[int]:
+    """Node indices with every child before its parents; refuses bad child indices and cycles."""
+    state = [0] * len(nodes)  # 0 new, 1 on the stack, 2 done
+    order: list[int] = []
+    for start in range(len(nodes)):
+        if state[start]:
+            continue
+        stack = [(start, iter(_children(nodes, start, label)))]
+        state[start] = 1
+        while stack:
+            i, it = stack[-1]
+            c = next(it, None)
+            if c is None:
+                stack.pop()
+                state[i] = 2
+                order.append(i)
+            elif state[c] == 1:
+                raise ModelFormatError(f"node {c} is its own ancestor (a cycle in the node graph)", label)
+            elif state[c] == 0:
+                state[c] = 1
+                stack.append((c, iter(_children(nodes, c, label))))
+    return order
+
+
+def _children(nodes: list, i: int, label: str) -> list[int]:
+    node = nodes[i]
+    if not isinstance(node, dict):
+        raise ModelFormatError(f"node {i} is not an object", label)
+    kids = node.get("children", [])
+    if not isinstance(kids, list) or not all(_index(c, len(nodes)) for c in kids):
+        raise ModelFormatError(f"node {i} has a child that does not exist", label)
+    return kids
+
+
 def read_gltf(path: str, label: str | None = None) -> Soup:
     """Read a .glb / .gltf file into a flattened soup (see the module docstring)."""
     import trimesh
 
     label = label or path
     doc, buffers, glb_bin = read_container(path, label)
+    check_document(doc, path, label)
     with open(path, "rb") as fh:
         ftype = "glb" if fh.read(4) == _GLB_MAGIC else "gltf"
     scene = trimesh.load(path, file_type=ftype, force="scene", process=False, maintain_order=True)

@@ -9,23 +9,46 @@ A :class:`~meshvis.soup.Material` keeps what its reader produced in ``source``:
 The writers go through the two functions here, which translate any of those into what
 their format holds: an MTL block with copied textures, or a glTF PBR description with the
 base colour texture as image bytes.
+
+Files are handled by the rules of ``docs/security.md``: a texture is read only from the
+model's own folder (and below), never through ``../`` or an absolute path outside it (a
+warning names the skipped texture); a texture is written only under a new name inside the
+output's folder (a name taken by a different file gets ``_1``, ``_2``...; a file with the
+same bytes is reused), never over an existing file and never over an input; the MTL file
+is never written over the input's own MTL.  The OBJ writer publishes the MTL and the
+textures together with the OBJ (:func:`write_mtl` returns what it created, so that a
+failure removes it).
 """
 
 from __future__ import annotations
 
+import contextlib
+import filecmp
 import io
 import os
 import re
-import shutil
+import tempfile
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
 
-from meshvis.io._common import atomic_write
+from meshvis.errors import OutputError
+from meshvis.io._common import atomic_write, one_line, register_created, temp_prefix
 from meshvis.soup import Material
 
 # MTL statements whose last token is a file name (texture maps)
 _MAP_STATEMENTS = re.compile(r"^\s*(map_\w+|bump|disp|decal|refl|norm)\s", re.IGNORECASE)
+
+
+class TextureWarning(UserWarning):
+    """A texture was skipped: outside the model's folder, missing, or not an image."""
+
+
+def inside_folder(path: str, folder: str) -> bool:
+    """True when ``path`` (symbolic links resolved) lies in ``folder`` or below it."""
+    real, root = os.path.realpath(path), os.path.realpath(folder)
+    return real == root or real.startswith(root.rstrip(os.sep) + os.sep)
 
 
 @dataclass
@@ -38,10 +61,27 @@ class MtlSource:
         The statements of the material's ``newmtl`` block, without the ``newmtl`` line.
     folder : str
         Folder of the MTL file; texture paths in ``text`` are relative to it.
+    root : str, optional
+        The model's folder: no texture outside it is read (default: ``folder``).
+    path : str, optional
+        The MTL file, which a writer must never replace.
+    label : str, optional
+        The model's name in warnings.
     """
 
     text: str
     folder: str
+    root: str | None = None
+    path: str | None = None
+    label: str | None = None
+
+    @classmethod
+    def checked(cls, text: str, folder: str, root: str, path: str, label: str) -> MtlSource:
+        """A source whose textures outside ``root`` are named in a :class:`TextureWarning` now."""
+        src = cls(text, folder, root, path, label)
+        for _, fname in src.textures():
+            src.texture_path(fname)
+        return src
 
     def textures(self) -> list[tuple[str, str]]:
         """(statement keyword, file name) of every texture map the block references."""
@@ -53,14 +93,113 @@ class MtlSource:
                     out.append((parts[0], parts[-1]))
         return out
 
+    def texture_path(self, fname: str, warn: bool = True) -> str | None:
+        """The file of texture ``fname``, or None (with a :class:`TextureWarning`) when it is
+        outside the model's folder or missing."""
+        root = self.root if self.root is not None else self.folder
+        full = os.path.normpath(os.path.join(self.folder, fname))
+        who = f"{self.label}: " if self.label else ""
+        if not inside_folder(full, root):
+            if warn:
+                warnings.warn(
+                    f"{who}texture {fname} is outside the model's folder; skipped", TextureWarning, 2
+                )
+            return None
+        return full if os.path.isfile(full) else None
 
-# ---------------------------------------------------------------------------- parsing helpers
+
+# ---------------------------------------------------------------------------- file helpers
 
 
-def copy_texture(src: str, dst: str) -> None:
-    """Copy a texture file with :func:`meshvis.io.atomic_write`."""
-    with open(src, "rb") as fin, atomic_write(dst, "wb") as fout:
-        shutil.copyfileobj(fin, fout)
+def publish_new(
+    data_or_src: bytes | str, folder: str, wanted: str, taken: dict[str, str], prefix: str = ".meshvis-"
+) -> tuple[str, bool]:
+    """Put a texture into ``folder`` under ``wanted`` or a free variant of it, never replacing a file.
+
+    Parameters
+    ----------
+    data_or_src : bytes (the image) or str (a file to copy)
+    folder : str
+        The output's folder.
+    wanted : str
+        The preferred file name.
+    taken : dict
+        Names already used by this writer -> what they hold (updated).
+    prefix : str
+        Start of the temporary file's name (the batch runner removes ``.<output stem>_*.tmp``).
+
+    Returns
+    -------
+    name : str
+        The file name used.
+    created : bool
+        Whether a new file was created (False: a file with the same bytes was reused).
+
+    Notes
+    -----
+    The bytes go to a temporary file that is hard-linked to the final name: ``os.link``
+    fails when the name exists, so two writers (batch workers) never overwrite each other.
+    """
+    key = data_or_src if isinstance(data_or_src, str) else f"<{hash(data_or_src)}>"
+    base, ext = os.path.splitext(wanted)
+    fd, tmp = tempfile.mkstemp(prefix=prefix, suffix=".tmp", dir=folder)
+    try:
+        with os.fdopen(fd, "wb") as fh:
+            if isinstance(data_or_src, str):
+                with open(data_or_src, "rb") as fin:
+                    while chunk := fin.read(1 << 20):
+                        fh.write(chunk)
+            else:
+                fh.write(data_or_src)
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.chmod(tmp, 0o666 & ~_umask())
+        for k in range(10_000):
+            name = wanted if k == 0 else f"{base}_{k}{ext}"
+            if name in taken and taken[name] != key:
+                continue
+            dst = os.path.join(folder, name)
+            if os.path.lexists(dst):
+                if os.path.isfile(dst) and not os.path.islink(dst) and filecmp.cmp(dst, tmp, shallow=False):
+                    taken[name] = key
+                    return name, False
+                continue
+            try:
+                os.link(tmp, dst)
+            except FileExistsError:
+                continue
+            except OSError:  # no hard links on this file system: exclusive create instead
+                try:
+                    out = os.open(dst, os.O_WRONLY | os.O_CREAT | os.O_EXCL, 0o666)
+                except FileExistsError:
+                    continue
+                with os.fdopen(out, "wb") as fh, open(tmp, "rb") as fin:
+                    while chunk := fin.read(1 << 20):
+                        fh.write(chunk)
+            taken[name] = key
+            register_created(dst)
+            return name, True
+        raise OutputError(f"no free name for texture {wanted}", folder)
+    except OSError as exc:
+        if isinstance(exc, OutputError):
+            raise
+        raise OutputError(f"cannot write texture {wanted}: {one_line(exc.strerror or exc)}", folder) from None
+    finally:
+        with contextlib.suppress(OSError):
+            os.unlink(tmp)
+
+
+def _umask() -> int:
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
+def remove_created(paths: list[str]) -> None:
+    """Remove files a failed write created (best effort)."""
+    for p in paths:
+        with contextlib.suppress(OSError):
+            os.unlink(p)
 
 
 _IMAGE_MIME = {b"\x89PNG": "image/png", b"\xff\xd8\xff": "image/jpeg"}
@@ -97,7 +236,12 @@ def _safe_file_name(text: str) -> str:
 
 
 def _image_bytes(image) -> tuple[bytes | None, str | None]:
-    """PNG bytes of a PIL image (kept as JPEG/PNG bytes when they are already bytes)."""
+    """PNG bytes of a PIL image (kept as JPEG/PNG bytes when they are already bytes).
+
+    Raises
+    ------
+    OSError (PIL's ``UnidentifiedImageError``) when the bytes are not an image.
+    """
     if image is None:
         return None, None
     if isinstance(image, (bytes, bytearray)):
@@ -113,6 +257,25 @@ def _image_bytes(image) -> tuple[bytes | None, str | None]:
         img = img.convert("RGBA")
     img.save(buf, format="PNG", compress_level=1)  # fast; size matters less than time here
     return buf.getvalue(), "image/png"
+
+
+def _texture_image(src: MtlSource, fname: str) -> tuple[bytes | None, str | None]:
+    """Image bytes of an MTL texture for embedding, or (None, None) with a warning."""
+    full = src.texture_path(fname, warn=False)  # the reader warned about outside paths
+    if full is None:
+        return None, None
+    with open(full, "rb") as fh:
+        data = fh.read()
+    try:
+        return _image_bytes(data)
+    except Exception as exc:  # PIL raises several kinds for bytes that are not an image
+        who = f"{src.label}: " if src.label else ""
+        warnings.warn(
+            f"{who}texture {fname} is not an image ({type(exc).__name__}); written without it",
+            TextureWarning,
+            3,
+        )
+        return None, None
 
 
 def _mtl_values(text: str) -> dict[str, list[str]]:
@@ -141,10 +304,8 @@ def describe_pbr(material: Material | None, name: str) -> PbrDescription:
             pass
         for key, fname in src.textures():
             if key.lower() == "map_kd":
-                full = os.path.join(src.folder, fname)
-                if os.path.isfile(full):
-                    with open(full, "rb") as fh:
-                        desc.image, desc.mime = _image_bytes(fh.read())
+                desc.image, desc.mime = _texture_image(src, fname)
+                if desc.image is not None:
                     desc.base_color[:3] = 1.0  # the texture carries the colour
                 break
         if desc.base_color[3] < 1.0:
@@ -168,63 +329,111 @@ def describe_pbr(material: Material | None, name: str) -> PbrDescription:
     return desc
 
 
-def write_mtl(materials: list[Material], names: list[str], mtl_path: str, out_folder: str, stem: str) -> None:
+def _protected(materials: list[Material]) -> list[str]:
+    """Input files an output must never replace: the source MTL files and textures."""
+    out = []
+    for mat in materials:
+        src = mat.source
+        if isinstance(src, MtlSource):
+            if src.path:
+                out.append(src.path)
+            out += [p for _, f in src.textures() if (p := src.texture_path(f, warn=False))]
+    return out
+
+
+def _check_mtl_target(mtl_path: str, materials: list[Material]) -> None:
+    if not os.path.exists(mtl_path):
+        return
+    for p in _protected(materials):
+        if os.path.exists(p) and os.path.samefile(p, mtl_path):
+            raise OutputError(
+                "is a file of the input model (its MTL or a texture); choose another output name", mtl_path
+            )
+
+
+def _mtl_block(
+    src: MtlSource, name: str, out_folder: str, taken: dict, created: list[str], prefix: str
+) -> list[str]:
+    """The lines of an OBJ-sourced block, its textures copied (or skipped) and renamed."""
+    lines = [f"newmtl {name}"]
+    map_keys = {k.lower() for k, _ in src.textures()}
+    for line in src.text.splitlines():
+        parts = line.split()
+        if len(parts) >= 2 and parts[0].lower() in map_keys:
+            fname = parts[-1]
+            full = src.texture_path(fname, warn=False)
+            if full is None:
+                if not inside_folder(os.path.join(src.folder, fname), src.root or src.folder):
+                    continue  # never point the output at a file outside the model's folder
+                lines.append(line)  # a missing texture: the reference stays as it was
+                continue
+            if inside_folder(full, out_folder):  # already in the output's folder: no copy
+                new = os.path.relpath(os.path.realpath(full), os.path.realpath(out_folder))
+            else:
+                new, made = publish_new(
+                    full, out_folder, _safe_file_name(os.path.basename(fname)), taken, prefix
+                )
+                if made:
+                    created.append(os.path.join(out_folder, new))
+            line = " ".join(parts[:-1] + [new.replace(os.sep, "/")])
+        lines.append(line)
+    return lines
+
+
+def write_mtl(
+    materials: list[Material], names: list[str], mtl_path: str, out_folder: str, stem: str
+) -> list[str]:
     """Write an MTL file for ``materials`` (named ``names``) and put their textures next to it.
 
     OBJ-sourced blocks are written back as read; each texture they reference is copied
-    into ``out_folder`` (unless it already is there) and the reference rewritten.  Other
-    materials get ``Kd``/``d`` and a PNG of their base colour texture named
-    ``<stem>_<material>.png``.  Every file is written with :func:`meshvis.io.atomic_write`.
+    into ``out_folder`` under a new name (unless it already is there) and the reference
+    rewritten; a texture outside the model's folder is left out.  Other materials get
+    ``Kd``/``d`` and a PNG of their base colour texture named ``<stem>_<material>.png``.
+
+    Returns
+    -------
+    list of str
+        The files this call created (textures, and the MTL when it did not exist), so a
+        caller whose own write fails afterwards can remove them (:func:`remove_created`).
+
+    Raises
+    ------
+    OutputError
+        ``mtl_path`` is the input's MTL file or one of its textures; a file cannot be written.
     """
     out_folder = os.path.abspath(out_folder)
-    taken: dict[str, str] = {}  # output file name -> source path (to avoid collisions)
-    blocks = []
-    for mat, name in zip(materials, names):
-        src = mat.source
-        lines = [f"newmtl {name}"]
-        if isinstance(src, MtlSource):
-            map_keys = {k.lower() for k, _ in src.textures()}
-            for line in src.text.splitlines():
-                parts = line.split()
-                if len(parts) >= 2 and parts[0].lower() in map_keys:
-                    fname = parts[-1]
-                    full = os.path.normpath(os.path.join(src.folder, fname))
-                    if os.path.isfile(full):
-                        inside = os.path.normpath(os.path.join(out_folder, fname))
-                        if os.path.abspath(src.folder) == out_folder or inside == full:
-                            new = fname
-                        else:
-                            new = _free_name(os.path.basename(fname), full, taken)
-                            dst = os.path.join(out_folder, new)
-                            if not (os.path.exists(dst) and os.path.samefile(dst, full)):
-                                copy_texture(full, dst)
-                            taken[new] = full
-                        line = " ".join(parts[:-1] + [new])
-                lines.append(line)
-        else:
-            desc = describe_pbr(mat, name)
-            r, g, b, a = desc.base_color.tolist()
-            lines.append(f"Kd {r!r} {g!r} {b!r}")
-            if a < 1.0:
-                lines.append(f"d {a!r}")
-            if desc.image is not None:
-                ext = ".jpg" if desc.mime == "image/jpeg" else ".png"
-                new = _free_name(_safe_file_name(f"{stem}_{name}") + ext, f"<{id(mat)}>", taken)
-                taken[new] = f"<{id(mat)}>"
-                with atomic_write(os.path.join(out_folder, new), "wb") as fh:
-                    fh.write(desc.image)
-                lines.append(f"map_Kd {new}")
-        blocks.append("\n".join(lines))
-    with atomic_write(mtl_path, "w") as fh:
-        fh.write("# written by meshvis\n\n" + "\n\n".join(blocks) + "\n")
-
-
-def _free_name(wanted: str, source: str, taken: dict[str, str]) -> str:
-    """``wanted``, or ``stem_1.ext``... when another source already uses that name."""
-    if wanted not in taken or taken[wanted] == source:
-        return wanted
-    base, ext = os.path.splitext(wanted)
-    k = 1
-    while f"{base}_{k}{ext}" in taken and taken[f"{base}_{k}{ext}"] != source:
-        k += 1
-    return f"{base}_{k}{ext}"
+    _check_mtl_target(mtl_path, materials)
+    taken: dict[str, str] = {}  # output file name -> what it holds (to avoid collisions)
+    created: list[str] = []
+    prefix = temp_prefix(os.path.join(out_folder, stem + "_"))[:-1]  # ".<stem>_", as the batch runner expects
+    try:
+        blocks = []
+        for mat, name in zip(materials, names):
+            src = mat.source
+            if isinstance(src, MtlSource):
+                lines = _mtl_block(src, name, out_folder, taken, created, prefix)
+            else:
+                lines = [f"newmtl {name}"]
+                desc = describe_pbr(mat, name)
+                r, g, b, a = desc.base_color.tolist()
+                lines.append(f"Kd {r!r} {g!r} {b!r}")
+                if a < 1.0:
+                    lines.append(f"d {a!r}")
+                if desc.image is not None:
+                    ext = ".jpg" if desc.mime == "image/jpeg" else ".png"
+                    new, made = publish_new(
+                        desc.image, out_folder, _safe_file_name(f"{stem}_{name}") + ext, taken, prefix
+                    )
+                    if made:
+                        created.append(os.path.join(out_folder, new))
+                    lines.append(f"map_Kd {new}")
+            blocks.append("\n".join(lines))
+        existed = os.path.exists(mtl_path)
+        with atomic_write(mtl_path, "w") as fh:
+            fh.write("# written by meshvis\n\n" + "\n\n".join(blocks) + "\n")
+        if not existed:
+            created.append(mtl_path)
+    except BaseException:
+        remove_created(created)
+        raise
+    return created

@@ -29,7 +29,7 @@ import numpy as np
 from meshvis.errors import ModelError, ModelFormatError
 from meshvis.io._common import atomic_write, fmt_floats, unique_names, weld_corners
 from meshvis.io.edits import FaceEdits, face_edits
-from meshvis.io.mtl import MtlSource, write_mtl
+from meshvis.io.mtl import MtlSource, TextureWarning, inside_folder, remove_created, write_mtl
 from meshvis.io.triangulate import triangulate
 from meshvis.soup import Material, Soup, SourceRecord
 
@@ -66,6 +66,10 @@ def _first_bad_face(f_lines: list[str]) -> int:
     return -1
 
 
+#: numbers on one ``v``/``vt`` line: x y z [w] or x y z r g b [a], with room to spare
+_MAX_ROW_NUMBERS = 16
+
+
 def _parse_rows(
     lines: list[str], keyword: str, width: int, what: str, label: str, line_numbers
 ) -> tuple[np.ndarray, np.ndarray]:
@@ -98,6 +102,8 @@ def _parse_rows(
     counts = np.diff(np.append(starts, len(marked))) - 1
     values = np.delete(marked, starts)
     widest = int(counts.max())
+    if widest > _MAX_ROW_NUMBERS:  # the padded table below would be k x widest
+        raise ModelFormatError(f"a {what} line has {widest} numbers (at most {_MAX_ROW_NUMBERS})", label)
     out = np.zeros((k, widest))
     mask = np.arange(widest) < counts[:, None]
     out[mask] = values
@@ -518,6 +524,9 @@ def _read_mtllibs(mtllibs: list[str], path: str) -> dict[str, MtlSource]:
                 break
         else:
             continue
+        if not inside_folder(mtl_path, folder):
+            warnings.warn(f"{path}: MTL file {lib} is outside the model's folder; skipped", TextureWarning, 2)
+            continue
         try:
             with open(mtl_path, "rb") as fh:
                 raw = fh.read()
@@ -533,7 +542,7 @@ def _read_mtllibs(mtllibs: list[str], path: str) -> dict[str, MtlSource]:
             s = line.strip()
             if s.startswith("newmtl") and (len(s) == 6 or s[6] in " \t"):
                 if name is not None and name not in out:
-                    out[name] = MtlSource("\n".join(block), mtl_folder)
+                    out[name] = MtlSource.checked("\n".join(block), mtl_folder, folder, mtl_path, path)
                 name, block = s[6:].strip(), []
             elif name is not None and s and not s.startswith("#"):
                 block.append(s)
@@ -576,10 +585,16 @@ def write_obj(
         if mtl_name:
             mat_names = unique_names([m.name for m in soup.materials], "material")
         text = _rebuilt_text(soup, groups, group_names, mtl_name, mat_names)
-    if mtl_name:
-        write_mtl(soup.materials, mat_names, os.path.join(folder, mtl_name), folder, stem)
-    with atomic_write(path, "w") as fh:
-        fh.write(text)
+    # the OBJ, its MTL and textures are published together: a failure in any leaves none
+    created: list[str] = []
+    try:
+        with atomic_write(path, "w") as fh:
+            fh.write(text)
+            if mtl_name:
+                created = write_mtl(soup.materials, mat_names, os.path.join(folder, mtl_name), folder, stem)
+    except BaseException:
+        remove_created(created)
+        raise
 
 
 def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:

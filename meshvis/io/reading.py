@@ -11,6 +11,7 @@ import os
 import re
 import struct
 
+from meshvis import _validate
 from meshvis.errors import MeshvisError, ModelError, ModelFormatError
 from meshvis.io import gltf, obj, off, ply, stl
 from meshvis.io._common import describe_exception, one_line
@@ -70,7 +71,7 @@ def load(path: str | os.PathLike, *, name: str | None = None) -> Soup:
     ModelFormatError
         Unknown extension, content of another format, content that does not parse.
     """
-    path = os.fspath(path)
+    path = _validate.path("path", path)
     label = name if name is not None else path
     fmt = _check_readable(path, label)
     with open(path, "rb") as fh:
@@ -86,6 +87,10 @@ def load(path: str | os.PathLike, *, name: str | None = None) -> Soup:
             )
     try:
         soup = _read(fmt, path, label)
+    except ModelError as exc:
+        if exc.path is None:  # raised below the reader (triangulation): name the file
+            raise type(exc)(exc.problem, label) from None
+        raise
     except MeshvisError:
         raise
     except MemoryError:
@@ -105,6 +110,8 @@ def _check_readable(path: str, label: str) -> str:
         raise ModelError("file not found", label)
     if os.path.isdir(path):
         raise ModelError("is a folder, not a model file", label)
+    if not os.path.isfile(path):  # opening a FIFO would block until something writes to it
+        raise ModelError("is not a regular file (a FIFO, socket or device)", label)
     ext = os.path.splitext(path)[1].lower()
     if ext not in READ_FORMATS:
         known = ", ".join(sorted(READ_FORMATS))
@@ -167,6 +174,32 @@ def _read(fmt: str, path: str, label: str) -> Soup:
     if fmt == "3mf":
         import trimesh  # 3MF is read through trimesh's loader
 
+        check_zip(path, label)
+
         scene = trimesh.load(path, file_type="3mf", force="scene", process=False, maintain_order=True)
         return soup_from_scene(scene, path=label)
     return READERS[fmt](path, label)
+
+
+def check_zip(path: str, label: str) -> None:
+    """Refuse a zip archive with more entries or more inflated bytes than the caps of
+    :mod:`meshvis.limits` (the sizes its directory declares, which :mod:`zipfile` enforces
+    while inflating)."""
+    import zipfile
+
+    from meshvis import limits
+
+    try:
+        with zipfile.ZipFile(path) as zf:
+            infos = zf.infolist()
+    except (zipfile.BadZipFile, OSError) as exc:
+        raise ModelFormatError(f"not a valid zip archive: {one_line(exc)}", label) from None
+    if len(infos) > limits.MAX_ZIP_ENTRIES:
+        raise ModelFormatError(
+            f"the archive has {len(infos)} entries, more than the cap of {limits.MAX_ZIP_ENTRIES}", label
+        )
+    total = sum(i.file_size for i in infos)
+    if total > limits.MAX_ZIP_BYTES:
+        raise ModelFormatError(
+            f"the archive inflates to {total} bytes, more than the cap of {limits.MAX_ZIP_BYTES}", label
+        )

@@ -19,6 +19,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from meshvis.errors import ModelFormatError
+
 
 def triangulate(
     vertices: np.ndarray, counts: np.ndarray, corners: np.ndarray
@@ -34,6 +36,11 @@ def triangulate(
     corners : (sum(counts),) int
         Vertex index of every corner, polygon after polygon.
 
+    Raises
+    ------
+    ModelFormatError
+        A polygon has more corners than the cap (:func:`check_corners`).
+
     Returns
     -------
     triangles : (t, 3) int64
@@ -44,6 +51,7 @@ def triangulate(
     """
     counts = np.asarray(counts, np.int64)
     corners = np.asarray(corners, np.int64)
+    check_corners(counts)
     start = np.zeros(len(counts), np.int64)
     np.cumsum(counts[:-1], out=start[1:])
     n_tri = counts - 2
@@ -86,6 +94,23 @@ def triangulate(
             local = ear_clip(pts[g])
             triangles[rows[g]] = pos[g][local]
     return triangles, source
+
+
+def check_corners(counts: np.ndarray) -> None:
+    """Refuse polygons with more corners than :data:`meshvis.limits.MAX_POLYGON_CORNERS`.
+
+    Raises
+    ------
+    ModelFormatError
+        Without a file name; :func:`meshvis.io.load` adds it.
+    """
+    from meshvis import limits
+
+    if len(counts) and int(counts.max()) > limits.MAX_POLYGON_CORNERS:
+        i = int(np.argmax(counts))
+        raise ModelFormatError(
+            f"polygon {i} has {int(counts[i])} corners, more than the cap of {limits.MAX_POLYGON_CORNERS}"
+        )
 
 
 def _newell_normal(pts: np.ndarray) -> np.ndarray:

@@ -13,6 +13,7 @@ from dataclasses import replace
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.errors import OutputError, ParameterError
 from meshvis.io import gltf, obj, off, ply, stl
 from meshvis.io.convert import as_soup
@@ -75,7 +76,7 @@ def save(
     ParameterError
         ``face_groups`` / ``face_values`` of the wrong length.
     """
-    path = os.fspath(path)
+    path = _validate.path("path", path)
     soup = as_soup(soup)
     ext = os.path.splitext(path)[1].lower()
     if ext not in WRITE_FORMATS:
@@ -89,21 +90,18 @@ def save(
     m = soup.n_faces
     groups = None
     if face_groups is not None:
-        groups = np.asarray(face_groups).astype(np.int64, copy=False).reshape(-1)
-        if len(groups) != m:
-            raise ParameterError(f"face_groups has {len(groups)} entries for {m} faces")
+        groups = _validate.per_face("face_groups", face_groups, m, "iu").astype(np.int64, copy=False)
         if m and groups.min() < 0:
             raise ParameterError("face_groups must be non-negative")
         n_groups = int(groups.max()) + 1 if m else 0
-        names = list(group_names) if group_names is not None else []
+        names = _validate.names("group_names", group_names)
         names += [f"group{k}" for k in range(len(names), n_groups)]
         group_names = [str(n) for n in names]
     values = {}
-    for key, val in (face_values or {}).items():
-        val = np.asarray(val)
-        if val.shape[:1] != (m,) or val.ndim != 1:
-            raise ParameterError(f"face_values[{key!r}] must have one value per face ({m})")
-        values[str(key)] = val
+    for key, val in (
+        _validate.instance("face_values", face_values, Mapping, True).items() if face_values else ()
+    ):
+        values[str(key)] = _validate.per_face(f"face_values[{key!r}]", val, m, "biuf")
     n_mat = int(soup.material_id.max()) + 1 if m else 0
     if n_mat > len(soup.materials):  # ids without a Material: give them one so writers can name them
         extra = [Material(f"material{i}") for i in range(len(soup.materials), n_mat)]

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.errors import ParameterError
 
 #: unit vectors of the axis names accepted as "up"
@@ -158,6 +159,7 @@ class Camera:
         directions : (height*width, 3) float64 array
             Unit ray directions.
         """
+        width, height = _validate.image_size((width, height))
         row, col = np.divmod(np.arange(width * height), width)
         return self.pixel_rays(col, row, width, height)
 
@@ -234,6 +236,7 @@ class Camera:
         at which the bounding sphere (times ``margin``) fills the view.  ``up`` defaults to
         the model's up axis by the rule of :func:`model_up`.
         """
+        azimuth, elevation = _validate.real("azimuth", azimuth), _validate.real("elevation", elevation)
         bounds = _bounds_of(model)
         center = bounds.mean(axis=0)
         radius = 0.5 * float(np.linalg.norm(bounds[1] - bounds[0])) or 1.0

@@ -25,6 +25,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.io import as_soup
 
 #: default push of an origin off its surface, as a fraction of the bounding-box diagonal
@@ -101,8 +102,8 @@ class RayCaster:
 
         soup = as_soup(model)
         self.soup = soup
-        self.offset = float(offset)
-        self.threads = default_threads() if threads is None else max(1, int(threads))
+        self.offset = _validate.real("offset", offset, 0.0, 0.1)
+        self.threads = default_threads() if threads is None else _validate.integer("threads", threads, 1)
         lo, hi = soup.bounds
         self.center = 0.5 * (lo + hi)
         diag = soup.diagonal
@@ -125,7 +126,8 @@ class RayCaster:
     @staticmethod
     def _unit_dirs(directions: np.ndarray) -> np.ndarray:
         d = np.asarray(directions, np.float64)
-        return d / np.sqrt(np.einsum("ij,ij->i", d, d))[:, None]
+        with np.errstate(invalid="ignore", divide="ignore"):  # a zero direction: NaN, refused by the caller
+            return d / np.sqrt(np.einsum("ij,ij->i", d, d))[:, None]
 
     # ------------------------------------------------------------------ raw calls
     def _run(self, o32: np.ndarray, d32: np.ndarray, query: str, dists: np.ndarray | None = None) -> Any:
@@ -197,10 +199,11 @@ class RayCaster:
         Hits
             ``side`` is 0 where ``dot(direction, normal) < 0`` (the ray met the front).
         """
-        origins = np.asarray(origins, np.float64).reshape(-1, 3)
-        d = self._unit_dirs(np.asarray(directions).reshape(-1, 3))
+        origins, directions = _validate.ray_arrays(origins, directions)
+        d = _validate.unit_directions(self._unit_dirs(directions))
         dists = None
         if max_distance is not None:
+            max_distance = _validate.max_distance(max_distance, len(origins))
             dists = np.broadcast_to(
                 np.asarray(max_distance, np.float64) * self.scale, (len(origins),)
             ).astype(np.float32)
@@ -229,8 +232,7 @@ class RayCaster:
         Both ends are excluded by ``offset`` × diagonal, so a target lying on a surface does
         not occlude itself; push origins off their own surface first (:meth:`push_off`).
         """
-        origins = np.asarray(origins, np.float64).reshape(-1, 3)
-        targets = np.asarray(targets, np.float64).reshape(-1, 3)
+        origins, targets = _validate.ray_arrays(origins, targets, "targets")
         seg = targets - origins
         length = np.linalg.norm(seg, axis=1)
         ok = length > 0
@@ -243,6 +245,7 @@ class RayCaster:
 
     def push_off(self, points: np.ndarray, face: np.ndarray, side: np.ndarray) -> np.ndarray:
         """Move points lying on ``face`` off its surface, towards ``side`` (0 front, 1 back)."""
+        face = _validate.face_indices("face", face, self.soup.n_faces)
         sign = np.where(np.asarray(side) == 0, 1.0, -1.0)
         return points + self.normals[face] * (sign * self.offset * self.diagonal)[:, None]
 
@@ -254,7 +257,7 @@ class RayCaster:
 
     def part_of(self, face: np.ndarray) -> np.ndarray:
         """Part id of each face index (-1 for misses)."""
-        face = np.asarray(face)
+        face = _validate.face_indices("face", face, self.soup.n_faces, allow_miss=True)
         out = np.full(face.shape, -1, np.int64)
         hit = face >= 0
         out[hit] = self.part_id[face[hit]]

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.io import as_soup
 from meshvis.rays.camera import Camera
 from meshvis.rays.caster import RayCaster
@@ -110,10 +111,12 @@ def render(
     >>> r.image.shape
     (24, 32, 3)
     """
+    width, height = _validate.render_args(size, color_by, face_values, azimuth, elevation)
+    _validate.instance("camera", camera, Camera, optional=True)
+    _validate.instance("caster", caster, RayCaster, optional=True)
     soup = as_soup(model)
     caster = caster or RayCaster(soup)
     camera = camera or Camera.fit(soup, azimuth=azimuth, elevation=elevation, up=up)
-    width, height = int(size[0]), int(size[1])
     origins, directions = camera.rays(width, height)
     hits = caster.intersect(origins, directions)
     hit = hits.hit
@@ -128,7 +131,7 @@ def render(
     elif color_by == "layer":
         if face_values is None:
             raise ValueError("color_by='layer' needs face_values")
-        vals = np.asarray(face_values)[face[hit]]
+        vals = _validate.per_face("face_values", face_values, soup.n_faces, "iu")[face[hit]]
         base = palette(int(vals.max()) + 2)[np.maximum(vals, 0)]
     elif color_by is None:
         base = np.full((int(hit.sum()), 3), 200.0)

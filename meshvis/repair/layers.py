@@ -14,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.soup import Soup
 
@@ -132,6 +133,8 @@ def layers(
     >>> r.n_layers, sorted(set(r.layer.tolist()))
     (2, [1, 2])
     """
+    _validate.repair_args(classification, Classification, classify_kw, classify)
+    max_layers = None if max_layers is None else _validate.integer("max_layers", max_layers, 1)
     c = classification or classify(model, **classify_kw)
     t0 = time.perf_counter()
     m = c.soup.n_faces

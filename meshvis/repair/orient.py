@@ -26,6 +26,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.errors import ParameterError
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.repair.layers import LayerResult, layers
@@ -223,6 +224,7 @@ def orient(
     >>> int(r.flipped.sum()) == len(f[::3])
     True
     """
+    _validate.repair_args(classification, Classification, classify_kw, classify)
     _check("front", front, ("ccw", "cw"))
     _check("two_sided", two_sided, ("keep", "duplicate", "strongest"))
     _check("semantics", semantics, ("layer", "cavity"))

@@ -12,6 +12,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.soup import Soup
 
@@ -75,6 +76,7 @@ def remove_interior(
     >>> r.kept.n_faces, r.removed.n_faces
     (320, 320)
     """
+    _validate.repair_args(classification, Classification, classify_kw, classify)
     c = classification or classify(model, **classify_kw)
     keep = np.any(c.outside > 0, axis=1)
     return RemovalResult(c.soup.subset(keep), c.soup.subset(~keep), keep, c)

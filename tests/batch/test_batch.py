@@ -11,6 +11,7 @@ import signal
 import subprocess
 import sys
 import tempfile
+import textwrap
 import time
 
 import numpy as np
@@ -56,14 +57,6 @@ def _triangle(path) -> str:
 def _noise(path) -> str:
     with open(path, "wb") as fh:
         fh.write(np.random.default_rng(1).integers(0, 256, 999, dtype=np.uint8).tobytes())
-    return str(path)
-
-
-def _slow_soup(path, n: int = 3000) -> str:
-    """Intersecting random triangles: many sample-point nodes, seconds of rays."""
-    rng = np.random.default_rng(0)
-    tris = rng.random((n, 1, 3)) + 0.08 * rng.normal(size=(n, 3, 3))
-    mio.save((tris.reshape(-1, 3), np.arange(3 * n).reshape(-1, 3)), path)
     return str(path)
 
 
@@ -348,56 +341,104 @@ def test_run_file_isolated_kills_a_hung_file(tmp_path, stuck_runners):
     assert mb.run_file_isolated(task, time_limit=60.0)["status"] == "ok"
 
 
-@pytest.mark.slow
-def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
+def _icosphere():
+    import trimesh
+
+    return trimesh.creation.icosphere(1)
+
+
+def _files(folder) -> list[str]:
+    return sorted(os.path.relpath(os.path.join(r, f), folder) for r, _, fs in os.walk(folder) for f in fs)
+
+
+DRIVER = textwrap.dedent(
+    '''
+    """Runs ``meshvis batch`` with the task of slow.obj replaced by one that starts writing
+    its output, records its pid and then waits: the batch is stopped at a known point."""
+    import os
+    import sys
+    import time
+
+    import meshvis.batch as mb
+
+    _OPEN = []
+
+
+    def hang(op, soup, args, progress):
+        from meshvis.io import atomic_write
+
+        writer = atomic_write(args["output"], "w")
+        _OPEN.append(writer)
+        writer.__enter__().write("partial")
+        with open(os.environ["MESHVIS_TEST_PID"] + ".part", "w") as fh:
+            fh.write(str(os.getpid()))
+        os.rename(os.environ["MESHVIS_TEST_PID"] + ".part", os.environ["MESHVIS_TEST_PID"])
+        time.sleep(3600)
+
+
+    def _plan(*args, **kw):
+        tasks = _real_plan(*args, **kw)
+        for t in tasks:
+            if os.path.basename(t.input) == "slow.obj":
+                t.runner = "batch_driver:hang"
+        return tasks
+
+
+    if __name__ == "__main__":
+        _real_plan = mb.plan
+        mb.plan = _plan
+        from meshvis.cli.main import main
+
+        sys.exit(main(sys.argv[1:]))
+    '''
+)
+
+
+def _stopped_batch(tmp_path, how: str) -> tuple[subprocess.CompletedProcess, str, int]:
+    """Start a batch of a.obj, b.obj and the hanging slow.obj, stop it with ``how`` once
+    a and b are done and slow is writing; return (result, output folder, pid of slow's worker)."""
     src = tmp_path / "in"
     src.mkdir()
-    _triangle(src / "a.obj")
-    _sphere(src / "b.obj")
-    _slow_soup(src / "slow.ply")  # the largest file: started first, still running at Ctrl-C
+    for name in ("a", "b", "slow"):
+        mio.save(_icosphere(), src / f"{name}.obj")
+    (tmp_path / "batch_driver.py").write_text(DRIVER)
     out = tmp_path / "out"
+    pid_file = str(tmp_path / "worker.pid")
+    argv = ["batch", str(src), "--op", "orient", "--out", str(out), "--jobs", "2", "--rays-per-node", "8"]
     proc = subprocess.Popen(
-        [
-            sys.executable,
-            "-m",
-            "meshvis",
-            "batch",
-            str(src),
-            "--op",
-            "orient",
-            "--out",
-            str(out),
-            "--jobs",
-            "2",
-            "--rays-per-node",
-            "2048",
-            "--no-progressive",
-        ],
+        [sys.executable, str(tmp_path / "batch_driver.py"), *argv, "-q"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
         cwd=tmp_path,  # the installed package, not the repository's meshvis/ folder
+        env=dict(os.environ, MESHVIS_TEST_PID=pid_file),
         start_new_session=True,
     )
     try:
         t0 = time.monotonic()
-        while not (out / "a.orient.report.json").exists() and time.monotonic() - t0 < 120:
+        done = [out / "a.orient.report.json", out / "b.orient.report.json", tmp_path / "worker.pid"]
+        while not all(p.exists() for p in done):
+            assert proc.poll() is None and time.monotonic() - t0 < 180, proc.stderr.read()
             time.sleep(0.05)
-        time.sleep(0.2)
-        os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C in a terminal reaches the whole process group
+        if how == "SIGINT":
+            os.killpg(proc.pid, signal.SIGINT)  # Ctrl-C in a terminal reaches the whole process group
+        else:
+            proc.send_signal(signal.SIGTERM)  # `kill PID`: the main process only
         stdout, stderr = proc.communicate(timeout=60)
     finally:
         if proc.poll() is None:
             os.killpg(proc.pid, signal.SIGKILL)
-    assert proc.returncode == 130, stderr
-    assert "meshvis: interrupted" in stderr and "Traceback" not in stderr
-    assert not _tmp_files(out)
-    summary = json.load(open(out / "summary.json"))
+    worker = int(open(pid_file).read())
+    return subprocess.CompletedProcess(proc.args, proc.returncode, stdout, stderr), str(out), worker
+
+
+def _assert_clean_stop(out: str, worker: int) -> None:
+    assert not [f for f in _files(out) if f.endswith(".tmp")]
+    summary = json.load(open(os.path.join(out, "summary.json")))
     assert summary["interrupted"] is True
     status = {os.path.basename(f["input"]): f["status"] for f in summary["files"]}
-    assert status == {"a.obj": "ok", "b.obj": "ok", "slow.ply": "interrupted"}
-    # every output that exists is complete: it has an 'ok' report and loads
-    assert sorted(os.listdir(out)) == [
+    assert status == {"a.obj": "ok", "b.obj": "ok", "slow.obj": "interrupted"}
+    assert _files(out) == [
         "a.orient.obj",
         "a.orient.report.json",
         "b.orient.obj",
@@ -405,9 +446,28 @@ def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
         "summary.csv",
         "summary.json",
     ]
-    for name in ("a", "b"):
-        assert json.load(open(out / f"{name}.orient.report.json"))["status"] == "ok"
-        assert mio.load(out / f"{name}.orient.obj").n_faces in (1, 80)
+    for name in ("a", "b"):  # every output that exists is complete
+        assert mio.load(os.path.join(out, f"{name}.orient.obj")).n_faces == 80
+    time.sleep(0.5)
+    with pytest.raises(ProcessLookupError):  # the worker is gone, not writing on
+        os.kill(worker, 0)
+
+
+@pytest.mark.slow
+def test_sigterm_to_batch_stops_workers_and_writes_the_summary(tmp_path):
+    r, out, worker = _stopped_batch(tmp_path, "SIGTERM")
+    assert r.returncode == 143, r.stderr
+    assert r.stderr == "meshvis: terminated\n"
+    _assert_clean_stop(out, worker)
+
+
+@pytest.mark.slow
+def test_ctrl_c_leaves_no_partial_outputs(tmp_path):
+    """Ctrl-C once a.obj and b.obj are done and slow.obj is half written (a known point, not a time)."""
+    r, out, worker = _stopped_batch(tmp_path, "SIGINT")
+    assert r.returncode == 130, r.stderr
+    assert r.stderr == "meshvis: interrupted\n"
+    _assert_clean_stop(out, worker)
 
 
 # ---------------------------------------------------------------- usage errors

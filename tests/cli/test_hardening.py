@@ -447,7 +447,8 @@ def test_disk_full_keeps_the_old_file(tmp_path, capsys, monkeypatch, good_files,
 
 
 def test_disk_full_on_the_report(tmp_path, capsys, monkeypatch, good_files):
-    """The model is written; the report then fails: clean error, no temporary file."""
+    """The model is staged; the report then fails: clean error, and neither the model nor a
+    temporary file is left (a command's outputs appear together or not at all)."""
     real_fdopen = os.fdopen
 
     def fdopen(fd, mode="r", *a, **kw):
@@ -461,7 +462,7 @@ def test_disk_full_on_the_report(tmp_path, capsys, monkeypatch, good_files):
         _argv("orient", good_files["ply"], tmp_path, out=str(tmp_path / "out.ply")) + ["--report", report],
     )
     _assert_one_line_error(rc, err, report, "no space left")
-    assert sorted(os.listdir(tmp_path)) == ["out.ply"]
+    assert sorted(os.listdir(tmp_path)) == []
 
 
 # ------------------------------------------------------------------ the real stderr
