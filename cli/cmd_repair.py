@@ -188,9 +188,7 @@ def run(args: argparse.Namespace) -> int:
     removed = getattr(args, "removed", None)
     # every output appears at the end, together, or none does (an error, Ctrl-C, SIGTERM)
     with staged_outputs(), stage_progress(args) as progress:
-        report = run_op(args.op, soup, argparse.Namespace(**{**vars(args), "removed": None}), progress)
-        if removed:
-            _write_removed(args, soup, report, removed)
+        report = run_op(args.op, soup, args, progress)
         report["input"] = args.input
         report["seconds_total"] = time.perf_counter() - t0
         if args.report:
@@ -198,18 +196,6 @@ def run(args: argparse.Namespace) -> int:
     if removed and not report["removed_faces"] and os.path.exists(removed):
         os.remove(removed)  # an older result there would pass for this run's (--force was given)
     return 0
-
-
-def _write_removed(args: argparse.Namespace, soup, report: dict, path: str) -> None:
-    """Write the removed faces, or say that there are none (no file: a model needs a face)."""
-    from meshvis.io import save
-
-    keep = report["per_face"]["keep"]
-    if keep.all():
-        say(args, f"nothing was removed; {path} not written")
-        return
-    save(soup.subset(~keep), path)
-    say(args, f"wrote the {int((~keep).sum())} removed faces to {path}")
 
 
 def run_op(op: str, soup, args: argparse.Namespace, progress=None) -> dict:

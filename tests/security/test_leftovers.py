@@ -220,7 +220,7 @@ def test_removed_with_nothing_removed(tmp_path, capsys):
     mio.save(trimesh.creation.icosphere(1), src)
     out, removed = tmp_path / "kept.obj", tmp_path / "removed.obj"
     assert main(["remove-interior", str(src), "-o", str(out), "--removed", str(removed)]) == 0
-    assert f"nothing was removed; {removed} not written" in capsys.readouterr().out
+    assert f"nothing was removed: {removed} not written" in capsys.readouterr().out
     assert sorted(os.listdir(tmp_path)) == ["ball.obj", "kept.obj"]
     removed.write_text("an older result")
     argv = ["remove-interior", str(src), "-o", str(out), "--removed", str(removed), "--force", "-q"]
@@ -236,5 +236,8 @@ def test_removed_faces_are_written_when_there_are_some(tmp_path, capsys):
     mio.save((v, f), src)
     argv = ["remove-interior", str(src), "-o", str(tmp_path / "k.obj"), "--removed", str(tmp_path / "r.obj")]
     assert main(argv) == 0
-    assert "wrote the 80 removed faces" in capsys.readouterr().out
+    assert (
+        f"removed 80 of 160 faces; wrote {tmp_path / 'k.obj'} and {tmp_path / 'r.obj'}"
+        in capsys.readouterr().out
+    )
     assert mio.load(tmp_path / "r.obj").n_faces == 80 and mio.load(tmp_path / "k.obj").n_faces == 80
