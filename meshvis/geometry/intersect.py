@@ -19,7 +19,7 @@ Pipeline
    pair is emitted once, from the cell that holds the lower corner of the two boxes'
    overlap.  Cell keys are int64 (21 bits per axis), matched by sorting and
    ``searchsorted``; large outputs are produced in bounded chunks.
-3. Narrow phase (:func:`classify_pairs`, vectorised over chunks of pairs): a
+3. Narrow phase (:func:`classify_pairs`, one numba loop over the pairs): a
    separating-axis test on the 17 axes that separate two triangles — the two normals, the
    six in-plane edge normals (precomputed per face) and the 9 edge x edge directions.  Each
    axis gives a gap between the two projected intervals; a gap along a unit axis is a lower
@@ -43,7 +43,11 @@ Appendix H excludes triangles sharing a vertex or an edge from the intersection 
   tangent wedges at the shared corner share a direction, :func:`_cross_beyond_vertex`) —
   MeshLab counts these too; the plain exclusion of the paper would miss them;
 * coplanar overlap is tested for adjacent pairs as well (duplicates and folded faces
-  share their corners).
+  share their corners);
+* pairs sharing an edge whose third corners lie on the same side of it, with the two
+  half-planes less than :data:`FOLD_ANGLE` (2 degrees) apart, are coplanar too: one face
+  lies folded onto the other (a quad stored with both of its diagonals), which the plane
+  distance test misses as soon as the planes are more than ``eps`` apart at the far corner.
 
 Pairs that lie in one plane are reported as coplanar or not at all, never as
 intersecting; two faces touching side by side in one plane without a shared corner show up
@@ -72,8 +76,9 @@ from meshvis.geometry.adjacency import WELD_TOL, weld
 EPS = 1e-6
 #: default angle tolerance between two planes (radians) for the coplanarity test
 ANGLE_EPS = 1e-3
-#: candidate pairs per narrow-phase chunk (bounds the temporary memory to ~100 MB)
-NARROW_CHUNK = 1 << 15
+#: two faces on one edge folded onto each other by less than this (radians, 2 degrees)
+#: are one surface stored twice: coplanar (the fold-over test of ``classify_pairs``)
+FOLD_ANGLE = np.radians(2.0)
 #: pairs expanded at once in the broad phase
 BROAD_CHUNK = 1 << 20
 _BITS = 21  # bits per axis of a cell key
@@ -227,11 +232,6 @@ def _dot(axes: np.ndarray, points: np.ndarray) -> np.ndarray:
     return np.matmul(axes, points.transpose(0, 2, 1))
 
 
-def _gap(pa: np.ndarray, pb: np.ndarray) -> np.ndarray:
-    """Signed gap between projected intervals (positive: separated; negative: overlap)."""
-    return np.maximum(_lmin(pb) - _lmax(pa), _lmin(pa) - _lmax(pb))
-
-
 class _FaceAxes:
     """Per-face separating axes, computed once: unit normal and three in-plane edge normals."""
 
@@ -254,59 +254,6 @@ class _FaceAxes:
         self.low, self.high = _lmin(proj), _lmax(proj)
 
 
-def _cross_beyond_vertex(fi, fj, Ti, Tj, fa: _FaceAxes, i, j, tau: float) -> np.ndarray:
-    """(k,) bool: two non-coplanar triangles sharing exactly one corner meet beyond it.
-
-    Both triangles are convex and contain the shared corner ``v``, so they share another
-    point exactly when their *tangent wedges* at ``v`` (the cones spanned by the two sides
-    leaving ``v``) share a direction.  Two wedges in different planes can only share the
-    direction ``±L``, ``L = n_i x n_j`` (the planes' common line): the test is whether ``L``
-    or ``-L`` lies in both wedges.  A direction on a wedge's border counts (touching along a
-    side is reported: conservative).  Pairs sharing two corners (an edge) cannot cross unless
-    they are folded into one plane, which the coplanarity test handles.
-    """
-    out = np.zeros(len(fi), bool)
-    eq = fi[:, :, None] == fj[:, None, :]
-    one = eq.sum(axis=(1, 2)) == 1
-    one &= fa.has_normal[i] & fa.has_normal[j]
-    k = np.flatnonzero(one)
-    if len(k) == 0:
-        return out
-    eq = eq[k]
-    ci = eq.any(axis=2).argmax(axis=1)  # corner of the shared vertex in each triangle
-    cj = eq.any(axis=1).argmax(axis=1)
-    ni, nj = fa.axes[i[k], 0], fa.axes[j[k], 0]
-    line = np.cross(ni, nj)
-    length = np.linalg.norm(line, axis=1)
-    reliable = length > tau
-    line[reliable] /= length[reliable, None]
-    rows = np.arange(len(k))
-
-    def sides(T, c):
-        v = T[rows, c]
-        u1 = T[rows, (c + 1) % 3] - v
-        u2 = T[rows, (c + 2) % 3] - v
-        u1 /= np.linalg.norm(u1, axis=1, keepdims=True)
-        u2 /= np.linalg.norm(u2, axis=1, keepdims=True)
-        return u1, u2
-
-    def inside(u1, u2, n, d):
-        # d between u1 and u2 (counter-clockwise about n), with a small angular slack
-        slack = -1e-9
-        a = np.einsum("kd,kd->k", np.cross(u1, d), n)
-        b = np.einsum("kd,kd->k", np.cross(d, u2), n)
-        return (a >= slack) & (b >= slack)
-
-    ui1, ui2 = sides(Ti[k], ci)
-    uj1, uj2 = sides(Tj[k], cj)
-    meet = (inside(ui1, ui2, ni, line) & inside(uj1, uj2, nj, line)) | (
-        inside(ui1, ui2, ni, -line) & inside(uj1, uj2, nj, -line)
-    )
-    # planes parallel to working precision but not within eps of each other: report
-    out[k] = np.where(reliable, meet, True)
-    return out
-
-
 def classify_pairs(
     triangles: np.ndarray,
     faces_welded: np.ndarray,
@@ -314,91 +261,59 @@ def classify_pairs(
     eps: float,
     near: float,
     angle_eps: float = ANGLE_EPS,
+    fold_angle: float = FOLD_ANGLE,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Narrow phase on candidate pairs of *normalised* triangles (unit diagonal).
 
-    Two stages, vectorised over chunks of pairs.  Stage 1 uses the 8 face axes (two unit
-    normals, six in-plane edge normals, precomputed per face); it also decides coplanarity.
-    Stage 2 adds the 9 edge x edge axes for the non-adjacent pairs stage 1 could not
-    separate by more than ``max(eps, near)``.  The gap along a unit axis never exceeds the
-    distance between the triangles, so ``max gap <= eps`` holds for every pair closer than
-    ``eps``.
+    Per pair (a numba kernel, :func:`meshvis.geometry._narrow.narrow_phase`): stage 1 uses
+    the 8 face axes (two unit normals, six in-plane edge normals, precomputed per face); it
+    also decides coplanarity.  Stage 2 adds the 9 edge x edge axes for the non-adjacent pairs
+    stage 1 could not separate by more than ``max(eps, near)``.  The gap along a unit axis
+    never exceeds the distance between the triangles, so ``max gap <= eps`` holds for every
+    pair closer than ``eps``.  Pairs sharing one corner are tested beyond it (tangent wedges
+    at the corner); pairs sharing an edge are coplanar when folded onto each other by less
+    than ``fold_angle``.
 
     Parameters
     ----------
     triangles : (m, 3, 3) float64 corners, normalised to unit bounding-box diagonal
-    faces_welded : (m, 3) int64, welded corner ids (adjacency)
-    pairs : (p, 2) int64 candidate pairs
+    faces_welded : (m, 3) int array, welded corner ids (adjacency)
+    pairs : (p, 2) int array, candidate pairs
     eps : float, distance tolerance for intersection and coplanarity (absolute, unit diagonal)
     near : float, distance below which a non-adjacent pair is "too close"
     angle_eps : float, radians
+    fold_angle : float
+        Radians: the largest angle between the half-planes of two faces on one edge that
+        still counts as one face folded onto the other.
 
     Returns
     -------
     intersects, coplanar, too_close : (p,) bool, per pair (see the module notes)
     """
-    p = len(pairs)
-    inter = np.zeros(p, bool)
-    copl = np.zeros(p, bool)
-    close = np.zeros(p, bool)
+    from meshvis.geometry._narrow import narrow_phase
+
     # cross products of factors at an angle below tau are skipped: their round-off
     # (~ machine eps / tau, relative to unit coordinates) must stay far below eps
     tau = min(1e-3, 100 * np.finfo(np.float64).eps / min(eps, near))
-    cos_angle = np.cos(angle_eps)
-    pad = max(eps, near)
     fa = _FaceAxes(triangles, tau)
-    for s in range(0, p, NARROW_CHUNK):
-        i, j = pairs[s : s + NARROW_CHUNK, 0], pairs[s : s + NARROW_CHUNK, 1]
-        fi, fj = faces_welded[i], faces_welded[j]
-        shared = _lmax((fi[:, :, None] == fj[:, None, :]).reshape(-1, 9))
-        Ti, Tj = triangles[i], triangles[j]
-        # stage 1: j's corners on i's axes and i's corners on j's axes
-        pj = _dot(fa.axes[i], Tj)  # (k, 4, 3)
-        pi = _dot(fa.axes[j], Ti)
-        gap = np.concatenate(
-            [
-                np.maximum(_lmin(pj) - fa.high[i], fa.low[i] - _lmax(pj)),
-                np.maximum(_lmin(pi) - fa.high[j], fa.low[j] - _lmax(pi)),
-            ],
-            axis=1,
-        )
-        gap[~np.concatenate([fa.valid[i], fa.valid[j]], axis=1)] = -np.inf
-        max_gap = _lmax(gap)
-        # coplanar: parallel, every corner within eps of the other plane, and the two
-        # triangles overlap by more than eps along each in-plane edge normal
-        flat = fa.has_normal[i] & fa.has_normal[j]
-        flat &= np.abs(np.einsum("kd,kd->k", fa.axes[i, 0], fa.axes[j, 0])) >= cos_angle
-        mid_i = 0.5 * (fa.low[i, 0] + fa.high[i, 0])
-        mid_j = 0.5 * (fa.low[j, 0] + fa.high[j, 0])
-        flat &= _lmax(np.abs(pj[:, 0] - mid_i[:, None])) <= eps
-        flat &= _lmax(np.abs(pi[:, 0] - mid_j[:, None])) <= eps
-        in_plane = _lmax(gap[:, [1, 2, 3, 5, 6, 7]])
-        c = flat & (in_plane < -eps)
-        # stage 2: edge x edge axes for the non-adjacent pairs still within reach
-        k = np.flatnonzero(~shared & (max_gap <= pad))
-        if len(k):
-            ei, ej = fa.edges[i[k]], fa.edges[j[k]]
-            axes = np.cross(ei[:, :, None], ej[:, None, :]).reshape(-1, 9, 3)
-            length = np.linalg.norm(axes, axis=2)
-            ok = length > tau * (fa.edge_len[i[k]][:, :, None] * fa.edge_len[j[k]][:, None, :]).reshape(-1, 9)
-            length[~ok] = 1.0
-            g = _gap(_dot(axes, Ti[k]), _dot(axes, Tj[k])) / length
-            g[~ok] = -np.inf
-            max_gap[k] = np.maximum(max_gap[k], _lmax(g))
-        hit = ~shared & ~flat & (max_gap <= eps)
-        near_pair = ~shared & (max_gap <= near)
-        # pairs sharing exactly one corner: do they cross beyond it?
-        k = np.flatnonzero(shared & ~flat)
-        if len(k):
-            cross = _cross_beyond_vertex(fi[k], fj[k], Ti[k], Tj[k], fa, i[k], j[k], tau)
-            hit[k] = cross
-            near_pair[k] = cross
-        sl = slice(s, s + len(i))
-        copl[sl] = c
-        # pairs in one plane are coplanar (overlapping) or nothing, never "intersecting"
-        inter[sl] = hit
-        close[sl] = near_pair
-    return inter, copl, close
+    inter, copl, close, fold = narrow_phase(
+        np.ascontiguousarray(triangles, np.float64),
+        np.ascontiguousarray(faces_welded),
+        fa.axes,
+        fa.valid,
+        fa.has_normal,
+        fa.low,
+        fa.high,
+        fa.edges,
+        fa.edge_len,
+        np.ascontiguousarray(pairs),
+        float(eps),
+        float(near),
+        float(tau),
+        float(np.cos(angle_eps)),
+        float(np.cos(fold_angle)),
+    )
+    return inter, copl | fold, close
 
 
 def _normalised(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:

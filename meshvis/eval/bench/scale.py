@@ -125,7 +125,8 @@ def format(results: list[dict], header: bool = True) -> str:
         if prev and prev["model"].startswith("icosphere") and r["model"].startswith("icosphere"):
             growth = f"{r['seconds'] / prev['seconds']:.2f}"
         st = " ".join(
-            f"{r['stages'].get(s):>10.2f}" if r["stages"].get(s) is not None else f"{'skipped':>10}" for s in stages
+            f"{r['stages'].get(s):>10.2f}" if r["stages"].get(s) is not None else f"{'skipped':>10}"
+            for s in stages
         )
         lines.append(
             f"{r['model'][:28]:<28} {r['faces']:>9} {r['seconds']:>8.2f} {growth:>5} {r['peak_mb']:>8.0f} {st} "
