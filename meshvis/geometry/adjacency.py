@@ -20,8 +20,15 @@ from scipy.sparse.csgraph import connected_components
 WELD_TOL = 1e-7
 
 
-#: odd 64-bit multipliers of the coordinate hash in :func:`_exact_groups` (any odd constants do)
-_HASH = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0x2545F4914F6CDD1D), np.uint64(0x27BB2EE687B0B0FD))
+#: constants of the splitmix64 finaliser, the bit mixer of the coordinate hash in :func:`_exact_groups`
+_MIX = (np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB), np.uint64(0x9E3779B97F4A7C15))
+
+
+def _mix(z: np.ndarray) -> np.ndarray:
+    """splitmix64 finaliser: every input bit changes about half of the output bits."""
+    z = (z ^ (z >> np.uint64(30))) * _MIX[0]
+    z = (z ^ (z >> np.uint64(27))) * _MIX[1]
+    return z ^ (z >> np.uint64(31))
 
 
 def used_vertices(faces: np.ndarray, n_vertices: int) -> np.ndarray:
@@ -47,7 +54,7 @@ def _exact_groups(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     and only the distinct points are sorted lexicographically.
     """
     bits = np.ascontiguousarray(pts).view(np.uint64)
-    h = bits[:, 0] * _HASH[0] ^ bits[:, 1] * _HASH[1] ^ bits[:, 2] * _HASH[2]
+    h = _mix(_mix(_mix(bits[:, 0] + _MIX[2]) ^ bits[:, 1]) ^ bits[:, 2])
     order = np.argsort(h, kind="stable")
     hs, s = h[order], pts[order]
     new = np.ones(len(pts), bool)

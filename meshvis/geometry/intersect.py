@@ -122,14 +122,6 @@ def _cells(lo: np.ndarray, hi: np.ndarray, h: float) -> tuple[np.ndarray, np.nda
     return owner, _key(cell), c0
 
 
-def _keep(a, b, ca, cb, key, lo, hi) -> np.ndarray:
-    """Mask of pairs met in their lowest common cell whose boxes really overlap."""
-    own = _key(np.maximum(ca, cb)) == key
-    a, b = a[own], b[own]
-    ok = _lmin((lo[a] <= hi[b]) & (lo[b] <= hi[a]))
-    return np.flatnonzero(own)[ok]
-
-
 def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
     """All pairs of overlapping axis-aligned boxes, through a hierarchical uniform grid.
 
@@ -141,6 +133,8 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
     -------
     (p, 2) int64, pairs ``i < j`` whose closed boxes overlap, sorted
     """
+    from meshvis.geometry._kernels import broad_pairs
+
     lower = np.asarray(lower, np.float64)
     upper = np.asarray(upper, np.float64)
     m = len(lower)
@@ -186,11 +180,9 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
         pos = np.arange(len(key))
         counts = np.searchsorted(sweep, rank + hi[ent, 0] * xs + margin, side="right") - pos - 1
         for sl in _chunks(counts):
-            row, other = _expand(pos[sl] + 1, counts[sl])
-            row = row + sl.start
-            a, b = ent[row], ent[other]
-            keep = _keep(a, b, own_low[a], own_low[b], key[row], lo, hi)
-            out.append(np.stack([a[keep], b[keep]], axis=1))
+            out.append(
+                broad_pairs(ent[sl], pos[sl] + 1, counts[sl], ent, own_low, own_low, key[sl], lo, hi, _BITS)
+            )
     # pairs across levels: finer boxes look up their cells on each coarser level
     for L in levels[1:]:
         key_c, ent_c, rank_c, sweep_c, margin = grids[L]
@@ -206,11 +198,11 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
         low_f = np.zeros((m, 3), np.int64)
         low_f[fine] = c0f
         for sl in _chunks(counts):
-            row, other = _expand(start[sl], counts[sl])
-            row = row + sl.start
-            a, b = fine[owner[row]], ent_c[other]
-            keep = _keep(a, b, low_f[a], own_low[b], key_f[row], lo, hi)
-            out.append(np.stack([a[keep], b[keep]], axis=1))
+            out.append(
+                broad_pairs(
+                    fine[owner[sl]], start[sl], counts[sl], ent_c, low_f, own_low, key_f[sl], lo, hi, _BITS
+                )
+            )
     pairs = np.concatenate(out) if out else np.zeros((0, 2), np.int64)
     keys = np.sort(pairs.min(axis=1) * np.int64(m) + pairs.max(axis=1))
     return np.stack([keys // m, keys % m], axis=1)
@@ -265,7 +257,7 @@ def classify_pairs(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Narrow phase on candidate pairs of *normalised* triangles (unit diagonal).
 
-    Per pair (a numba kernel, :func:`meshvis.geometry._narrow.narrow_phase`): stage 1 uses
+    Per pair (a numba kernel, :func:`meshvis.geometry._kernels.narrow_phase`): stage 1 uses
     the 8 face axes (two unit normals, six in-plane edge normals, precomputed per face); it
     also decides coplanarity.  Stage 2 adds the 9 edge x edge axes for the non-adjacent pairs
     stage 1 could not separate by more than ``max(eps, near)``.  The gap along a unit axis
@@ -290,7 +282,7 @@ def classify_pairs(
     -------
     intersects, coplanar, too_close : (p,) bool, per pair (see the module notes)
     """
-    from meshvis.geometry._narrow import narrow_phase
+    from meshvis.geometry._kernels import narrow_phase
 
     # cross products of factors at an angle below tau are skipped: their round-off
     # (~ machine eps / tau, relative to unit coordinates) must stay far below eps

@@ -1,4 +1,4 @@
-"""Numba kernel of the narrow phase of :func:`meshvis.geometry.intersect.classify_pairs`.
+"""Numba kernels of the intersection tests of :mod:`meshvis.geometry.intersect`: broad and narrow phase.
 
 One loop over the candidate pairs, with the arithmetic of the separating-axis and
 shared-corner tests written out per pair: no (pairs, axes, corners) temporaries, and the
@@ -21,7 +21,7 @@ SLACK = 1e-12
 WEDGE_SLACK = 1e-9
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _proj_gap(ax, ay, az, T, lo, hi):
     """Gap between [lo, hi] and the projection of the 3 corners T (3, 3) on the axis."""
     p0 = ax * T[0, 0] + ay * T[0, 1] + az * T[0, 2]
@@ -32,22 +32,29 @@ def _proj_gap(ax, ay, az, T, lo, hi):
     return max(pmin - hi, lo - pmax), p0, p1, p2
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _unit_from(T, c, k):
+    """Unit vector from corner c to corner k of T, as three scalars (no allocation)."""
+    x = T[k, 0] - T[c, 0]
+    y = T[k, 1] - T[c, 1]
+    z = T[k, 2] - T[c, 2]
+    n = math.sqrt(x * x + y * y + z * z)
+    return x / n, y / n, z / n
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
 def _in_wedge(T, c, n, dx, dy, dz):
     """Direction d lies in the wedge of T at corner c (counter-clockwise about n)."""
-    v = T[c]
-    u1 = T[(c + 1) % 3] - v
-    u2 = T[(c + 2) % 3] - v
-    u1 = u1 / math.sqrt(u1[0] ** 2 + u1[1] ** 2 + u1[2] ** 2)
-    u2 = u2 / math.sqrt(u2[0] ** 2 + u2[1] ** 2 + u2[2] ** 2)
-    # a = (u1 x d) . n, b = (d x u2) . n
-    a = (u1[1] * dz - u1[2] * dy) * n[0] + (u1[2] * dx - u1[0] * dz) * n[1] + (u1[0] * dy - u1[1] * dx) * n[2]
-    b = (dy * u2[2] - dz * u2[1]) * n[0] + (dz * u2[0] - dx * u2[2]) * n[1] + (dx * u2[1] - dy * u2[0]) * n[2]
+    ax, ay, az = _unit_from(T, c, (c + 1) % 3)
+    bx, by, bz = _unit_from(T, c, (c + 2) % 3)
+    # (u1 x d) . n and (d x u2) . n
+    a = (ay * dz - az * dy) * n[0] + (az * dx - ax * dz) * n[1] + (ax * dy - ay * dx) * n[2]
+    b = (dy * bz - dz * by) * n[0] + (dz * bx - dx * bz) * n[1] + (dx * by - dy * bx) * n[2]
     s = -WEDGE_SLACK * (1 + SLACK)
     return a >= s and b >= s
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def narrow_phase(
     tri, fw, axes, valid, has_normal, low, high, edges, edge_len, pairs, eps, near, tau, cos_angle, cos_fold
 ):
@@ -143,7 +150,7 @@ def narrow_phase(
     return inter, copl, close, fold
 
 
-@numba.njit(cache=True, nogil=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _folded(Ti, Tj, fi, fj, cos_fold):
     """Two faces on one edge whose other corners lie on the same side, at an angle below the fold.
 
@@ -168,14 +175,54 @@ def _folded(Ti, Tj, fi, fj, cos_fold):
     for c in range(3):
         if fj[c] != fi[a] and fj[c] != fi[b]:
             kj = c
-    e = Ti[b] - Ti[a]
-    e = e / math.sqrt(e[0] ** 2 + e[1] ** 2 + e[2] ** 2)
-    u = Ti[ki] - Ti[a]
-    w = Tj[kj] - Ti[a]
-    u = u - (u[0] * e[0] + u[1] * e[1] + u[2] * e[2]) * e
-    w = w - (w[0] * e[0] + w[1] * e[1] + w[2] * e[2]) * e
-    lu = math.sqrt(u[0] ** 2 + u[1] ** 2 + u[2] ** 2)
-    lw = math.sqrt(w[0] ** 2 + w[1] ** 2 + w[2] ** 2)
+    ex, ey, ez = _unit_from(Ti, a, b)
+    ux = Ti[ki, 0] - Ti[a, 0]
+    uy = Ti[ki, 1] - Ti[a, 1]
+    uz = Ti[ki, 2] - Ti[a, 2]
+    wx = Tj[kj, 0] - Ti[a, 0]
+    wy = Tj[kj, 1] - Ti[a, 1]
+    wz = Tj[kj, 2] - Ti[a, 2]
+    du = ux * ex + uy * ey + uz * ez
+    dw = wx * ex + wy * ey + wz * ez
+    ux, uy, uz = ux - du * ex, uy - du * ey, uz - du * ez
+    wx, wy, wz = wx - dw * ex, wy - dw * ey, wz - dw * ez
+    lu = math.sqrt(ux * ux + uy * uy + uz * uz)
+    lw = math.sqrt(wx * wx + wy * wy + wz * wz)
     if lu == 0 or lw == 0:
         return False
-    return (u[0] * w[0] + u[1] * w[1] + u[2] * w[2]) / (lu * lw) >= cos_fold
+    return (ux * wx + uy * wy + uz * wz) / (lu * lw) >= cos_fold
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def broad_pairs(first, starts, counts, ent, low_a, low_b, key, lo, hi, bits):
+    """Pairs met in their lowest common grid cell whose boxes overlap (broad phase step).
+
+    Row ``q`` stands for box ``first[q]`` in the cell ``key[q]``; its candidates are the
+    boxes ``ent[starts[q] : starts[q] + counts[q]]``.  A pair is kept when the cell holding
+    the lower corner of the two boxes' overlap (``max`` of their lower cells on this grid,
+    ``low_a`` / ``low_b``) is this cell -- so each pair is emitted once -- and the closed
+    boxes overlap on every axis.  Returns (k, 2) int64 pairs, smaller index first.
+    """
+    out = np.empty((counts.sum(), 2), np.int64)
+    n = 0
+    for q in range(first.shape[0]):
+        a = first[q]
+        for o in range(starts[q], starts[q] + counts[q]):
+            b = ent[o]
+            cx = max(low_a[a, 0], low_b[b, 0])
+            cy = max(low_a[a, 1], low_b[b, 1])
+            cz = max(low_a[a, 2], low_b[b, 2])
+            if ((cx << (2 * bits)) | (cy << bits) | cz) != key[q]:
+                continue
+            if (
+                lo[a, 0] <= hi[b, 0]
+                and lo[b, 0] <= hi[a, 0]
+                and lo[a, 1] <= hi[b, 1]
+                and lo[b, 1] <= hi[a, 1]
+                and lo[a, 2] <= hi[b, 2]
+                and lo[b, 2] <= hi[a, 2]
+            ):
+                out[n, 0] = min(a, b)
+                out[n, 1] = max(a, b)
+                n += 1
+    return out[:n]
