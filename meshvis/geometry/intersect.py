@@ -66,6 +66,7 @@ about 1e-9 approaches float64 round-off of the normalised coordinates and is ref
 from __future__ import annotations
 
 import functools
+from collections.abc import Callable
 
 import numpy as np
 
@@ -79,6 +80,8 @@ ANGLE_EPS = 1e-3
 #: two faces on one edge folded onto each other by less than this (radians, 2 degrees)
 #: are one surface stored twice: coplanar (the fold-over test of ``classify_pairs``)
 FOLD_ANGLE = np.radians(2.0)
+#: candidate pairs per call of the narrow-phase kernel (a progress step)
+NARROW_CHUNK = 1 << 21
 #: pairs expanded at once in the broad phase
 BROAD_CHUNK = 1 << 20
 _BITS = 21  # bits per axis of a cell key
@@ -254,6 +257,7 @@ def classify_pairs(
     near: float,
     angle_eps: float = ANGLE_EPS,
     fold_angle: float = FOLD_ANGLE,
+    progress: Callable[[float], None] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Narrow phase on candidate pairs of *normalised* triangles (unit diagonal).
 
@@ -277,6 +281,8 @@ def classify_pairs(
     fold_angle : float
         Radians: the largest angle between the half-planes of two faces on one edge that
         still counts as one face folded onto the other.
+    progress : callable, optional
+        ``progress(fraction)`` after each chunk of :data:`NARROW_CHUNK` pairs.
 
     Returns
     -------
@@ -288,24 +294,32 @@ def classify_pairs(
     # (~ machine eps / tau, relative to unit coordinates) must stay far below eps
     tau = min(1e-3, 100 * np.finfo(np.float64).eps / min(eps, near))
     fa = _FaceAxes(triangles, tau)
-    inter, copl, close, fold = narrow_phase(
-        np.ascontiguousarray(triangles, np.float64),
-        np.ascontiguousarray(faces_welded),
-        fa.axes,
-        fa.valid,
-        fa.has_normal,
-        fa.low,
-        fa.high,
-        fa.edges,
-        fa.edge_len,
-        np.ascontiguousarray(pairs),
-        float(eps),
-        float(near),
-        float(tau),
-        float(np.cos(angle_eps)),
-        float(np.cos(fold_angle)),
-    )
-    return inter, copl | fold, close
+    tri = np.ascontiguousarray(triangles, np.float64)
+    fw = np.ascontiguousarray(faces_welded, np.int64)
+    out = np.zeros((3, len(pairs)), bool)
+    for s in range(0, len(pairs), NARROW_CHUNK):
+        sl = slice(s, s + NARROW_CHUNK)
+        inter, copl, close, fold = narrow_phase(
+            tri,
+            fw,
+            fa.axes,
+            fa.valid,
+            fa.has_normal,
+            fa.low,
+            fa.high,
+            fa.edges,
+            fa.edge_len,
+            np.ascontiguousarray(pairs[sl]),
+            float(eps),
+            float(near),
+            float(tau),
+            float(np.cos(angle_eps)),
+            float(np.cos(fold_angle)),
+        )
+        out[0, sl], out[1, sl], out[2, sl] = inter, copl | fold, close
+        if progress is not None:
+            progress(min(s + NARROW_CHUNK, len(pairs)) / len(pairs))
+    return out[0], out[1], out[2]
 
 
 def _normalised(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
@@ -326,6 +340,7 @@ def intersection_flags(
     angle_eps: float = ANGLE_EPS,
     faces_welded: np.ndarray | None = None,
     weld_tol: float = WELD_TOL,
+    progress: Callable[[float], None] | None = None,
 ) -> dict:
     """Per-face flags of appendix H §2: intersects another face, coplanar with one, too close.
 
@@ -344,6 +359,8 @@ def intersection_flags(
         Welded faces (:func:`meshvis.geometry.adjacency.weld`), to skip welding here.
     weld_tol : float
         Weld tolerance used when ``faces_welded`` is not given.
+    progress : callable, optional
+        ``progress(fraction)``: after the broad phase and after each narrow-phase chunk.
 
     Returns
     -------
@@ -375,8 +392,12 @@ def intersection_flags(
     pad = max(eps, near)
     lower = tri.min(axis=1) - pad
     upper = tri.max(axis=1) + pad
+    report = progress or (lambda fraction: None)
     pairs = candidate_pairs(lower, upper)
-    inter, copl, close = classify_pairs(tri, np.asarray(faces_welded, np.int64), pairs, eps, near, angle_eps)
+    report(0.4)
+    inter, copl, close = classify_pairs(
+        tri, faces_welded, pairs, eps, near, angle_eps, progress=lambda x: report(0.4 + 0.6 * x)
+    )
 
     def flags(mask):
         return np.bincount(pairs[mask].ravel(), minlength=m) > 0

@@ -121,9 +121,8 @@ class Classification:
             "clusters": int(self.pre.clustering.n_clusters),
             "edges": self.graph.n_edges,
             "flagged_faces": int(self.flagged.sum()),
-            "intersecting_faces": int(self.pre.intersects.sum()),
-            "coplanar_faces": int(self.pre.coplanar.sum()),
-            "degenerate_faces": int(self.degenerate.sum()),
+            # the counts of the analysis pass `meshvis info` runs too
+            **self.pre.analysis.counts,
             "rays": int(self.counts.rays),
             "reverse_rays": int(self.counts.reverse_rays),
             "hint_rays": int(self.params.get("hint_rays", 0)),
@@ -267,13 +266,14 @@ def classify(
     report = progress or (lambda stage, frac: None)
 
     t = time.perf_counter()
+    report("scene", 0.0)
     if caster is None:
         caster = RayCaster(soup) if offset is None else RayCaster(soup, offset=offset)
     stages.append(Stage("scene", True, time.perf_counter() - t, "Embree scene on the normalised copy"))
 
     t = time.perf_counter()
     report("preprocess", 0.0)
-    pre = preprocess(soup)
+    pre = preprocess(soup, progress=lambda stage, frac: report("preprocess", frac))
     if pre.degenerate.all():  # no side has an area: there is no graph to cut
         what = "the only face is" if soup.n_faces == 1 else f"all {soup.n_faces} faces are"
         raise ModelError(f"{what} degenerate (zero area): nothing to classify", soup.path)
