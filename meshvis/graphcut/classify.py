@@ -42,6 +42,17 @@ from meshvis.soup import Soup
 FIRST_ROUND_RAYS = 4
 #: upper bound of the per-node ray multiplier of large clusters
 CLUSTER_RAY_FACTOR_MAX = 64
+#: standard deviations of the escape share within which a node counts as undecided
+#: against the opening threshold (:func:`opening_undecided`)
+OPENING_Z = 3.0
+#: no escape in n rays bounds the escape share below this / n with 99.9 % (-ln 1e-3)
+ZERO_ESCAPE_BOUND = 6.9
+
+
+def sees_others(hits) -> np.ndarray:
+    """(n,) bool: some ray of the node hit another node (off-diagonal hits)."""
+    h = hits.tocsr()
+    return np.asarray(h.sum(axis=1)).ravel() - h.diagonal() > 0
 
 
 @dataclass
@@ -190,6 +201,41 @@ def ray_allocation(nodes: NodeSet, rays: int) -> np.ndarray:
     alloc = rays * factor
     alloc[nodes.area <= 0] = 0
     return alloc
+
+
+def opening_undecided(
+    escaped: np.ndarray,
+    counted: np.ndarray,
+    opening: float | None,
+    n_faces: np.ndarray,
+    sees_others: np.ndarray,
+) -> np.ndarray:
+    """(n,) bool: nodes whose escape share cannot yet be told above or below ``opening``.
+
+    The share of ``n`` rays is binomial: a node is undecided while ``opening`` lies within
+    :data:`OPENING_Z` standard deviations of its share (the deviation taken at the larger of
+    the share and the threshold, so that both sides are refined alike), or within a factor of
+    two of it.  A node none of whose rays escaped is decided once ``-ln(1e-3) / n`` (the
+    99.9 % bound of its share) is below ``opening``, when it is a single face or sample
+    point (there are many, and the prior holds for them) or when all its rays came back to
+    itself (``sees_others`` False: a closed shell's inside, which settles in its first round).
+    Undecided nodes keep receiving rays, and the sampling does not stop while one is left
+    with budget: otherwise whether a crack near the threshold leaks depends on the seed.
+    """
+    if opening is None:
+        return np.zeros(len(escaped), bool)
+    n = np.maximum(counted, 1)
+    share = escaped / n
+    p = np.maximum(share, opening)
+    band = OPENING_Z * np.sqrt(p * (1 - p) / n)
+    # no escape in n rays bounds the share below ZERO_ESCAPE_BOUND / n (99.9 %); a node
+    # whose rays all came back to itself (a closed shell's inside) is decided all the same
+    unbounded = (escaped == 0) & (n_faces > 1) & (ZERO_ESCAPE_BOUND / n > opening) & sees_others
+    return (
+        ((escaped > 0) | unbounded)
+        & (counted > 0)
+        & ((np.abs(share - opening) <= band) | ((share > 0.5 * opening) & (share < 2 * opening)))
+    )
 
 
 def classify(
@@ -366,7 +412,11 @@ def classify(
         )
         if not progressive:
             break
-        if changed is not None and changed <= tolerance:
+        near_threshold = opening_undecided(
+            counts.escaped, counted, opening, nodes.n_faces, sees_others(counts.hits)
+        ) & (cast < budget)
+        # only clusters of several faces (the sheets around a crack) hold the loop open
+        if changed is not None and changed <= tolerance and not (near_threshold & (nodes.n_faces > 1)).any():
             stop_reason = f"converged after {len(rounds)} rounds (change {changed:.2e} <= {tolerance:g})"
             break
         # Next round: double the rays of the nodes that are still undecided.  After the
@@ -381,11 +431,12 @@ def classify(
             # after the first round also every node whose terminal links are close to a tie
             margin = np.abs(w.cap_out - w.cap_in) <= 0.5 * np.maximum(w.cap_out, w.cap_in)
             active |= margin & (np.maximum(w.cap_out, w.cap_in) > 0)
-        if opening is not None:
-            # and every node whose escape share is too close to the opening threshold to tell
-            share = counts.escaped / np.maximum(counted, 1)
-            active |= (share > 0.5 * opening) & (share < 2 * opening)
+        # and every node whose escape share is too close to the opening threshold to tell
+        active |= near_threshold
         give = np.where(active, np.minimum(cast, budget - cast), 0)
+        # a node undecided against the opening threshold gets its whole remaining budget at
+        # once: it is settled in one more round instead of one doubling per round
+        give[near_threshold] = (budget - cast)[near_threshold]
         prev, prev_nodes = labels, cut.outside
         if not active.any():
             stop_reason = f"settled after {len(rounds)} round(s): no node left undecided"
