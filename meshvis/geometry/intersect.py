@@ -136,8 +136,6 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
     -------
     (p, 2) int64, pairs ``i < j`` whose closed boxes overlap, sorted
     """
-    from meshvis.geometry._kernels import broad_pairs
-
     lower = np.asarray(lower, np.float64)
     upper = np.asarray(upper, np.float64)
     m = len(lower)
@@ -151,64 +149,86 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
         return np.stack([i, j], axis=1).astype(np.int64)
     # finest cell: the median box size (at least 2**-20 of the whole: 21-bit keys)
     h0 = max(float(np.median((hi - lo).max(axis=1))), size * 2.0**-20)
-    # each box goes to the finest level where it covers at most MAX_CELLS cells; levels
-    # are nested (cell size doubles), so the cell count only falls with the level
+    level = _levels(lo, hi, h0, size)
+    grids, own_low = {}, np.zeros((m, 3), np.int64)  # lower cell of each box on its own level
+    out = []
+    for L in np.unique(level):
+        grids[L] = _Grid(lo, hi, np.flatnonzero(level == L), h0 * 2.0**L, size, own_low)
+        out += grids[L].pairs_within(lo, hi, own_low)
+    for L in list(grids)[1:]:
+        out += grids[L].pairs_from_finer(lo, hi, np.flatnonzero(level < L), own_low)
+    pairs = np.concatenate(out) if out else np.zeros((0, 2), np.int64)
+    keys = np.sort(pairs.min(axis=1) * np.int64(m) + pairs.max(axis=1))
+    return np.stack([keys // m, keys % m], axis=1)
+
+
+def _levels(lo: np.ndarray, hi: np.ndarray, h0: float, size: float) -> np.ndarray:
+    """Grid level of each box: the finest where it covers at most :data:`MAX_CELLS` cells.
+
+    Levels are nested (the cell size doubles), so the cell count only falls with the level.
+    """
     top = int(np.ceil(np.log2(size / h0))) + 1
-    level = np.full(m, top, np.int64)
+    level = np.full(len(lo), top, np.int64)
     for L in range(top - 1, -1, -1):
         h = h0 * 2.0**L
         covered = (np.floor(hi / h) - np.floor(lo / h) + 1).prod(axis=1)
         level[covered <= MAX_CELLS] = L
-    # within a cell, entries are sorted by the lower x of their box (sweep and prune): the
-    # sort value is "cell rank + x scaled into [0, 0.5]", so that one searchsorted finds,
-    # for every entry, the end of the entries of its cell that start before its box ends
-    # (the margin keeps the float rounding of that value on the safe side)
-    xs = 0.5 / size
-    out = []
-    levels = np.unique(level)
-    grids = {}
-    own_low = np.zeros((m, 3), np.int64)  # lower cell of each box on its own level
-    for L in levels:
-        tri = np.flatnonzero(level == L)
-        owner, key, c0 = _cells(lo[tri], hi[tri], h0 * 2.0**L)
-        ent = tri[owner]
+    return level
+
+
+class _Grid:
+    """The boxes of one level in their cells, sorted for a sweep along x within each cell.
+
+    The sort value is "cell rank + x scaled into [0, 0.5]", so that one searchsorted finds,
+    for every entry, the end of the entries of its cell that start before its box ends
+    (``margin`` keeps the float rounding of that value on the safe side).
+    """
+
+    def __init__(self, lo, hi, boxes: np.ndarray, h: float, size: float, own_low: np.ndarray):
+        owner, key, c0 = _cells(lo[boxes], hi[boxes], h)
+        ent = boxes[owner]
         order = np.lexsort((lo[ent, 0], key))
-        key, ent = key[order], ent[order]
-        rank = np.concatenate([[0], np.cumsum(key[1:] != key[:-1])])
-        sweep = rank + lo[ent, 0] * xs
-        margin = 8 * np.spacing(rank[-1] + 1.0)  # above the rounding of rank + x
-        own_low[tri] = c0
-        grids[L] = (key, ent, rank, sweep, margin)
-        # pairs within one level: the later entries of the same cell starting before x ends
+        self.key, self.ent = key[order], ent[order]
+        self.h, self.xs = h, 0.5 / size
+        self.rank = np.concatenate([[0], np.cumsum(self.key[1:] != self.key[:-1])])
+        self.sweep = self.rank + lo[self.ent, 0] * self.xs
+        self.margin = 8 * np.spacing(self.rank[-1] + 1.0)  # above the rounding of rank + x
+        own_low[boxes] = c0
+
+    def pairs_within(self, lo, hi, own_low) -> list[np.ndarray]:
+        """Pairs in one cell of this level: later entries starting before the box ends in x."""
+        from meshvis.geometry._kernels import broad_pairs
+
+        key, ent = self.key, self.ent
         pos = np.arange(len(key))
-        counts = np.searchsorted(sweep, rank + hi[ent, 0] * xs + margin, side="right") - pos - 1
-        for sl in _chunks(counts):
-            out.append(
-                broad_pairs(ent[sl], pos[sl] + 1, counts[sl], ent, own_low, own_low, key[sl], lo, hi, _BITS)
-            )
-    # pairs across levels: finer boxes look up their cells on each coarser level
-    for L in levels[1:]:
-        key_c, ent_c, rank_c, sweep_c, margin = grids[L]
-        fine = np.flatnonzero(level < L)
+        counts = np.searchsorted(self.sweep, self.rank + hi[ent, 0] * self.xs + self.margin, side="right")
+        counts -= pos + 1
+        return [
+            broad_pairs(ent[sl], pos[sl] + 1, counts[sl], ent, own_low, own_low, key[sl], lo, hi, _BITS)
+            for sl in _chunks(counts)
+        ]
+
+    def pairs_from_finer(self, lo, hi, fine: np.ndarray, own_low) -> list[np.ndarray]:
+        """Pairs of finer boxes ``fine`` with this level's: each looks up its cells here."""
+        from meshvis.geometry._kernels import broad_pairs
+
         if len(fine) == 0:
-            continue
-        owner, key_f, c0f = _cells(lo[fine], hi[fine], h0 * 2.0**L)
-        start = np.searchsorted(key_c, key_f, side="left")
-        found = key_c[np.minimum(start, len(key_c) - 1)] == key_f
-        r = rank_c[np.minimum(start, len(key_c) - 1)]
-        end = np.searchsorted(sweep_c, r + hi[fine[owner], 0] * xs + margin, side="right")
+            return []
+        owner, key_f, c0f = _cells(lo[fine], hi[fine], self.h)
+        last = len(self.key) - 1
+        start = np.searchsorted(self.key, key_f, side="left")
+        found = self.key[np.minimum(start, last)] == key_f
+        r = self.rank[np.minimum(start, last)]
+        end = np.searchsorted(self.sweep, r + hi[fine[owner], 0] * self.xs + self.margin, side="right")
         counts = np.where(found, np.maximum(end - start, 0), 0)
-        low_f = np.zeros((m, 3), np.int64)
+        low_f = np.zeros_like(own_low)
         low_f[fine] = c0f
-        for sl in _chunks(counts):
-            out.append(
-                broad_pairs(
-                    fine[owner[sl]], start[sl], counts[sl], ent_c, low_f, own_low, key_f[sl], lo, hi, _BITS
-                )
+        return [
+            broad_pairs(
+                fine[owner[sl]], start[sl], counts[sl], self.ent, low_f, own_low, key_f[sl], lo, hi, _BITS
             )
-    pairs = np.concatenate(out) if out else np.zeros((0, 2), np.int64)
-    keys = np.sort(pairs.min(axis=1) * np.int64(m) + pairs.max(axis=1))
-    return np.stack([keys // m, keys % m], axis=1)
+            for sl in _chunks(counts)
+        ]
 
 
 # --------------------------------------------------------------------------- narrow phase
