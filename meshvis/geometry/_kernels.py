@@ -194,16 +194,16 @@ def _folded(Ti, Tj, fi, fj, cos_fold):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def broad_pairs(first, starts, counts, ent, low_a, low_b, key, lo, hi, bits):
+def broad_pairs(first, starts, counts, ent, low_a, low_b, key, lo, hi, bits, m):
     """Pairs met in their lowest common grid cell whose boxes overlap (broad phase step).
 
     Row ``q`` stands for box ``first[q]`` in the cell ``key[q]``; its candidates are the
     boxes ``ent[starts[q] : starts[q] + counts[q]]``.  A pair is kept when the cell holding
     the lower corner of the two boxes' overlap (``max`` of their lower cells on this grid,
     ``low_a`` / ``low_b``) is this cell -- so each pair is emitted once -- and the closed
-    boxes overlap on every axis.  Returns (k, 2) int64 pairs, smaller index first.
+    boxes overlap on every axis.  Returns (k,) int64 pair keys ``i * m + j`` with ``i < j``.
     """
-    out = np.empty((counts.sum(), 2), np.int64)
+    out = np.empty(counts.sum(), np.int64)
     n = 0
     for q in range(first.shape[0]):
         a = first[q]
@@ -222,7 +222,6 @@ def broad_pairs(first, starts, counts, ent, low_a, low_b, key, lo, hi, bits):
                 and lo[a, 2] <= hi[b, 2]
                 and lo[b, 2] <= hi[a, 2]
             ):
-                out[n, 0] = min(a, b)
-                out[n, 1] = max(a, b)
+                out[n] = min(a, b) * m + max(a, b)
                 n += 1
     return out[:n]

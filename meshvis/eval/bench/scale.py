@@ -16,6 +16,7 @@ import json
 import os
 import subprocess
 import sys
+import tempfile
 import time
 
 #: icosphere subdivisions of the generated sizes (20 k ... 5 M faces)
@@ -70,19 +71,35 @@ def one(spec: str, seed: int) -> dict:
     from meshvis.io import load
 
     t0 = time.perf_counter()
-    soup = generated(int(spec[4:]), seed) if spec.startswith("ico:") else load(spec)
+    if spec.endswith(".npz"):  # a generated soup, written by the parent process
+        import numpy as np
+
+        from meshvis.soup import Soup
+
+        with np.load(spec) as z:
+            soup, name = Soup(z["vertices"], z["faces"]), str(z["name"])
+    else:
+        soup, name = load(spec), os.path.basename(spec)
     t_load = time.perf_counter() - t0
     t = time.perf_counter()
     c = classify(soup, seed=seed)
     total = time.perf_counter() - t
+    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     raw = raw_embree_seconds(soup)
+    # the counts `meshvis info` prints must be the classification's (one shared pass)
+    from meshvis.geometry.diagnostics import diagnose
+
+    info, rep = diagnose(soup), c.report(per_face=False)
+    keys = ("degenerate_faces", "duplicate_faces", "intersecting_faces", "coplanar_faces")
     scene = next(s.seconds for s in c.stages if s.name == "scene")
     return {
-        "model": os.path.basename(spec) if not spec.startswith("ico:") else f"icosphere({spec[4:]}) soup",
+        "model": name,
         "faces": soup.n_faces,
         "load_seconds": t_load,
         "seconds": total,
-        "peak_mb": resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024,
+        "peak_mb": peak,
+        "info_counts_agree": all(info[k] == rep[k] for k in keys),
+        "counts": {k: rep[k] for k in keys},
         "stages": {s.name: (s.seconds if s.ran else None) for s in c.stages},
         "raw_embree_seconds": raw,
         "scene_over_raw": scene / raw if raw > 0 else None,
@@ -95,15 +112,29 @@ def one(spec: str, seed: int) -> dict:
 def run(specs: list[str], seed: int = 0) -> list[dict]:
     """Run every spec (``ico:N`` or a path) in its own subprocess; return their results."""
     out = []
-    for spec in specs:
-        code = f"import json, sys; from meshvis.eval.bench.scale import one; print(json.dumps(one({spec!r}, {seed})))"
-        p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
-        if p.returncode:
-            out.append({"model": spec, "error": (p.stderr.strip().splitlines() or ["?"])[-1]})
-            continue
-        out.append(json.loads(p.stdout.strip().splitlines()[-1]))
-        print(format(out[-1:], header=len(out) == 1), file=sys.stderr, flush=True)
+    with tempfile.TemporaryDirectory() as tmp:
+        for spec in specs:
+            out.append(_run_one(spec, seed, tmp))
+            print(format(out[-1:], header=len(out) == 1), file=sys.stderr, flush=True)
     return out
+
+
+def _run_one(spec: str, seed: int, tmp: str) -> dict:
+    """One child process.  A generated size is made here and handed over as an .npz file,
+    so that the child's peak memory is that of loading and classifying only."""
+    import numpy as np
+
+    if spec.startswith("ico:"):
+        soup = generated(int(spec[4:]), seed)
+        path = os.path.join(tmp, "model.npz")
+        np.savez(path, vertices=soup.vertices, faces=soup.faces, name=f"icosphere({spec[4:]}) soup")
+        del soup
+        spec = path
+    code = f"import json; from meshvis.eval.bench.scale import one; print(json.dumps(one({spec!r}, {seed})))"
+    p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+    if p.returncode:
+        return {"model": spec, "error": (p.stderr.strip().splitlines() or ["?"])[-1]}
+    return json.loads(p.stdout.strip().splitlines()[-1])
 
 
 def format(results: list[dict], header: bool = True) -> str:
@@ -114,7 +145,7 @@ def format(results: list[dict], header: bool = True) -> str:
         lines.append(
             f"{'model':<28} {'faces':>9} {'total s':>8} {'x4':>5} {'peak MB':>8} "
             + " ".join(f"{s:>10}" for s in stages)
-            + f" {'raw emb s':>9} {'scene/raw':>9} {'load':>5}"
+            + f" {'raw emb s':>9} {'scene/raw':>9} {'info=cls':>8} {'load':>5}"
         )
     prev = None
     for r in results:
@@ -130,7 +161,8 @@ def format(results: list[dict], header: bool = True) -> str:
         )
         lines.append(
             f"{r['model'][:28]:<28} {r['faces']:>9} {r['seconds']:>8.2f} {growth:>5} {r['peak_mb']:>8.0f} {st} "
-            f"{r['raw_embree_seconds']:>9.2f} {r['scene_over_raw']:>9.2f} {r['load_average']:>5.1f}"
+            f"{r['raw_embree_seconds']:>9.2f} {r['scene_over_raw']:>9.2f} {'yes' if r['info_counts_agree'] else 'NO':>8} "
+            f"{r['load_average']:>5.1f}"
         )
         prev = r
     return "\n".join(lines)
