@@ -28,7 +28,7 @@ def add_parser(sub) -> None:
     add_models_argument(c)
     c.set_defaults(func=run_classify)
 
-    for name in ("accuracy", "stability", "labeling", "labeling-sweep", "compare"):
+    for name in ("accuracy", "stability", "labeling", "labeling-sweep", "compare", "scale"):
         try:
             mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])
         except ModuleNotFoundError:

@@ -36,6 +36,10 @@ def run(args: argparse.Namespace) -> int:
 
     if not (1e-9 <= args.eps < 1):
         raise ParameterError(f"--eps must lie in [1e-9, 1), got {args.eps}")
-    report = diagnose(load(args.model), eps=args.eps, intersections=not args.no_intersections)
+    from .progress import stage_progress
+
+    soup = load(args.model)
+    with stage_progress(args) as progress:
+        report = diagnose(soup, eps=args.eps, intersections=not args.no_intersections, progress=progress)
     print(json.dumps(report, indent=1) if args.json else format_report(report))
     return 0

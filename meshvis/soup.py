@@ -192,7 +192,9 @@ class Soup:
         """(2, 3) min and max corner of the bounding box of the *used* vertices."""
         if self.n_faces == 0:
             return np.zeros((2, 3))
-        used = self.vertices[np.unique(self.faces)]
+        mask = np.zeros(self.n_vertices, bool)
+        mask[self.faces.ravel()] = True  # a mask, not np.unique: O(n + m) with no sort
+        used = self.vertices[mask]
         return np.stack([used.min(axis=0), used.max(axis=0)])
 
     @cached_property
@@ -440,7 +442,9 @@ def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -
         raise ModelError(f"negative vertex index {lo} in the faces", path)
     if hi >= len(vertices):
         raise ModelError(f"vertex index {hi} is out of range (the model has {len(vertices)} vertices)", path)
-    used = vertices[np.unique(faces)]
+    mask = np.zeros(len(vertices), bool)
+    mask[faces.ravel().astype(np.intp, copy=False)] = True
+    used = vertices[mask]
     from meshvis import limits
 
     if float(np.abs(used).max()) > limits.MAX_COORDINATE:  # a Python float: no float32 overflow

@@ -20,17 +20,62 @@ from scipy.sparse.csgraph import connected_components
 WELD_TOL = 1e-7
 
 
+#: constants of the splitmix64 finaliser, the bit mixer of the coordinate hash in :func:`_exact_groups`
+_MIX = (np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB), np.uint64(0x9E3779B97F4A7C15))
+
+
+def _mix(z: np.ndarray) -> np.ndarray:
+    """splitmix64 finaliser: every input bit changes about half of the output bits."""
+    z = (z ^ (z >> np.uint64(30))) * _MIX[0]
+    z = (z ^ (z >> np.uint64(27))) * _MIX[1]
+    return z ^ (z >> np.uint64(31))
+
+
+def used_vertices(faces: np.ndarray, n_vertices: int) -> np.ndarray:
+    """(k,) int64: sorted ids of the vertices some face uses (a mask, O(n + m), no sort)."""
+    mask = np.zeros(n_vertices, bool)
+    mask[np.asarray(faces).ravel()] = True
+    return np.flatnonzero(mask)
+
+
 def _diagonal(vertices: np.ndarray, faces: np.ndarray) -> float:
     if len(faces) == 0:
         return 0.0
-    used = vertices[np.unique(faces)]
+    used = vertices[used_vertices(faces, len(vertices))]
     return float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+
+
+def _exact_groups(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distinct rows of ``pts`` in lexicographic order, and the row of each input point.
+
+    The same answer as ``np.unique(pts, axis=0, return_inverse=True)``, 5-20x faster: the
+    points are grouped by sorting a 64-bit hash of their bits (one int64 argsort), each
+    group is checked to hold one point only (a hash collision falls back to ``np.unique``)
+    and only the distinct points are sorted lexicographically.
+    """
+    bits = np.ascontiguousarray(pts).view(np.uint64)
+    h = _mix(_mix(_mix(bits[:, 0] + _MIX[2]) ^ bits[:, 1]) ^ bits[:, 2])
+    order = np.argsort(h, kind="stable")
+    hs, s = h[order], pts[order]
+    new = np.ones(len(pts), bool)
+    new[1:] = hs[1:] != hs[:-1]
+    group = np.cumsum(new) - 1
+    first = s[np.flatnonzero(new)]
+    if np.any(first[group] != s):  # two different points with one hash: rare, stay exact
+        uniq, inverse = np.unique(pts, axis=0, return_inverse=True)
+        return uniq, inverse.reshape(-1)
+    lex = np.lexsort((first[:, 2], first[:, 1], first[:, 0]))
+    rank = np.empty(len(first), np.int64)
+    rank[lex] = np.arange(len(first))
+    inverse = np.empty(len(pts), np.int64)
+    inverse[order] = rank[group]
+    return first[lex], inverse
 
 
 def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tuple[np.ndarray, np.ndarray]:
     """Merge vertices that lie closer than ``tol`` times the bounding-box diagonal.
 
-    Exact duplicates are merged first (``np.unique`` on the coordinates); the remaining
+    Exact duplicates are merged first (grouped by a hash of the coordinates); the remaining
     distinct points are paired with a k-d tree (``cKDTree.query_pairs``) and merged by
     connected components, so a chain of points each within ``tol`` of the next becomes one
     vertex (harmless at the tiny default tolerance).
@@ -65,11 +110,10 @@ def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tupl
     index = np.full(len(vertices), -1, np.int64)
     if len(faces) == 0:
         return index, faces.copy()
-    used = np.unique(faces)
+    used = used_vertices(faces, len(vertices))
     # + 0.0 turns -0.0 into 0.0 so that both weld exactly
     pts = vertices[used] + 0.0
-    uniq, inverse = np.unique(pts, axis=0, return_inverse=True)
-    inverse = inverse.reshape(-1)
+    uniq, inverse = _exact_groups(pts)
     label = np.arange(len(uniq))
     radius = tol * _diagonal(vertices, faces)
     if radius > 0 and len(uniq) > 1:
@@ -154,7 +198,7 @@ def edges(faces_welded: np.ndarray) -> EdgeTable:
     """Unique undirected edges of welded faces, their face counts and traversal directions.
 
     Edge keys are ``lo * n + hi`` in int64 (``n`` = number of welded vertices), sorted
-    once; counts come from ``np.unique``.
+    once; edges and counts come from the runs of equal keys in that order.
 
     Parameters
     ----------
@@ -177,8 +221,13 @@ def edges(faces_welded: np.ndarray) -> EdgeTable:
     face = np.repeat(np.flatnonzero(ok), 3)
     keys = lo * np.int64(n) + hi
     order = np.argsort(keys, kind="stable")
-    ukeys, edge_of, count = np.unique(keys[order], return_inverse=True, return_counts=True)
-    edge_of = edge_of.reshape(-1)
+    sorted_keys = keys[order]
+    new = np.ones(len(keys), bool)
+    new[1:] = sorted_keys[1:] != sorted_keys[:-1]
+    starts = np.flatnonzero(new)
+    ukeys = sorted_keys[starts]
+    edge_of = np.cumsum(new) - 1
+    count = np.diff(np.append(starts, len(keys)))
     face_edge = np.full((m, 3), -1, np.int64)
     per_half = np.empty(len(keys), np.int64)
     per_half[order] = edge_of

@@ -1,6 +1,8 @@
 """What is wrong with a model: the numbers behind ``meshvis info``.
 
-:func:`diagnose` runs the connectivity analysis of :mod:`meshvis.geometry.adjacency` and the
+:func:`analyse` is the one pass over a model that both ``meshvis info`` (:func:`diagnose`)
+and the graph cut (:func:`meshvis.graphcut.preprocess.preprocess`) run, so that both report
+the same counts.  :func:`diagnose` runs the connectivity analysis of :mod:`meshvis.geometry.adjacency` and the
 conservative intersection / coplanarity tests of :mod:`meshvis.geometry.intersect` (the same
 preprocessing the graph cut uses, appendix H §2) and returns plain JSON-ready values, with
 the time each stage took.  :func:`format_report` turns them into a short table.
@@ -10,12 +12,118 @@ from __future__ import annotations
 
 import os
 import time
+from collections.abc import Callable
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from meshvis.geometry import adjacency, intersect
 from meshvis.io import as_soup
+from meshvis.soup import Soup
+
+#: a face whose smallest altitude is at most this fraction of the diagonal is degenerate:
+#: it is not classified (it has no side worth a ray) and ``info`` counts it as degenerate
+DEGENERATE_TOL = 1e-9
+
+Progress = Callable[[str, float], None]
+
+
+@dataclass
+class Analysis:
+    """One pass over a model's connectivity and defects, shared by ``info`` and ``classify``.
+
+    Attributes
+    ----------
+    faces_welded : (m, 3) int32 or int64, welded corner ids (:func:`adjacency.weld`)
+    table : EdgeTable of the welded faces
+    degenerate : (m,) bool, smallest altitude at most :data:`DEGENERATE_TOL` times the
+        diagonal, or zero area
+    collapsed : (m,) bool, two corners welded into one (weld tolerance)
+    duplicate_first : (m,) int64, :func:`adjacency.duplicate_faces`
+    flags : dict of :func:`intersect.intersection_flags`, or None when not run
+    seconds : dict, time of each step
+    """
+
+    faces_welded: np.ndarray
+    table: adjacency.EdgeTable
+    degenerate: np.ndarray
+    collapsed: np.ndarray
+    duplicate_first: np.ndarray
+    flags: dict | None
+    seconds: dict[str, float] = field(default_factory=dict)
+
+    @property
+    def counts(self) -> dict[str, int | None]:
+        """The defect counts both ``info`` and the classification report."""
+        f = self.flags
+        m = len(self.degenerate)
+        return {
+            "degenerate_faces": int(self.degenerate.sum()),
+            "collapsed_faces": int(self.collapsed.sum()),
+            "duplicate_faces": int((self.duplicate_first != np.arange(m)).sum()),
+            "intersecting_faces": None if f is None else int(f["intersects"].sum()),
+            "coplanar_faces": None if f is None else int(f["coplanar"].sum()),
+            "too_close_faces": None if f is None else int(f["too_close"].sum()),
+        }
+
+
+def analyse(
+    soup: Soup,
+    *,
+    eps: float | None = None,
+    weld_tol: float = adjacency.WELD_TOL,
+    intersections: bool = True,
+    progress: Progress | None = None,
+) -> Analysis:
+    """Weld, edges, degenerate, duplicate and intersecting faces of a soup, in one pass.
+
+    Parameters
+    ----------
+    soup : Soup
+    eps : float, optional
+        Distance tolerance of the intersection tests (fraction of the diagonal; default
+        :data:`meshvis.geometry.intersect.EPS`).
+    weld_tol : float
+        Weld tolerance (fraction of the diagonal).
+    intersections : bool
+        Run the intersection / coplanarity tests (the slowest step).
+    progress : callable, optional
+        ``progress(stage, fraction)``, called between the steps.
+
+    Returns
+    -------
+    Analysis
+    """
+    report = progress or (lambda stage, fraction: None)
+    seconds: dict[str, float] = {}
+    t = time.perf_counter()
+
+    def lap(name: str, fraction: float) -> None:
+        nonlocal t
+        now = time.perf_counter()
+        seconds[name] = round(now - t, 4)
+        t = now
+        report("analyse", fraction)
+
+    report("analyse", 0.0)
+    v, f = soup.vertices, soup.faces
+    _, fw = adjacency.weld(v, f, weld_tol)
+    lap("weld", 0.15)
+    table = adjacency.edges(fw)
+    lap("edges", 0.25)
+    collapsed = adjacency.collapsed(fw)
+    degenerate = adjacency.degenerate_faces(v, f, tol=DEGENERATE_TOL) | (soup.areas <= 0)
+    lap("degenerate", 0.3)
+    first = adjacency.duplicate_faces(fw)
+    lap("duplicates", 0.35)
+    flags = None
+    if intersections:
+        flags = intersect.intersection_flags(
+            v, f, eps, faces_welded=fw, progress=lambda x: report("analyse", 0.35 + 0.65 * x)
+        )
+        lap("intersections", 1.0)
+    return Analysis(fw, table, degenerate, collapsed, first, flags, seconds)
 
 
 def diagnose(
@@ -24,6 +132,7 @@ def diagnose(
     eps: float = intersect.EPS,
     weld_tol: float = adjacency.WELD_TOL,
     intersections: bool = True,
+    progress: Progress | None = None,
 ) -> dict:
     """Count the defects of a model.
 
@@ -39,6 +148,8 @@ def diagnose(
     intersections : bool
         Run the (slowest) intersection / coplanarity stage.  When ``False`` its counts are
         ``None``.
+    progress : callable, optional
+        ``progress(stage, fraction)``, as for :func:`meshvis.classify`.
 
     Returns
     -------
@@ -46,74 +157,58 @@ def diagnose(
         ``faces``, ``vertices`` (stored), ``welded_vertices``, ``parts``, ``components``
         (faces connected through shared edges; collapsed faces left out), ``edges``,
         ``boundary_edges`` (one face), ``nonmanifold_edges`` (more than two faces),
-        ``degenerate_faces`` (smallest altitude below the weld tolerance, or collapsed),
-        ``duplicate_faces`` (redundant copies of a face: same welded corners, either
-        winding), ``intersecting_faces``, ``coplanar_faces`` (overlapping a coplanar face),
-        ``too_close_faces`` (a non-adjacent face within ``eps``), ``winding_consistent`` and
-        ``inconsistent_edges`` (manifold edges traversed twice in the same direction),
-        ``closed`` (no boundary edge), ``edge_manifold`` (no non-manifold edge),
-        ``bounds`` ([min, max] corners), ``diagonal``, ``area``, ``eps`` and ``weld_tol``
-        (absolute, model units), ``path``, ``seconds`` (per stage) and ``total_seconds``.
+        ``degenerate_faces`` (smallest altitude at most :data:`DEGENERATE_TOL` times the
+        diagonal, or zero area: the faces the classification leaves out),
+        ``collapsed_faces`` (two corners welded into one), ``duplicate_faces`` (redundant
+        copies of a face: same welded corners, either winding), ``intersecting_faces``,
+        ``coplanar_faces`` (overlapping a coplanar face), ``too_close_faces`` (a non-adjacent
+        face within ``eps``), ``winding_consistent`` and ``inconsistent_edges`` (manifold
+        edges traversed twice in the same direction), ``closed`` (no boundary edge),
+        ``edge_manifold`` (no non-manifold edge), ``bounds`` ([min, max] corners),
+        ``diagonal``, ``area``, ``eps`` and ``weld_tol`` (absolute, model units), ``path``,
+        ``seconds`` (per stage) and ``total_seconds``.  The defect counts are those of
+        :attr:`Analysis.counts`, the same pass the classification runs.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> d = diagnose(trimesh.creation.box())
+    >>> d["closed"], d["degenerate_faces"], d["intersecting_faces"]
+    (True, 0, 0)
     """
-    seconds: dict[str, float] = {}
     t_all = time.perf_counter()
-
-    def lap(name: str, t0: float) -> float:
-        now = time.perf_counter()
-        seconds[name] = round(now - t0, 4)
-        return now
-
     t = time.perf_counter()
     soup = as_soup(model)
-    t = lap("load", t)
-    v, f = soup.vertices, soup.faces
+    seconds = {"load": round(time.perf_counter() - t, 4)}
+    a = analyse(soup, eps=eps, weld_tol=weld_tol, intersections=intersections, progress=progress)
+    seconds.update(a.seconds)
+    t = time.perf_counter()
     m = soup.n_faces
-    diag = soup.diagonal
+    _, label = adjacency.components(m, adjacency.face_adjacency(a.table, manifold_only=False))
+    n_comp = len(np.unique(label[~a.collapsed]))
+    seconds["components"] = round(time.perf_counter() - t, 4)
+    return _summary(soup, a, n_comp, eps, weld_tol, seconds, time.perf_counter() - t_all)
 
-    _, fw = adjacency.weld(v, f, weld_tol)
-    t = lap("weld", t)
 
-    table = adjacency.edges(fw)
-    consistent = table.consistent
-    t = lap("edges", t)
-
-    keep = ~adjacency.collapsed(fw)
-    _, label = adjacency.components(m, adjacency.face_adjacency(table, manifold_only=False))
-    n_comp = len(np.unique(label[keep]))
-    t = lap("components", t)
-
-    degenerate = adjacency.degenerate_faces(v, f, weld_tol, faces_welded=fw)
-    t = lap("degenerate", t)
-
-    first = adjacency.duplicate_faces(fw)
-    t = lap("duplicates", t)
-
-    inter = copl = close = None
-    if intersections:
-        flags = intersect.intersection_flags(v, f, eps, faces_welded=fw)
-        inter = int(flags["intersects"].sum())
-        copl = int(flags["coplanar"].sum())
-        close = int(flags["too_close"].sum())
-        t = lap("intersections", t)
-
+def _summary(
+    soup: Soup, a: Analysis, n_comp: int, eps: float, weld_tol: float, seconds: dict, total: float
+) -> dict:
+    """The JSON-ready dictionary of :func:`diagnose`."""
+    table, m, diag = a.table, soup.n_faces, soup.diagonal
     n_boundary = int(table.boundary.sum())
     n_nonmanifold = int(table.nonmanifold.sum())
-    n_inconsistent = int((~consistent).sum())
+    n_inconsistent = int((~table.consistent).sum())
     return {
         "path": None if soup.path is None else os.fspath(soup.path),
         "faces": int(m),
         "vertices": int(soup.n_vertices),
-        "welded_vertices": int(fw.max()) + 1 if m else 0,
+        "welded_vertices": int(a.faces_welded.max()) + 1 if m else 0,
         "parts": int(soup.n_parts),
         "components": int(n_comp),
         "edges": int(len(table.count)),
         "boundary_edges": n_boundary,
         "nonmanifold_edges": n_nonmanifold,
-        "degenerate_faces": int(degenerate.sum()),
-        "duplicate_faces": int((first != np.arange(m)).sum()),
-        "intersecting_faces": inter,
-        "coplanar_faces": copl,
-        "too_close_faces": close,
+        **a.counts,
         "winding_consistent": n_inconsistent == 0,
         "inconsistent_edges": n_inconsistent,
         "closed": n_boundary == 0,
@@ -124,7 +219,7 @@ def diagnose(
         "eps": float(eps * diag),
         "weld_tol": float(weld_tol * diag),
         "seconds": seconds,
-        "total_seconds": round(time.perf_counter() - t_all, 4),
+        "total_seconds": round(total, 4),
     }
 
 
@@ -141,6 +236,7 @@ _ROWS = [
     ("winding_consistent", "winding consistent"),
     ("inconsistent_edges", "inconsistently wound edges"),
     ("degenerate_faces", "degenerate faces"),
+    ("collapsed_faces", "faces collapsed by welding"),
     ("duplicate_faces", "duplicate faces"),
     ("intersecting_faces", "faces intersecting another"),
     ("coplanar_faces", "faces overlapping a coplanar one"),

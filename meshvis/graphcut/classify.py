@@ -43,6 +43,17 @@ from meshvis.soup import Soup
 FIRST_ROUND_RAYS = 4
 #: upper bound of the per-node ray multiplier of large clusters
 CLUSTER_RAY_FACTOR_MAX = 64
+#: standard deviations of the escape share within which a node counts as undecided
+#: against the opening threshold (:func:`opening_undecided`)
+OPENING_Z = 3.0
+#: no escape in n rays bounds the escape share below this / n with 99.9 % (-ln 1e-3)
+ZERO_ESCAPE_BOUND = 6.9
+
+
+def sees_others(hits) -> np.ndarray:
+    """(n,) bool: some ray of the node hit another node (off-diagonal hits)."""
+    h = hits.tocsr()
+    return np.asarray(h.sum(axis=1)).ravel() - h.diagonal() > 0
 
 
 @dataclass
@@ -122,9 +133,8 @@ class Classification:
             "clusters": int(self.pre.clustering.n_clusters),
             "edges": self.graph.n_edges,
             "flagged_faces": int(self.flagged.sum()),
-            "intersecting_faces": int(self.pre.intersects.sum()),
-            "coplanar_faces": int(self.pre.coplanar.sum()),
-            "degenerate_faces": int(self.degenerate.sum()),
+            # the counts of the analysis pass `meshvis info` runs too
+            **self.pre.analysis.counts,
             "rays": int(self.counts.rays),
             "reverse_rays": int(self.counts.reverse_rays),
             "hint_rays": int(self.params.get("hint_rays", 0)),
@@ -192,6 +202,41 @@ def ray_allocation(nodes: NodeSet, rays: int) -> np.ndarray:
     alloc = rays * factor
     alloc[nodes.area <= 0] = 0
     return alloc
+
+
+def opening_undecided(
+    escaped: np.ndarray,
+    counted: np.ndarray,
+    opening: float | None,
+    n_faces: np.ndarray,
+    sees_others: np.ndarray,
+) -> np.ndarray:
+    """(n,) bool: nodes whose escape share cannot yet be told above or below ``opening``.
+
+    The share of ``n`` rays is binomial: a node is undecided while ``opening`` lies within
+    :data:`OPENING_Z` standard deviations of its share (the deviation taken at the larger of
+    the share and the threshold, so that both sides are refined alike), or within a factor of
+    two of it.  A node none of whose rays escaped is decided once ``-ln(1e-3) / n`` (the
+    99.9 % bound of its share) is below ``opening``, when it is a single face or sample
+    point (there are many, and the prior holds for them) or when all its rays came back to
+    itself (``sees_others`` False: a closed shell's inside, which settles in its first round).
+    Undecided nodes keep receiving rays, and the sampling does not stop while one is left
+    with budget: otherwise whether a crack near the threshold leaks depends on the seed.
+    """
+    if opening is None:
+        return np.zeros(len(escaped), bool)
+    n = np.maximum(counted, 1)
+    share = escaped / n
+    p = np.maximum(share, opening)
+    band = OPENING_Z * np.sqrt(p * (1 - p) / n)
+    # no escape in n rays bounds the share below ZERO_ESCAPE_BOUND / n (99.9 %); a node
+    # whose rays all came back to itself (a closed shell's inside) is decided all the same
+    unbounded = (escaped == 0) & (n_faces > 1) & (ZERO_ESCAPE_BOUND / n > opening) & sees_others
+    return (
+        ((escaped > 0) | unbounded)
+        & (counted > 0)
+        & ((np.abs(share - opening) <= band) | ((share > 0.5 * opening) & (share < 2 * opening)))
+    )
 
 
 def classify(
@@ -270,149 +315,15 @@ def classify(
     rng = np.random.default_rng(seed)
     stages: list[Stage] = []
     report = progress or (lambda stage, frac: None)
-
-    t = time.perf_counter()
-    if caster is None:
-        caster = RayCaster(soup) if offset is None else RayCaster(soup, offset=offset)
-    stages.append(Stage("scene", True, time.perf_counter() - t, "Embree scene on the normalised copy"))
-
-    t = time.perf_counter()
-    report("preprocess", 0.0)
-    pre = preprocess(soup)
-    if pre.degenerate.all():  # no side has an area: there is no graph to cut
-        what = "the only face is" if soup.n_faces == 1 else f"all {soup.n_faces} faces are"
-        raise ModelError(f"{what} degenerate (zero area): nothing to classify", soup.path)
-    stages.append(
-        Stage(
-            "preprocess",
-            True,
-            time.perf_counter() - t,
-            f"{pre.clustering.n_clusters} clusters, {int(pre.flagged.sum())} flagged faces",
-        )
+    caster = _scene(soup, caster, offset, stages, report)
+    pre = _preprocess(soup, stages, report)
+    nodes = _nodes(soup, pre, caster, samples_per_face, sampling_scheme, stages)
+    hint_out, hint_in, hint_rays = _hints(caster, nodes, hints, rng, stages)
+    loop = _Sampling(
+        caster, nodes, soup, pre.degenerate, rng, hint_out, hint_in, use_filter, opening, solver, report
     )
-
-    t = time.perf_counter()
-    off_abs = caster.offset * caster.diagonal
-    nodes = build_nodes(
-        soup.triangles,
-        soup.normals,
-        soup.areas,
-        pre.clustering,
-        pre.flagged,
-        pre.partner_pairs,
-        samples=samples_per_face,
-        scheme=sampling_scheme,
-        offset=off_abs,
-        proximity=2 * off_abs,
-    )
-    point_note = (
-        f"{nodes.n_points} sample points" if nodes.n_points else "skipped point nodes: no flagged faces"
-    )
-    stages.append(Stage("nodes", True, time.perf_counter() - t, f"{nodes.n} nodes; {point_note}"))
-
-    hint_out = hint_in = None
-    hint_rays = 0
-    if hints is not None and not hints.empty:
-        t = time.perf_counter()
-        hint_out, hint_in, hint_rays = hint_weights(caster, nodes, hints, rng)
-        stages.append(Stage("hints", True, time.perf_counter() - t, f"{hint_rays} rays from hints"))
-    else:
-        stages.append(Stage("hints", False, 0.0, "no hints given"))
-
-    counts = VisibilityCounts(nodes.n)
-    is_point = nodes.is_point
-    rounds: list[dict] = []
-    budget = ray_allocation(nodes, rays_per_node)
-    _validate.ray_budget(int(budget.sum()), nodes.n, rays_per_node)
-    cast = np.zeros(nodes.n, np.int64)
-    give = ray_allocation(nodes, min(FIRST_ROUND_RAYS, rays_per_node) if progressive else rays_per_node)
-    prev = prev_nodes = None
-    t_sample = t_cut = 0.0
-    stop_reason = "single round"
-    while True:
-        t = time.perf_counter()
-        report("sampling", float(cast.sum()) / max(float(budget.sum()), 1.0))
-        sample_round(caster, nodes, give, rng, counts)
-        cast += give
-        t_sample += time.perf_counter() - t
-
-        t = time.perf_counter()
-        counted = counts.cast - counts.discarded
-        weights = graph_weights(
-            counts.hits,
-            counted,
-            counts.escaped,
-            nodes.area,
-            nodes.opposite,
-            is_point,
-            hint_out=hint_out,
-            hint_in=hint_in,
-            use_filter=use_filter,
-            opening=opening,
-        )
-        graph = VisibilityGraph(nodes.n, weights)
-        cut = graph.cut(solver)
-        labels = face_labels(nodes, cut.outside, soup.n_faces, pre.degenerate)
-        t_cut += time.perf_counter() - t
-
-        changed: float | None = (
-            None
-            if prev is None
-            else float(
-                (np.abs(labels - prev).sum(axis=1) * soup.areas).sum() / max(2 * soup.total_area, 1e-300)
-            )
-        )
-        rounds.append(
-            {
-                "rays": int(counts.rays),
-                "nodes_sampled": int((give > 0).sum()),
-                "edges": graph.n_edges,
-                "changed_area_fraction": changed,
-            }
-        )
-        if not progressive:
-            break
-        if changed is not None and changed <= tolerance:
-            stop_reason = f"converged after {len(rounds)} rounds (change {changed:.2e} <= {tolerance:g})"
-            break
-        # Next round: double the rays of the nodes that are still undecided.  After the
-        # first round every node is undecided; later only nodes whose label changed and
-        # nodes on the cut (an edge to a node of the other label) get more rays.
-        active = np.zeros(nodes.n, bool) if prev_nodes is None else cut.outside != prev_nodes
-        w = graph.weights
-        across = cut.outside[w.edges_i] != cut.outside[w.edges_j]
-        active[w.edges_i[across]] = True
-        active[w.edges_j[across]] = True
-        if prev_nodes is None:
-            # after the first round also every node whose terminal links are close to a tie
-            margin = np.abs(w.cap_out - w.cap_in) <= 0.5 * np.maximum(w.cap_out, w.cap_in)
-            active |= margin & (np.maximum(w.cap_out, w.cap_in) > 0)
-        if opening is not None:
-            # and every node whose escape share is too close to the opening threshold to tell
-            share = counts.escaped / np.maximum(counted, 1)
-            active |= (share > 0.5 * opening) & (share < 2 * opening)
-        give = np.where(active, np.minimum(cast, budget - cast), 0)
-        prev, prev_nodes = labels, cut.outside
-        if not active.any():
-            stop_reason = f"settled after {len(rounds)} round(s): no node left undecided"
-            break
-        if give.sum() == 0:
-            stop_reason = f"ray budget reached after {len(rounds)} rounds"
-            break
-
-    stages.append(
-        Stage(
-            "sampling", True, t_sample, f"{counts.rays} rays + {counts.reverse_rays} reverse; {stop_reason}"
-        )
-    )
-    stages.append(
-        Stage(
-            "cut",
-            True,
-            t_cut,
-            f"{graph.n_edges} edges, solver {cut.solver}, filter {'on' if use_filter else 'off'}",
-        )
-    )
+    loop.run(rays_per_node, progressive, tolerance)
+    stages += loop.stages(use_filter)
     report("done", 1.0)
     params = {
         "rays_per_node": rays_per_node,
@@ -429,17 +340,208 @@ def classify(
     }
     return Classification(
         soup=soup,
-        outside=labels,
+        outside=loop.labels,
         degenerate=pre.degenerate,
         flagged=pre.flagged,
         cluster=pre.clustering.cluster,
         nodes=nodes,
-        graph=graph,
-        counts=counts,
-        cut=cut,
+        graph=loop.graph,
+        counts=loop.counts,
+        cut=loop.cut,
         caster=caster,
         pre=pre,
         stages=stages,
-        rounds=rounds,
+        rounds=loop.rounds,
         params=params,
     )
+
+
+# ---------------------------------------------------------------------- the stages of classify
+def _scene(
+    soup: Soup, caster: RayCaster | None, offset: float | None, stages: list[Stage], report
+) -> RayCaster:
+    """The Embree scene (or the caller's prebuilt one)."""
+    t = time.perf_counter()
+    report("scene", 0.0)
+    if caster is None:
+        caster = RayCaster(soup) if offset is None else RayCaster(soup, offset=offset)
+    stages.append(Stage("scene", True, time.perf_counter() - t, "Embree scene on the normalised copy"))
+    return caster
+
+
+def _preprocess(soup: Soup, stages: list[Stage], report) -> Preprocessed:
+    """Flags and clusters (appendix H §2); every face degenerate is a :class:`ModelError`."""
+    t = time.perf_counter()
+    report("preprocess", 0.0)
+    pre = preprocess(soup, progress=lambda stage, frac: report("preprocess", frac))
+    if pre.degenerate.all():  # no side has an area: there is no graph to cut
+        what = "the only face is" if soup.n_faces == 1 else f"all {soup.n_faces} faces are"
+        raise ModelError(f"{what} degenerate (zero area): nothing to classify", soup.path)
+    note = f"{pre.clustering.n_clusters} clusters, {int(pre.flagged.sum())} flagged faces"
+    stages.append(Stage("preprocess", True, time.perf_counter() - t, note))
+    return pre
+
+
+def _nodes(
+    soup: Soup, pre: Preprocessed, caster: RayCaster, samples: int, scheme: int, stages: list[Stage]
+) -> NodeSet:
+    """Half-space nodes: cluster sides and the sample points of flagged faces."""
+    t = time.perf_counter()
+    off_abs = caster.offset * caster.diagonal
+    nodes = build_nodes(
+        soup.triangles,
+        soup.normals,
+        soup.areas,
+        pre.clustering,
+        pre.flagged,
+        pre.partner_pairs,
+        samples=samples,
+        scheme=scheme,
+        offset=off_abs,
+        proximity=2 * off_abs,
+    )
+    point_note = (
+        f"{nodes.n_points} sample points" if nodes.n_points else "skipped point nodes: no flagged faces"
+    )
+    stages.append(Stage("nodes", True, time.perf_counter() - t, f"{nodes.n} nodes; {point_note}"))
+    return nodes
+
+
+def _hints(caster: RayCaster, nodes: NodeSet, hints: Hints | None, rng, stages: list[Stage]):
+    """Terminal weights from user hints: (hint_out, hint_in, rays), or (None, None, 0)."""
+    if hints is None or hints.empty:
+        stages.append(Stage("hints", False, 0.0, "no hints given"))
+        return None, None, 0
+    t = time.perf_counter()
+    hint_out, hint_in, hint_rays = hint_weights(caster, nodes, hints, rng)
+    stages.append(Stage("hints", True, time.perf_counter() - t, f"{hint_rays} rays from hints"))
+    return hint_out, hint_in, hint_rays
+
+
+class _Sampling:
+    """Progressive visibility sampling and cutting: the state carried from round to round."""
+
+    def __init__(
+        self, caster, nodes, soup, degenerate, rng, hint_out, hint_in, use_filter, opening, solver, report
+    ):
+        self.caster, self.nodes, self.soup, self.degenerate, self.rng = caster, nodes, soup, degenerate, rng
+        self.hint_out, self.hint_in, self.use_filter, self.opening = hint_out, hint_in, use_filter, opening
+        self.solver, self.report = solver, report
+        self.counts = VisibilityCounts(nodes.n)
+        self.rounds: list[dict] = []
+        self.t_sample = self.t_cut = 0.0
+        self.stop_reason = "single round"
+        self.graph = self.cut = self.labels = None
+
+    def run(self, rays_per_node: int, progressive: bool, tolerance: float) -> None:
+        """Cast rounds of rays and cut after each until the labels settle (module notes)."""
+        nodes = self.nodes
+        budget = ray_allocation(nodes, rays_per_node)
+        _validate.ray_budget(int(budget.sum()), nodes.n, rays_per_node)
+        cast = np.zeros(nodes.n, np.int64)
+        give = ray_allocation(nodes, min(FIRST_ROUND_RAYS, rays_per_node) if progressive else rays_per_node)
+        prev = prev_nodes = None
+        while True:
+            self._sample(give, cast, budget)
+            cast += give
+            self._cut()
+            changed = self._changed(prev)
+            self.rounds.append(
+                {
+                    "rays": int(self.counts.rays),
+                    "nodes_sampled": int((give > 0).sum()),
+                    "edges": self.graph.n_edges,
+                    "changed_area_fraction": changed,
+                }
+            )
+            if not progressive:
+                break
+            counted = self.counts.cast - self.counts.discarded
+            near_threshold = opening_undecided(
+                self.counts.escaped, counted, self.opening, nodes.n_faces, sees_others(self.counts.hits)
+            ) & (cast < budget)
+            # only clusters of several faces (the sheets around a crack) hold the loop open
+            held = (near_threshold & (nodes.n_faces > 1)).any()
+            if changed is not None and changed <= tolerance and not held:
+                self.stop_reason = (
+                    f"converged after {len(self.rounds)} rounds (change {changed:.2e} <= {tolerance:g})"
+                )
+                break
+            active = self._undecided(prev_nodes) | near_threshold
+            give = np.where(active, np.minimum(cast, budget - cast), 0)
+            # a node undecided against the opening threshold gets its whole remaining budget at
+            # once: it is settled in one more round instead of one doubling per round
+            give[near_threshold] = (budget - cast)[near_threshold]
+            prev, prev_nodes = self.labels, self.cut.outside
+            if not active.any():
+                self.stop_reason = f"settled after {len(self.rounds)} round(s): no node left undecided"
+                break
+            if give.sum() == 0:
+                self.stop_reason = f"ray budget reached after {len(self.rounds)} rounds"
+                break
+
+    def _sample(self, give: np.ndarray, cast: np.ndarray, budget: np.ndarray) -> None:
+        t = time.perf_counter()
+        self.report("sampling", float(cast.sum()) / max(float(budget.sum()), 1.0))
+        sample_round(self.caster, self.nodes, give, self.rng, self.counts)
+        self.t_sample += time.perf_counter() - t
+
+    def _cut(self) -> None:
+        """Weights (Eq. 5-9) from the counts so far, the min cut and the face labels."""
+        t = time.perf_counter()
+        c, nodes = self.counts, self.nodes
+        weights = graph_weights(
+            c.hits,
+            c.cast - c.discarded,
+            c.escaped,
+            nodes.area,
+            nodes.opposite,
+            nodes.is_point,
+            hint_out=self.hint_out,
+            hint_in=self.hint_in,
+            use_filter=self.use_filter,
+            opening=self.opening,
+        )
+        self.graph = VisibilityGraph(nodes.n, weights)
+        self.cut = self.graph.cut(self.solver)
+        self.labels = face_labels(nodes, self.cut.outside, self.soup.n_faces, self.degenerate)
+        self.t_cut += time.perf_counter() - t
+
+    def _changed(self, prev: np.ndarray | None) -> float | None:
+        """Fraction of the side area whose label changed since the previous round."""
+        if prev is None:
+            return None
+        soup = self.soup
+        return float(
+            (np.abs(self.labels - prev).sum(axis=1) * soup.areas).sum() / max(2 * soup.total_area, 1e-300)
+        )
+
+    def _undecided(self, prev_nodes: np.ndarray | None) -> np.ndarray:
+        """Nodes that get more rays: label changed, on the cut, or (first round) near a tie."""
+        outside, w = self.cut.outside, self.graph.weights
+        active = np.zeros(self.nodes.n, bool) if prev_nodes is None else outside != prev_nodes
+        across = outside[w.edges_i] != outside[w.edges_j]
+        active[w.edges_i[across]] = True
+        active[w.edges_j[across]] = True
+        if prev_nodes is None:
+            # after the first round also every node whose terminal links are close to a tie
+            margin = np.abs(w.cap_out - w.cap_in) <= 0.5 * np.maximum(w.cap_out, w.cap_in)
+            active |= margin & (np.maximum(w.cap_out, w.cap_in) > 0)
+        return active
+
+    def stages(self, use_filter: bool) -> list[Stage]:
+        c = self.counts
+        return [
+            Stage(
+                "sampling",
+                True,
+                self.t_sample,
+                f"{c.rays} rays + {c.reverse_rays} reverse; {self.stop_reason}",
+            ),
+            Stage(
+                "cut",
+                True,
+                self.t_cut,
+                f"{self.graph.n_edges} edges, solver {self.cut.solver}, filter {'on' if use_filter else 'off'}",
+            ),
+        ]

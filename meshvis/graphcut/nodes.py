@@ -163,11 +163,36 @@ def build_nodes(
     NodeSet
         Cluster nodes first, then two nodes per sample point.
     """
-    m = len(triangles)
     side_node = clustering.side_node
     n_cluster = clustering.n_nodes
+    e_node, e_face, e_side, node_start, c_area, c_faces = _cluster_entries(side_node, n_cluster, areas)
+    pts = _point_nodes(triangles, normals, areas, flagged, partner_pairs, samples, scheme, offset, proximity)
+    n_points = len(pts["point_face"])
+    p_area = np.repeat(areas[pts["flagged"]] / samples, samples)
+    return NodeSet(
+        n=n_cluster + 2 * n_points,
+        n_cluster=n_cluster,
+        area=np.concatenate([c_area, np.repeat(p_area, 2)]),
+        opposite=np.concatenate([clustering.opposite, n_cluster + (np.arange(2 * n_points) ^ 1)]),
+        n_faces=np.concatenate([c_faces, np.ones(2 * n_points, np.int64)]),
+        side_node=side_node,
+        entry_node=e_node,
+        entry_face=e_face,
+        entry_side=e_side,
+        entry_cumarea=np.cumsum(areas[e_face]),
+        node_start=node_start,
+        samples=samples,
+        tangents=tangent_frames(normals),
+        **pts,
+    )
 
-    # -- cluster nodes: (node, face, side) entries sorted by node
+
+def _cluster_entries(side_node: np.ndarray, n_cluster: int, areas: np.ndarray):
+    """Entries of the cluster nodes.
+
+    Returns the (node, face, side) entries sorted by node, the start of each node's
+    entries, and each node's area and face count.
+    """
     faces_c = np.flatnonzero(side_node[:, 0] >= 0)
     e_node = np.concatenate([side_node[faces_c, 0], side_node[faces_c, 1]])
     e_face = np.concatenate([faces_c, faces_c])
@@ -177,8 +202,14 @@ def build_nodes(
     node_start = np.searchsorted(e_node, np.arange(n_cluster + 1))
     c_area = np.bincount(e_node, areas[e_face], minlength=n_cluster)
     c_faces = np.bincount(e_node, minlength=n_cluster)
+    return e_node, e_face, e_side, node_start, c_area, c_faces
 
-    # -- point nodes on flagged faces
+
+def _point_nodes(
+    triangles, normals, areas, flagged, partner_pairs, samples, scheme, offset, proximity
+) -> dict:
+    """Sample points of the flagged faces with their pushed ray origins (NodeSet fields)."""
+    m = len(triangles)
     flagged_faces = np.flatnonzero(flagged)
     flagged_index = np.full(m, -1, np.int64)
     flagged_index[flagged_faces] = np.arange(len(flagged_faces))
@@ -190,40 +221,20 @@ def build_nodes(
         origin[:, s] = _pushed_origins(
             pos, point_face, s, triangles, normals, flagged_index, partner_pairs, samples, offset, proximity
         )
-
     tf = triangles[flagged_faces]
     e1, e2 = tf[:, 1] - tf[:, 0], tf[:, 2] - tf[:, 0]
     metric = np.stack(
         [np.einsum("ij,ij->i", e1, e1), np.einsum("ij,ij->i", e1, e2), np.einsum("ij,ij->i", e2, e2)], axis=1
     )
-    p_area = np.repeat(areas[flagged_faces] / samples, samples)
-    n_points = len(point_face)
-    n = n_cluster + 2 * n_points
-    area = np.concatenate([c_area, np.repeat(p_area, 2)])
-    opposite = np.concatenate([clustering.opposite, n_cluster + (np.arange(2 * n_points) ^ 1)])
-    n_faces = np.concatenate([c_faces, np.ones(2 * n_points, np.int64)])
-    return NodeSet(
-        n=n,
-        n_cluster=n_cluster,
-        area=area,
-        opposite=opposite,
-        n_faces=n_faces,
-        side_node=side_node,
-        entry_node=e_node,
-        entry_face=e_face,
-        entry_side=e_side,
-        entry_cumarea=np.cumsum(areas[e_face]),
-        node_start=node_start,
-        flagged=flagged_faces,
-        samples=samples,
-        point_face=point_face,
-        point_pos=pos,
-        point_origin=origin,
-        flagged_index=flagged_index,
-        sample_bary=bary,
-        flagged_metric=metric,
-        tangents=tangent_frames(normals),
-    )
+    return {
+        "flagged": flagged_faces,
+        "point_face": point_face,
+        "point_pos": pos,
+        "point_origin": origin,
+        "flagged_index": flagged_index,
+        "sample_bary": bary,
+        "flagged_metric": metric,
+    }
 
 
 #: |cos| between a partner's normal and a side normal below which the two are taken as

@@ -7,17 +7,17 @@ the input's faces.
 
 from __future__ import annotations
 
+from collections.abc import Callable
 from dataclasses import dataclass
 
 import numpy as np
 
-from meshvis.geometry.adjacency import WELD_TOL, degenerate_faces, edges, weld
-from meshvis.geometry.intersect import intersection_flags
+from meshvis.geometry.adjacency import WELD_TOL
+from meshvis.geometry.diagnostics import DEGENERATE_TOL, Analysis, analyse
 from meshvis.graphcut.clusters import Clustering, cluster_sides
 from meshvis.soup import Soup
 
-#: a face whose smallest altitude is below this fraction of the diagonal is not classified
-DEGENERATE_TOL = 1e-9
+__all__ = ["DEGENERATE_TOL", "Preprocessed", "preprocess"]
 
 
 @dataclass
@@ -33,6 +33,7 @@ class Preprocessed:
     partner_pairs : (k, 2) int64, the face pairs behind the flags
     clustering : Clustering
     faces_welded : (m, 3) int64
+    analysis : Analysis, the pass shared with ``meshvis info`` (its ``counts``)
     """
 
     intersects: np.ndarray
@@ -43,25 +44,40 @@ class Preprocessed:
     partner_pairs: np.ndarray
     clustering: Clustering
     faces_welded: np.ndarray
+    analysis: Analysis
 
 
-def preprocess(soup: Soup, *, eps: float | None = None, weld_tol: float = WELD_TOL) -> Preprocessed:
+def preprocess(
+    soup: Soup,
+    *,
+    eps: float | None = None,
+    weld_tol: float = WELD_TOL,
+    progress: Callable[[str, float], None] | None = None,
+) -> Preprocessed:
     """Flag difficult faces and cluster the others (appendix H §2).
 
     Parameters
     ----------
-    soup : the model
-    eps : distance tolerance of the intersection/coplanarity tests (fraction of the diagonal)
-    weld_tol : weld tolerance for adjacency (fraction of the diagonal)
+    soup : Soup, the model
+    eps : float, optional
+        Distance tolerance of the intersection/coplanarity tests (fraction of the diagonal).
+    weld_tol : float
+        Weld tolerance for adjacency (fraction of the diagonal).
+    progress : callable, optional
+        ``progress(stage, fraction)`` of the analysis pass.
+
+    Returns
+    -------
+    Preprocessed
     """
-    _, faces_welded = weld(soup.vertices, soup.faces, weld_tol)
-    flags = intersection_flags(soup.vertices, soup.faces, eps, faces_welded=faces_welded)
-    degenerate = degenerate_faces(soup.vertices, soup.faces, tol=DEGENERATE_TOL) | (soup.areas <= 0)
+    analysis = analyse(soup, eps=eps, weld_tol=weld_tol, progress=progress)
+    flags, faces_welded, degenerate = analysis.flags, analysis.faces_welded, analysis.degenerate
+    assert flags is not None  # analyse() tests intersections unless told not to
     flagged = (flags["intersects"] | flags["coplanar"]) & ~degenerate
     pairs = np.concatenate([flags["intersect_pairs"], flags["coplanar_pairs"], flags["close_pairs"]]).astype(
         np.int64
     )
-    clustering = cluster_sides(edges(faces_welded), ~flagged & ~degenerate, ~flags["too_close"])
+    clustering = cluster_sides(analysis.table, ~flagged & ~degenerate, ~flags["too_close"])
     return Preprocessed(
         intersects=flags["intersects"],
         coplanar=flags["coplanar"],
@@ -71,4 +87,5 @@ def preprocess(soup: Soup, *, eps: float | None = None, weld_tol: float = WELD_T
         partner_pairs=pairs.reshape(-1, 2),
         clustering=clustering,
         faces_welded=faces_welded,
+        analysis=analysis,
     )

@@ -110,13 +110,17 @@ class RayCaster:
         # a model that is a single point (all faces degenerate) still gets a usable scale
         self.scale = 1.0 / diag if diag > 0 else 1.0
         self.diagonal = diag if diag > 0 else 1.0
-        self.normals = soup.normals
         self.part_id = soup.part_id
         v32 = ((soup.vertices - self.center) * self.scale).astype(np.float32)
         # Vertices unused by faces may be far away or non-finite: clamp them harmlessly.
         v32[~np.isfinite(v32).all(axis=1)] = 0
         self._scene = rs.EmbreeScene()
         self._mesh = mc.TriangleMesh(self._scene, v32, soup.faces.astype(np.int32))
+
+    @property
+    def normals(self) -> np.ndarray:
+        """(m, 3) unit face normals of the model (computed on first use, not with the scene)."""
+        return self.soup.normals
 
     # ------------------------------------------------------------------ coordinates
     def to_unit(self, points: np.ndarray) -> np.ndarray:

@@ -224,3 +224,16 @@ def test_cli_info_errors(tmp_path, capsys):
     trimesh.creation.box().export(path)
     assert main(["info", str(path), "--eps", "0"]) == 2
     assert "--eps" in capsys.readouterr().err
+
+
+def test_diagnose_advances_a_progress_bar_through_every_step():
+    import trimesh
+
+    from meshvis.geometry.diagnostics import diagnose
+
+    seen = []
+    diagnose(trimesh.creation.icosphere(3), progress=lambda stage, fraction: seen.append((stage, fraction)))
+    fractions = [f for _, f in seen]
+    assert fractions[0] == 0.0 and fractions[-1] == 1.0
+    assert fractions == sorted(fractions)
+    assert len(set(fractions)) >= 6  # weld, edges, degenerate, duplicates, broad and narrow phase

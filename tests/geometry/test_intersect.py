@@ -190,6 +190,39 @@ def test_folded_pair_sharing_an_edge_is_coplanar():
     assert not d["intersects"].any()
 
 
+def bent_quad(degrees: float) -> np.ndarray:
+    """Corners a, b, c, d of a unit square bent along its diagonal ac by ``degrees``."""
+    t = np.radians(degrees)
+    # d rotates about the diagonal ac (through the origin, direction (1, 1, 0) / sqrt 2)
+    axis = np.array([1.0, 1.0, 0.0]) / np.sqrt(2)
+    d0 = np.array([0.0, 1.0, 0.0])
+    along = (d0 @ axis) * axis
+    perp = d0 - along
+    d = along + np.cos(t) * perp + np.sin(t) * np.cross(axis, perp)
+    return np.array([[0, 0, 0], [1, 0, 0], [1, 1, 0], d], float)
+
+
+@pytest.mark.parametrize("welded", [True, False])
+def test_quad_stored_with_both_diagonals_planes_one_degree_apart_is_coplanar(welded):
+    # abc + acd and abd + bcd cover the same bent quad twice; every pair shares an edge and
+    # abc / abd (and acd / bcd ...) lie folded onto each other 1 degree apart
+    q = bent_quad(1.0)
+    f = np.array([[0, 1, 2], [0, 2, 3], [0, 1, 3], [1, 2, 3]])
+    v, f = (q, f) if welded else soup(*q[f])
+    d = intersection_flags(v, f)
+    assert d["coplanar"].all()
+    assert not d["intersects"].any()
+    folded = pair_set(d["coplanar_pairs"])
+    assert (0, 2) in folded and (1, 3) in folded
+    assert (0, 1) not in folded  # abc and acd lie side by side on their diagonal
+
+
+def test_fold_wider_than_the_fold_angle_is_not_coplanar():
+    q = bent_quad(10.0)
+    d = intersection_flags(q, np.array([[0, 1, 2], [0, 2, 3], [0, 1, 3], [1, 2, 3]]))
+    assert not d["coplanar"].any()
+
+
 # --------------------------------------------------------------------------- invariance
 def mixed_scene():
     tris = crossing_pair([0, 0, 0]) + crossing_pair([3, 0, 0])

@@ -1,0 +1,227 @@
+"""Numba kernels of the intersection tests of :mod:`meshvis.geometry.intersect`: broad and narrow phase.
+
+One loop over the candidate pairs, with the arithmetic of the separating-axis and
+shared-corner tests written out per pair: no (pairs, axes, corners) temporaries, and the
+pairs never leave the cache.  The tests and their tolerances are those documented in
+:mod:`meshvis.geometry.intersect`; the comparisons carry a relative slack of
+:data:`SLACK` on the reporting side, so that a different order of the floating-point
+operations can only add reports (the flags stay conservative).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+#: relative slack of every reporting comparison (far above float64 reordering error)
+SLACK = 1e-12
+#: angular slack of the wedge test at a shared corner (as in the vectorised version)
+WEDGE_SLACK = 1e-9
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _proj_gap(ax, ay, az, T, lo, hi):
+    """Gap between [lo, hi] and the projection of the 3 corners T (3, 3) on the axis."""
+    p0 = ax * T[0, 0] + ay * T[0, 1] + az * T[0, 2]
+    p1 = ax * T[1, 0] + ay * T[1, 1] + az * T[1, 2]
+    p2 = ax * T[2, 0] + ay * T[2, 1] + az * T[2, 2]
+    pmin = min(p0, min(p1, p2))
+    pmax = max(p0, max(p1, p2))
+    return max(pmin - hi, lo - pmax), p0, p1, p2
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _unit_from(T, c, k):
+    """Unit vector from corner c to corner k of T, as three scalars (no allocation)."""
+    x = T[k, 0] - T[c, 0]
+    y = T[k, 1] - T[c, 1]
+    z = T[k, 2] - T[c, 2]
+    n = math.sqrt(x * x + y * y + z * z)
+    return x / n, y / n, z / n
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _in_wedge(T, c, n, dx, dy, dz):
+    """Direction d lies in the wedge of T at corner c (counter-clockwise about n)."""
+    ax, ay, az = _unit_from(T, c, (c + 1) % 3)
+    bx, by, bz = _unit_from(T, c, (c + 2) % 3)
+    # (u1 x d) . n and (d x u2) . n
+    a = (ay * dz - az * dy) * n[0] + (az * dx - ax * dz) * n[1] + (ax * dy - ay * dx) * n[2]
+    b = (dy * bz - dz * by) * n[0] + (dz * bx - dx * bz) * n[1] + (dx * by - dy * bx) * n[2]
+    s = -WEDGE_SLACK * (1 + SLACK)
+    return a >= s and b >= s
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def narrow_phase(
+    tri, fw, axes, valid, has_normal, low, high, edges, edge_len, pairs, eps, near, tau, cos_angle, cos_fold
+):
+    """Per-pair (intersects, coplanar, too_close, folded) flags; see ``classify_pairs``."""
+    p = pairs.shape[0]
+    inter = np.zeros(p, np.bool_)
+    copl = np.zeros(p, np.bool_)
+    close = np.zeros(p, np.bool_)
+    fold = np.zeros(p, np.bool_)
+    pad = max(eps, near)
+    eps_r = eps * (1 + SLACK)
+    near_r = near * (1 + SLACK)
+    pad_r = pad * (1 + SLACK)
+    for q in range(p):
+        i = pairs[q, 0]
+        j = pairs[q, 1]
+        Ti = tri[i]
+        Tj = tri[j]
+        nshared = 0
+        ci = -1
+        cj = -1
+        for a in range(3):
+            for b in range(3):
+                if fw[i, a] == fw[j, b]:
+                    nshared += 1
+                    ci = a
+                    cj = b
+        # stage 1: the 4 axes of each face
+        max_gap = -np.inf
+        in_plane = -np.inf
+        dev_j = 0.0  # largest distance of j's corners from i's mid-plane
+        dev_i = 0.0
+        mid_i = 0.5 * (low[i, 0] + high[i, 0])
+        mid_j = 0.5 * (low[j, 0] + high[j, 0])
+        for k in range(4):
+            g, p0, p1, p2 = _proj_gap(axes[i, k, 0], axes[i, k, 1], axes[i, k, 2], Tj, low[i, k], high[i, k])
+            if k == 0:
+                dev_j = max(abs(p0 - mid_i), max(abs(p1 - mid_i), abs(p2 - mid_i)))
+            if valid[i, k]:
+                max_gap = max(max_gap, g)
+                if k > 0:
+                    in_plane = max(in_plane, g)
+            g, p0, p1, p2 = _proj_gap(axes[j, k, 0], axes[j, k, 1], axes[j, k, 2], Ti, low[j, k], high[j, k])
+            if k == 0:
+                dev_i = max(abs(p0 - mid_j), max(abs(p1 - mid_j), abs(p2 - mid_j)))
+            if valid[j, k]:
+                max_gap = max(max_gap, g)
+                if k > 0:
+                    in_plane = max(in_plane, g)
+        both = has_normal[i] and has_normal[j]
+        cosn = axes[i, 0, 0] * axes[j, 0, 0] + axes[i, 0, 1] * axes[j, 0, 1] + axes[i, 0, 2] * axes[j, 0, 2]
+        flat = both and abs(cosn) >= cos_angle * (1 - SLACK) and dev_j <= eps_r and dev_i <= eps_r
+        copl[q] = flat and in_plane < -eps * (1 - SLACK)
+        if nshared == 0:
+            # stage 2: edge x edge axes while the pair is still within reach
+            if max_gap <= pad_r:
+                for a in range(3):
+                    for b in range(3):
+                        ex = edges[i, a, 1] * edges[j, b, 2] - edges[i, a, 2] * edges[j, b, 1]
+                        ey = edges[i, a, 2] * edges[j, b, 0] - edges[i, a, 0] * edges[j, b, 2]
+                        ez = edges[i, a, 0] * edges[j, b, 1] - edges[i, a, 1] * edges[j, b, 0]
+                        length = math.sqrt(ex * ex + ey * ey + ez * ez)
+                        if not length > tau * edge_len[i, a] * edge_len[j, b]:
+                            continue
+                        g, p0, p1, p2 = _proj_gap(ex, ey, ez, Ti, 0.0, 0.0)
+                        lo_i = min(p0, min(p1, p2))
+                        hi_i = max(p0, max(p1, p2))
+                        g, p0, p1, p2 = _proj_gap(ex, ey, ez, Tj, lo_i, hi_i)
+                        max_gap = max(max_gap, g / length)
+            inter[q] = (not flat) and max_gap <= eps_r
+            close[q] = max_gap <= near_r
+        elif not flat:
+            if nshared == 1 and both:
+                ni = axes[i, 0]
+                nj = axes[j, 0]
+                lx = ni[1] * nj[2] - ni[2] * nj[1]
+                ly = ni[2] * nj[0] - ni[0] * nj[2]
+                lz = ni[0] * nj[1] - ni[1] * nj[0]
+                length = math.sqrt(lx * lx + ly * ly + lz * lz)
+                if length > tau:
+                    lx /= length
+                    ly /= length
+                    lz /= length
+                    meet = (_in_wedge(Ti, ci, ni, lx, ly, lz) and _in_wedge(Tj, cj, nj, lx, ly, lz)) or (
+                        _in_wedge(Ti, ci, ni, -lx, -ly, -lz) and _in_wedge(Tj, cj, nj, -lx, -ly, -lz)
+                    )
+                else:
+                    meet = True
+                inter[q] = meet
+                close[q] = meet
+            elif nshared == 2 and both:
+                fold[q] = _folded(Ti, Tj, fw[i], fw[j], cos_fold)
+    return inter, copl, close, fold
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _folded(Ti, Tj, fi, fj, cos_fold):
+    """Two faces on one edge whose other corners lie on the same side, at an angle below the fold.
+
+    ``u`` and ``w`` are the unit vectors from the shared edge to each third corner,
+    perpendicular to the edge; their angle is the angle between the two half-planes (0 when
+    one face lies folded onto the other).
+    """
+    # shared edge: the corners of i found in j; k_i, k_j the third corners
+    a = -1
+    b = -1
+    ki = 0
+    for c in range(3):
+        hit = fi[c] == fj[0] or fi[c] == fj[1] or fi[c] == fj[2]
+        if hit:
+            if a < 0:
+                a = c
+            else:
+                b = c
+        else:
+            ki = c
+    kj = 0
+    for c in range(3):
+        if fj[c] != fi[a] and fj[c] != fi[b]:
+            kj = c
+    ex, ey, ez = _unit_from(Ti, a, b)
+    ux = Ti[ki, 0] - Ti[a, 0]
+    uy = Ti[ki, 1] - Ti[a, 1]
+    uz = Ti[ki, 2] - Ti[a, 2]
+    wx = Tj[kj, 0] - Ti[a, 0]
+    wy = Tj[kj, 1] - Ti[a, 1]
+    wz = Tj[kj, 2] - Ti[a, 2]
+    du = ux * ex + uy * ey + uz * ez
+    dw = wx * ex + wy * ey + wz * ez
+    ux, uy, uz = ux - du * ex, uy - du * ey, uz - du * ez
+    wx, wy, wz = wx - dw * ex, wy - dw * ey, wz - dw * ez
+    lu = math.sqrt(ux * ux + uy * uy + uz * uz)
+    lw = math.sqrt(wx * wx + wy * wy + wz * wz)
+    if lu == 0 or lw == 0:
+        return False
+    return (ux * wx + uy * wy + uz * wz) / (lu * lw) >= cos_fold
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def broad_pairs(first, starts, counts, ent, low_a, low_b, key, lo, hi, bits, m):
+    """Pairs met in their lowest common grid cell whose boxes overlap (broad phase step).
+
+    Row ``q`` stands for box ``first[q]`` in the cell ``key[q]``; its candidates are the
+    boxes ``ent[starts[q] : starts[q] + counts[q]]``.  A pair is kept when the cell holding
+    the lower corner of the two boxes' overlap (``max`` of their lower cells on this grid,
+    ``low_a`` / ``low_b``) is this cell -- so each pair is emitted once -- and the closed
+    boxes overlap on every axis.  Returns (k,) int64 pair keys ``i * m + j`` with ``i < j``.
+    """
+    out = np.empty(counts.sum(), np.int64)
+    n = 0
+    for q in range(first.shape[0]):
+        a = first[q]
+        for o in range(starts[q], starts[q] + counts[q]):
+            b = ent[o]
+            cx = max(low_a[a, 0], low_b[b, 0])
+            cy = max(low_a[a, 1], low_b[b, 1])
+            cz = max(low_a[a, 2], low_b[b, 2])
+            if ((cx << (2 * bits)) | (cy << bits) | cz) != key[q]:
+                continue
+            if (
+                lo[a, 0] <= hi[b, 0]
+                and lo[b, 0] <= hi[a, 0]
+                and lo[a, 1] <= hi[b, 1]
+                and lo[b, 1] <= hi[a, 1]
+                and lo[a, 2] <= hi[b, 2]
+                and lo[b, 2] <= hi[a, 2]
+            ):
+                out[n] = min(a, b) * m + max(a, b)
+                n += 1
+    return out[:n]
