@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from meshvis.eval.bench.real import add_models_argument
+from meshvis.eval.bench.real_models import add_models_argument
 
 from .common import positive_int, write_json
 

@@ -2,14 +2,17 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from meshvis.eval.generators import real_models_dir
 from meshvis.geometry.diagnostics import diagnose
 from meshvis.graphcut.classify import classify
 from meshvis.io import load
 from meshvis.soup import Soup
+
+REAL = Path(__file__).resolve().parents[3] / "shared" / "models" / "real"
 
 KEYS = (
     "degenerate_faces",
@@ -32,7 +35,7 @@ def assert_same_counts(soup: Soup) -> dict:
 
 @pytest.mark.parametrize("name", SMALL)
 def test_info_and_classify_agree_on_real_models(name):
-    path = real_models_dir() / name
+    path = REAL / name
     if not path.exists():
         pytest.skip(f"{path} is not there")
     assert_same_counts(load(path))

@@ -35,7 +35,7 @@ import numpy as np
 from meshvis.errors import OutputError
 from meshvis.eval.baselines import BASELINES, require_baselines
 from meshvis.eval.bench import cases as C
-from meshvis.eval.bench.real import DEFAULT_MODELS, add_models_argument
+from meshvis.eval.bench.real_models import DEFAULT_MODELS, add_models_argument
 
 #: meshvis sweeps (rays per node)
 RAYS_FULL = (1, 2, 4, 8, 16, 32, 64)

@@ -24,7 +24,7 @@ import numpy as np
 
 from meshvis.eval import generators as gen
 from meshvis.eval.baselines import BASELINES, Baseline, BaselineResult
-from meshvis.eval.bench.real import DEFAULT_MODELS, models_folder
+from meshvis.eval.bench.real_models import DEFAULT_MODELS, models_folder
 from meshvis.eval.generators import GroundTruth
 from meshvis.eval.metrics import layer_error, orientation_error, removal_scores
 

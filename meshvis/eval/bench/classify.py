@@ -11,7 +11,7 @@ import os
 import time
 from typing import Any
 
-from meshvis.eval.bench.real import DEFAULT_MODELS, models_folder
+from meshvis.eval.bench.real_models import DEFAULT_MODELS, models_folder
 from meshvis.eval.generators import skin_and_ribcage
 from meshvis.graphcut.classify import classify
 from meshvis.io import load

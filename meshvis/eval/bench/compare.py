@@ -29,7 +29,7 @@ import numpy as np
 from meshvis.eval.baselines import BASELINES, require_baselines
 from meshvis.eval.bench import cases as C
 from meshvis.eval.bench.accuracy import prepare_out
-from meshvis.eval.bench.real import DEFAULT_MODELS, add_models_argument
+from meshvis.eval.bench.real_models import DEFAULT_MODELS, add_models_argument
 
 #: inputs of the full and the quick comparison
 FULL = ("sphere_pair", "skin_ribcage", "cow", "spot", "dog_skin")

@@ -21,7 +21,7 @@ from typing import Any
 
 import numpy as np
 
-from meshvis.eval.bench.real import DEFAULT_MODELS, add_models_argument, models_folder
+from meshvis.eval.bench.real_models import DEFAULT_MODELS, add_models_argument, models_folder
 from meshvis.labeling.candidates import LAYOUTS
 from meshvis.labeling.idbuffer import id_buffer
 from meshvis.labeling.inputs import label_texts, load_models

@@ -19,6 +19,8 @@ import sys
 import tempfile
 import time
 
+from meshvis.eval.bench.real_models import add_models_argument
+
 #: icosphere subdivisions of the generated sizes (20 k ... 5 M faces)
 SUBDIVISIONS = (5, 6, 7, 8, 9)
 #: real models run by default (the largest of the shared folders)
@@ -31,6 +33,7 @@ def add_arguments(p) -> None:
         "--sizes", type=int, nargs="*", default=list(SUBDIVISIONS), help="icosphere subdivisions (5..9)"
     )
     p.add_argument("--no-real", action="store_true", help="generated sizes only")
+    add_models_argument(p)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", metavar="FILE")
 
@@ -170,11 +173,11 @@ def format(results: list[dict], header: bool = True) -> str:
 
 def main(args) -> int:
     """CLI entry of ``meshvis bench scale``."""
-    from meshvis.eval.generators import real_models_dir
+    from meshvis.eval.bench.real_models import models_folder
 
     specs = [f"ico:{n}" for n in args.sizes]
     if not args.no_real:
-        base = os.path.dirname(str(real_models_dir()))
+        base = os.path.dirname(os.path.abspath(models_folder(args.models_dir)))
         specs += args.models or [os.path.join(base, r) for r in REAL]
     results = run(specs, seed=args.seed)
     print(format(results))

@@ -7,7 +7,7 @@ import pytest
 from meshvis.errors import ParameterError
 from meshvis.eval.bench import cases as C
 from meshvis.eval.bench import labeling_sweep
-from meshvis.eval.bench.real import DEFAULT_MODELS, models_folder
+from meshvis.eval.bench.real_models import DEFAULT_MODELS, models_folder
 
 
 def test_default_is_relative_to_the_current_folder():
