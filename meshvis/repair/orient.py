@@ -1,20 +1,36 @@
 """Normal orientation (appendix H §5, "Normal Orientation").
 
-Every face whose sides got exactly one outside label (or whose sample points agree) is
-turned so that its front faces the outside.  The other cases are decided by options:
+:func:`orient` decides, for every face, which side becomes its front, in named steps:
 
-* two-sided faces (both sides outside: sheets, leaves): ``keep`` as they are (default),
-  ``duplicate`` (emit both orientations) or ``strongest`` (the side with the larger
-  escaping ray share, i.e. outside weight per area, Eq. 7, wins);
-* hidden faces (both sides inside): oriented by the layer they belong to — layer
-  semantics (DESIGN.md §4): each shell faces outward with respect to its layer; with
-  ``semantics="cavity"``, shells of even layers face inward instead (a solid with voids).
-  A shell faces outward as a whole: a hidden face takes the orientation voted by area
-  over the connected, orientable patch of faces (joined by manifold edges) it belongs to,
-  where every face that is one-sided (at layer 1 or at its own layer) votes.  This
-  settles faces whose own evidence is ambiguous: contact faces between touching solids,
-  and parts of one solid inside another that are two-sided once the outer layer is
-  peeled.  A face whose patch has no vote keeps its own layer side;
+1. **own sides** — every face whose sides got exactly one outside label (or whose sample
+   points agree) faces the outside; two-sided and conflicting faces are decided by the
+   options below;
+2. **hidden sides** — faces with no outside side are oriented by the layer they belong to
+   (layer semantics, DESIGN.md §4: each shell faces outward with respect to its layer; with
+   ``semantics="cavity"`` shells of even layers face inward), voted by area over their
+   orientable patch; faces two-sided at their layer on a patch without a vote are decided
+   by ray parity against their own body where that body is closed, and keep their winding
+   where it is open;
+3. **whole patches** — an orientable patch (faces joined by manifold edges after welding,
+   flagged faces included) is turned as a whole or not at all: every face of a patch with
+   a clear area vote takes the patch's side.  What is seen from outside votes (one-sided
+   faces; flagged faces whose sample points disagree, weighted by the margin); faces that
+   are one-sided only at a deeper layer vote only on patches no layer-1 face votes for.
+   This keeps a consistently wound model's winding (a face of a self-intersecting fold
+   follows its surface) and settles contact faces between touching solids;
+4. **visible sides** — the side a viewer sees wins over the patch vote and over layer
+   semantics: every face of an *open* patch whose cluster's own rays do not already show
+   its side clearly is tested with rays of its own (:mod:`meshvis.repair.evidence`) and
+   turned where that evidence is decisive and shows its other side.  Faces of closed
+   patches follow their patch: a closed patch bounds a volume, and a face of it whose back
+   pokes out through the surface is a self-intersection, not a face turned the wrong way.
+
+Options for the undecided cases:
+
+* two-sided faces (both sides outside: sheets, leaves): ``keep`` (default) leaves them as
+  they are unless their patch or their own visibility decides them, ``duplicate`` emits
+  both orientations, ``strongest`` lets the side with the larger escaping ray share (outside
+  weight per area, Eq. 7) win;
 * flagged faces whose sample points disagree: by area ``majority`` (default) or
   ``duplicate``.
 """
@@ -232,6 +248,20 @@ def patches(c: Classification) -> Patches:
     return Patches(cl, closed)
 
 
+def _closed_body(c: Classification) -> np.ndarray:
+    """(m,) bool: the face's body (its component over all welded edges, non-manifold ones
+    included) has no boundary edge."""
+    from meshvis.geometry.adjacency import components, edges, face_adjacency
+
+    table = edges(c.pre.faces_welded)
+    body = components(c.soup.n_faces, face_adjacency(table, manifold_only=False))[1]
+    edge = np.maximum(table.face_edge, 0)
+    at_boundary = ((table.count[edge] == 1) & (table.face_edge >= 0)).any(axis=1)
+    open_body = np.zeros(int(body.max()) + 1, bool)
+    open_body[body[at_boundary]] = True
+    return ~open_body[body]
+
+
 def _own_sides(c: Classification, two_sided: str) -> tuple[np.ndarray, np.ndarray]:
     """Status of every face and the side its own labels put in front (hidden faces: 0)."""
     o = c.outside
@@ -278,8 +308,12 @@ def _hidden_sides(
     # over the face's own side (contact faces between touching solids see both ways)
     outer[hidden] = np.where(decisive[hidden], vote[hidden], np.maximum(side, 0))
     # faces two-sided at their layer on a patch without a vote (a sliver of surface cut
-    # off by non-manifold edges where solids touch): ray parity against their own body
+    # off by non-manifold edges where solids touch): ray parity against their own body,
+    # where that body is closed (parity means nothing on an open one: those faces keep
+    # their winding)
     open_ = hidden & ~own_layer & ~decisive
+    outer[open_ & ~_closed_body(c)] = 0
+    open_ &= _closed_body(c)
     n_parity = int(open_.sum())
     if n_parity:
         outer[open_] = parity_side(c, np.flatnonzero(open_), seed=int(c.params.get("seed", 0)))
@@ -329,6 +363,25 @@ def _whole_patches(
     return voted, int(change.sum())
 
 
+def _clearly_one_sided(c: Classification, outer: np.ndarray) -> np.ndarray:
+    """(m,) bool: clustered faces whose cluster escapes more than 4 times (the evidence
+    dominance of :mod:`meshvis.repair.evidence`) as
+    often through the side they show as through the other (from the classification's own
+    rays): the cluster's evidence already speaks for its faces."""
+    from meshvis.repair.evidence import DOMINANCE
+
+    counts = c.counts
+    share = counts.escaped / np.maximum(counts.cast - counts.discarded, 1)
+    node = c.nodes.side_node
+    ok = node[:, 0] >= 0
+    rows = np.flatnonzero(ok)
+    shown = share[node[rows, outer[rows]]]
+    other = share[node[rows, 1 - outer[rows]]]
+    clear = np.zeros(len(outer), bool)
+    clear[rows] = shown > DOMINANCE * other
+    return clear
+
+
 def _visible_sides(
     c: Classification, p: Patches, outer: np.ndarray, movable: np.ndarray, seed: int
 ) -> tuple[np.ndarray, int, int]:
@@ -342,7 +395,7 @@ def _visible_sides(
     """
     from meshvis.repair import evidence
 
-    test = np.flatnonzero(movable & ~p.closed)
+    test = np.flatnonzero(movable & ~p.closed & ~_clearly_one_sided(c, outer))
     turned = np.zeros(len(outer), bool)
     if len(test) == 0:
         return turned, 0, 0
