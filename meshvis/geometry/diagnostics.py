@@ -14,7 +14,7 @@ from typing import Any
 
 import numpy as np
 
-from meshvis.geometry import adjacency, intersect
+from meshvis.geometry import adjacency, duplicates, intersect
 from meshvis.io import as_soup
 
 
@@ -47,7 +47,8 @@ def diagnose(
         (faces connected through shared edges; collapsed faces left out), ``edges``,
         ``boundary_edges`` (one face), ``nonmanifold_edges`` (more than two faces),
         ``degenerate_faces`` (smallest altitude below the weld tolerance, or collapsed),
-        ``duplicate_faces`` (redundant copies of a face: same welded corners, either
+        ``double_sided_pairs`` (faces stored twice with opposite winding,
+        :mod:`meshvis.geometry.duplicates`), ``duplicate_faces`` (redundant copies of a face: same welded corners, either
         winding), ``intersecting_faces``, ``coplanar_faces`` (overlapping a coplanar face),
         ``too_close_faces`` (a non-adjacent face within ``eps``), ``winding_consistent`` and
         ``inconsistent_edges`` (manifold edges traversed twice in the same direction),
@@ -111,6 +112,7 @@ def diagnose(
         "nonmanifold_edges": n_nonmanifold,
         "degenerate_faces": int(degenerate.sum()),
         "duplicate_faces": int((first != np.arange(m)).sum()),
+        "double_sided_pairs": int(len(duplicates.opposite_copies(fw))),
         "intersecting_faces": inter,
         "coplanar_faces": copl,
         "too_close_faces": close,
@@ -142,6 +144,7 @@ _ROWS = [
     ("inconsistent_edges", "inconsistently wound edges"),
     ("degenerate_faces", "degenerate faces"),
     ("duplicate_faces", "duplicate faces"),
+    ("double_sided_pairs", "double-sided pairs (copies with opposite winding)"),
     ("intersecting_faces", "faces intersecting another"),
     ("coplanar_faces", "faces overlapping a coplanar one"),
     ("too_close_faces", "faces near a non-adjacent one"),

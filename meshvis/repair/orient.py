@@ -25,6 +25,9 @@
    patches follow their patch: a closed patch bounds a volume, and a face of it whose back
    pokes out through the surface is a self-intersection, not a face turned the wrong way.
 
+Both copies of a sheet stored twice with opposite winding (double-sided by duplication,
+:mod:`meshvis.geometry.duplicates`) are written as they are.
+
 Options for the undecided cases:
 
 * two-sided faces (both sides outside: sheets, leaves): ``keep`` (default) leaves them as
@@ -43,6 +46,7 @@ from typing import Any
 import numpy as np
 
 from meshvis.errors import ParameterError
+from meshvis.geometry.duplicates import in_opposite_copy
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.repair.layers import LayerResult, layers
 from meshvis.soup import Soup
@@ -67,6 +71,8 @@ class OrientResult:
     patch_faces : int, faces turned to agree with the vote of their patch
     visibility : dict, the per-face visibility test: faces ``tested``, faces ``turned``
         to show the side a viewer sees, ``rays`` cast
+    double_sided : int, faces kept as they are because they are one copy of a sheet stored
+        twice with opposite winding (:mod:`meshvis.geometry.duplicates`)
     """
 
     soup: Soup
@@ -79,6 +85,7 @@ class OrientResult:
     parity_faces: int = 0
     patch_faces: int = 0
     visibility: dict | None = None
+    double_sided: int = 0
 
     def report(self, per_face: bool = True) -> dict:
         counts = np.bincount(self.status, minlength=len(STATUS_NAMES))
@@ -98,6 +105,7 @@ class OrientResult:
             self.parity_faces if self.parity_faces else "skipped: every hidden face had a vote"
         )
         d["patch_faces"] = self.patch_faces
+        d["double_sided_copies"] = self.double_sided
         vis = self.visibility or {"tested": 0, "turned": 0, "rays": 0}
         d["visibility"] = dict(vis) if vis["tested"] else "skipped: every face is on a closed patch"
         if per_face:
@@ -453,6 +461,9 @@ def orient(
     # kept two-sided faces follow their patch and what a viewer sees; the other options
     # decided them on purpose, and degenerate faces have no side
     movable = (status != DEGENERATE) & ((status != TWO_SIDED) | (two_sided == "keep"))
+    # both copies of a sheet stored twice with opposite winding stay as they are
+    paired = in_opposite_copy(c.pre.faces_welded)
+    movable &= ~paired
     p = patches(c)
     voted, n_patch = _whole_patches(c, p, status, outer, own_layer, movable)
     seen, n_tested, n_rays = _visible_sides(c, p, outer, movable, int(c.params.get("seed", 0)))
@@ -467,9 +478,11 @@ def orient(
     # degenerate faces, and kept two-sided faces that neither their patch nor a viewer
     # decided, are written untouched
     untouched = (status == TWO_SIDED) & (two_sided == "keep") & ~voted & ~seen
-    flip[untouched | (status == DEGENERATE)] = False
+    flip[untouched | paired | (status == DEGENERATE)] = False
     extra = np.flatnonzero(dup)
     source = np.concatenate([np.arange(m), extra])
     out = c.soup.subset(source).flipped(np.concatenate([flip, ~flip[extra]]))
     visibility = {"tested": n_tested, "turned": int(seen.sum()), "rays": n_rays}
-    return OrientResult(out, source, flip, dup, status, c, lay, n_parity, n_patch, visibility)
+    return OrientResult(
+        out, source, flip, dup, status, c, lay, n_parity, n_patch, visibility, int(paired.sum())
+    )

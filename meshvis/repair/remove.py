@@ -1,7 +1,9 @@
 """Inside removal (appendix H §5, "Inside Removal").
 
 One classification; every face with an outside side — or, for faces classified through
-sample points, at least one outside sample point — is kept, the rest is removed.
+sample points, at least one outside sample point — is kept, the rest is removed.  Of a
+sheet stored twice with opposite winding (:mod:`meshvis.geometry.duplicates`) whose one
+side is hidden, only the copy facing the seen side is kept.
 Every input face ends up in exactly one of the two outputs.
 """
 
@@ -12,6 +14,7 @@ from typing import Any
 
 import numpy as np
 
+from meshvis.geometry.duplicates import hidden_copies, opposite_copies
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.soup import Soup
 
@@ -77,4 +80,7 @@ def remove_interior(
     """
     c = classification or classify(model, **classify_kw)
     keep = (c.outside > 0).any(axis=1)
+    # a sheet stored twice with opposite winding keeps only the copy facing the viewer
+    # where its other side is hidden
+    keep &= ~hidden_copies(opposite_copies(c.pre.faces_welded), c.outside)
     return RemovalResult(c.soup.subset(keep), c.soup.subset(~keep), keep, c)
