@@ -18,7 +18,7 @@ from typing import Any
 
 import numpy as np
 
-from meshvis.geometry import adjacency, intersect
+from meshvis.geometry import adjacency, duplicates, intersect
 from meshvis.io import as_soup
 from meshvis.soup import Soup
 
@@ -159,7 +159,8 @@ def diagnose(
         ``boundary_edges`` (one face), ``nonmanifold_edges`` (more than two faces),
         ``degenerate_faces`` (smallest altitude at most :data:`DEGENERATE_TOL` times the
         diagonal, or zero area: the faces the classification leaves out),
-        ``collapsed_faces`` (two corners welded into one), ``duplicate_faces`` (redundant
+        ``collapsed_faces`` (two corners welded into one), ``double_sided_pairs`` (faces stored
+        twice with opposite winding, :mod:`meshvis.geometry.duplicates`), ``duplicate_faces`` (redundant
         copies of a face: same welded corners, either winding), ``intersecting_faces``,
         ``coplanar_faces`` (overlapping a coplanar face), ``too_close_faces`` (a non-adjacent
         face within ``eps``), ``winding_consistent`` and ``inconsistent_edges`` (manifold
@@ -209,6 +210,7 @@ def _summary(
         "boundary_edges": n_boundary,
         "nonmanifold_edges": n_nonmanifold,
         **a.counts,
+        "double_sided_pairs": int(len(duplicates.opposite_copies(a.faces_welded))),
         "winding_consistent": n_inconsistent == 0,
         "inconsistent_edges": n_inconsistent,
         "closed": n_boundary == 0,
@@ -238,6 +240,7 @@ _ROWS = [
     ("degenerate_faces", "degenerate faces"),
     ("collapsed_faces", "faces collapsed by welding"),
     ("duplicate_faces", "duplicate faces"),
+    ("double_sided_pairs", "double-sided pairs (copies with opposite winding)"),
     ("intersecting_faces", "faces intersecting another"),
     ("coplanar_faces", "faces overlapping a coplanar one"),
     ("too_close_faces", "faces near a non-adjacent one"),

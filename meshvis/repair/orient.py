@@ -1,20 +1,39 @@
 """Normal orientation (appendix H §5, "Normal Orientation").
 
-Every face whose sides got exactly one outside label (or whose sample points agree) is
-turned so that its front faces the outside.  The other cases are decided by options:
+:func:`orient` decides, for every face, which side becomes its front, in named steps:
 
-* two-sided faces (both sides outside: sheets, leaves): ``keep`` as they are (default),
-  ``duplicate`` (emit both orientations) or ``strongest`` (the side with the larger
-  escaping ray share, i.e. outside weight per area, Eq. 7, wins);
-* hidden faces (both sides inside): oriented by the layer they belong to — layer
-  semantics (DESIGN.md §4): each shell faces outward with respect to its layer; with
-  ``semantics="cavity"``, shells of even layers face inward instead (a solid with voids).
-  A shell faces outward as a whole: a hidden face takes the orientation voted by area
-  over the connected, orientable patch of faces (joined by manifold edges) it belongs to,
-  where every face that is one-sided (at layer 1 or at its own layer) votes.  This
-  settles faces whose own evidence is ambiguous: contact faces between touching solids,
-  and parts of one solid inside another that are two-sided once the outer layer is
-  peeled.  A face whose patch has no vote keeps its own layer side;
+1. **own sides** — every face whose sides got exactly one outside label (or whose sample
+   points agree) faces the outside; two-sided and conflicting faces are decided by the
+   options below;
+2. **hidden sides** — faces with no outside side are oriented by the layer they belong to
+   (layer semantics, DESIGN.md §4: each shell faces outward with respect to its layer; with
+   ``semantics="cavity"`` shells of even layers face inward), voted by area over their
+   orientable patch; faces two-sided at their layer on a patch without a vote are decided
+   by ray parity against their own body where that body is closed, and keep their winding
+   where it is open;
+3. **whole patches** — an orientable patch (faces joined by manifold edges after welding,
+   flagged faces included) is turned as a whole or not at all: every face of a patch with
+   a clear area vote takes the patch's side.  What is seen from outside votes (one-sided
+   faces; flagged faces whose sample points disagree, weighted by the margin); faces that
+   are one-sided only at a deeper layer vote only on patches no layer-1 face votes for.
+   This keeps a consistently wound model's winding (a face of a self-intersecting fold
+   follows its surface) and settles contact faces between touching solids;
+4. **visible sides** — the side a viewer sees wins over the patch vote and over layer
+   semantics: every face of an *open* patch whose cluster's own rays do not already show
+   its side clearly is tested with rays of its own (:mod:`meshvis.repair.evidence`) and
+   turned where that evidence is decisive and shows its other side.  Faces of closed
+   patches follow their patch: a closed patch bounds a volume, and a face of it whose back
+   pokes out through the surface is a self-intersection, not a face turned the wrong way.
+
+Both copies of a sheet stored twice with opposite winding (double-sided by duplication,
+:mod:`meshvis.geometry.duplicates`) are written as they are.
+
+Options for the undecided cases:
+
+* two-sided faces (both sides outside: sheets, leaves): ``keep`` (default) leaves them as
+  they are unless their patch or their own visibility decides them, ``duplicate`` emits
+  both orientations, ``strongest`` lets the side with the larger escaping ray share (outside
+  weight per area, Eq. 7) win;
 * flagged faces whose sample points disagree: by area ``majority`` (default) or
   ``duplicate``.
 """
@@ -28,6 +47,7 @@ import numpy as np
 
 from meshvis import _validate
 from meshvis.errors import ParameterError
+from meshvis.geometry.duplicates import in_opposite_copy
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.repair.layers import LayerResult, layers
 from meshvis.soup import Soup
@@ -49,6 +69,11 @@ class OrientResult:
     duplicated : (m,) bool, input faces written in both orientations
     status : (m,) int8, one of ``STATUS_NAMES`` per input face
     parity_faces : int, hidden faces whose side came from ray parity (:func:`parity_side`)
+    patch_faces : int, faces turned to agree with the vote of their patch
+    visibility : dict, the per-face visibility test: faces ``tested``, faces ``turned``
+        to show the side a viewer sees, ``rays`` cast
+    double_sided : int, faces kept as they are because they are one copy of a sheet stored
+        twice with opposite winding (:mod:`meshvis.geometry.duplicates`)
     """
 
     soup: Soup
@@ -59,6 +84,9 @@ class OrientResult:
     classification: Classification
     layers: LayerResult | None
     parity_faces: int = 0
+    patch_faces: int = 0
+    visibility: dict | None = None
+    double_sided: int = 0
 
     def report(self, per_face: bool = True) -> dict:
         counts = np.bincount(self.status, minlength=len(STATUS_NAMES))
@@ -77,6 +105,10 @@ class OrientResult:
         d["parity_faces"] = (
             self.parity_faces if self.parity_faces else "skipped: every hidden face had a vote"
         )
+        d["patch_faces"] = self.patch_faces
+        d["double_sided_copies"] = self.double_sided
+        vis = self.visibility or {"tested": 0, "turned": 0, "rays": 0}
+        d["visibility"] = dict(vis) if vis["tested"] else "skipped: every face is on a closed patch"
         if per_face:
             d["per_face"] = {
                 "flipped": self.flipped,
@@ -190,6 +222,201 @@ def parity_side(
     return (odd.reshape(-1, rays).sum(axis=1) * 2 > rays).astype(np.int8)
 
 
+@dataclass(frozen=True)
+class Patches:
+    """Orientable surface patches: faces joined by manifold edges (after welding).
+
+    Attributes
+    ----------
+    clustering : the orientation double cover (:func:`meshvis.graphcut.clusters.cluster_sides`)
+        over every non-degenerate face
+    closed : (m,) bool, the face's patch is closed: every edge of every face of it is a
+        manifold edge between two faces of the patch
+    """
+
+    clustering: Any
+    closed: np.ndarray
+
+
+def patches(c: Classification) -> Patches:
+    """The orientable patches of the classified model and which of them are closed."""
+    from meshvis.geometry.adjacency import edges
+    from meshvis.graphcut.clusters import cluster_sides, manifold_face_pairs
+
+    table = edges(c.pre.faces_welded)
+    cl = cluster_sides(table, ~c.degenerate)
+    patch = cl.cluster
+    edge_ok = (table.face_edge >= 0) & (table.count[np.maximum(table.face_edge, 0)] == 2)
+    open_patch = np.zeros(max(cl.n_clusters, 1), bool)
+    open_patch[patch[~edge_ok.all(axis=1) & (patch >= 0)]] = True
+    f, g, _ = manifold_face_pairs(table)
+    across = patch[f] != patch[g]  # a manifold edge leaving the patch (degenerate or split face)
+    for side in (f[across], g[across]):
+        open_patch[patch[side][patch[side] >= 0]] = True
+    closed = (patch >= 0) & ~open_patch[np.maximum(patch, 0)]
+    return Patches(cl, closed)
+
+
+def _closed_body(c: Classification) -> np.ndarray:
+    """(m,) bool: the face's body (its component over all welded edges, non-manifold ones
+    included) has no boundary edge."""
+    from meshvis.geometry.adjacency import components, edges, face_adjacency
+
+    table = edges(c.pre.faces_welded)
+    body = components(c.soup.n_faces, face_adjacency(table, manifold_only=False))[1]
+    edge = np.maximum(table.face_edge, 0)
+    at_boundary = ((table.count[edge] == 1) & (table.face_edge >= 0)).any(axis=1)
+    open_body = np.zeros(int(body.max()) + 1, bool)
+    open_body[body[at_boundary]] = True
+    return ~open_body[body]
+
+
+def _own_sides(c: Classification, two_sided: str) -> tuple[np.ndarray, np.ndarray]:
+    """Status of every face and the side its own labels put in front (hidden faces: 0)."""
+    o = c.outside
+    m = c.soup.n_faces
+    out0, out1 = o[:, 0] > 0, o[:, 1] > 0
+    full0, full1 = o[:, 0] >= 1, o[:, 1] >= 1
+    agree = (np.isin(o[:, 0], (0.0, 1.0))) & (np.isin(o[:, 1], (0.0, 1.0)))
+    status = np.full(m, ONE_SIDED, np.int8)
+    status[agree & full0 & full1] = TWO_SIDED
+    status[~out0 & ~out1] = HIDDEN
+    status[~agree & (out0 | out1)] = CONFLICT
+    status[c.degenerate] = DEGENERATE
+    outer = np.zeros(m, np.int8)  # side that should become the front
+    outer[(status == ONE_SIDED) & full1] = 1
+    conflict = status == CONFLICT
+    outer[conflict] = (o[conflict, 1] > o[conflict, 0]).astype(np.int8)
+    if two_sided == "strongest":
+        ts = status == TWO_SIDED
+        outer[ts] = strongest_side(c)[ts]
+    return status, outer
+
+
+def _hidden_sides(
+    c: Classification, status: np.ndarray, outer: np.ndarray, semantics: str
+) -> tuple[LayerResult | None, np.ndarray, int]:
+    """Sides of the hidden faces by layer semantics, patch vote and ray parity (in place).
+
+    Returns the layers (None when nothing is hidden), the faces that are one-sided at their
+    own layer, and the number of faces decided by ray parity.
+    """
+    m = c.soup.n_faces
+    hidden = status == HIDDEN
+    own_layer = np.zeros(m, bool)
+    if not hidden.any():
+        return None, own_layer, 0
+    lay = layers(c.soup, classification=c)
+    side = lay.outer_side[hidden]
+    side = np.where(side == 2, -1, side)
+    own = side >= 0  # one-sided at its own layer
+    own_layer[np.flatnonzero(hidden)[own]] = True
+    outer[hidden] = np.maximum(side, 0)
+    vote, decisive = surface_vote(c, outer, (status == ONE_SIDED) | own_layer)
+    # a shell faces outward as a whole: where the face's patch has a clear vote it wins
+    # over the face's own side (contact faces between touching solids see both ways)
+    outer[hidden] = np.where(decisive[hidden], vote[hidden], np.maximum(side, 0))
+    # faces two-sided at their layer on a patch without a vote (a sliver of surface cut
+    # off by non-manifold edges where solids touch): ray parity against their own body,
+    # where that body is closed (parity means nothing on an open one: those faces keep
+    # their winding)
+    open_ = hidden & ~own_layer & ~decisive
+    outer[open_ & ~_closed_body(c)] = 0
+    open_ &= _closed_body(c)
+    n_parity = int(open_.sum())
+    if n_parity:
+        outer[open_] = parity_side(c, np.flatnonzero(open_), seed=int(c.params.get("seed", 0)))
+    if semantics == "cavity":
+        even = hidden & (lay.layer % 2 == 0)
+        outer[even] = 1 - outer[even]
+    return lay, own_layer, n_parity
+
+
+def _whole_patches(
+    c: Classification,
+    p: Patches,
+    status: np.ndarray,
+    outer: np.ndarray,
+    own_layer: np.ndarray,
+    movable: np.ndarray,
+) -> tuple[np.ndarray, int]:
+    """Turn every patch as a whole (in place): each face of a patch with a clear vote takes
+    the patch's side.  Voters: one-sided faces with their area, flagged faces whose sample
+    points disagree with their area times the margin; only where none of them votes, the
+    faces one-sided at their own layer (hidden faces) with their area.
+    Returns the faces of patches with a clear vote, and how many of them changed side.
+    """
+    o = c.outside
+    node = p.clustering.side_node
+    ok = node[:, 0] >= 0
+    conflict = status == CONFLICT
+    seen = c.soup.areas * (status == ONE_SIDED)
+    seen[conflict] = c.soup.areas[conflict] * np.abs(o[conflict, 1] - o[conflict, 0])
+    side = outer.copy()
+    voted = np.zeros(len(outer), bool)
+    # what is seen from outside votes first; faces one-sided only at a deeper layer
+    # decide the patches that no face of layer 1 votes for
+    for weight in (seen, c.soup.areas * own_layer):
+        votes = np.zeros(p.clustering.n_nodes)
+        d = np.flatnonzero(ok & (weight > 0))
+        np.add.at(votes, node[d, outer[d]], weight[d])
+        v0, v1 = votes[node[ok, 0]], votes[node[ok, 1]]
+        now = np.zeros(len(outer), bool)
+        now[ok] = v0 != v1
+        now &= ~voted
+        side[now] = (v1 > v0)[now[ok]].astype(np.int8)
+        voted |= now
+    voted &= movable
+    change = voted & (side != outer)
+    outer[voted] = side[voted]
+    return voted, int(change.sum())
+
+
+def _clearly_one_sided(c: Classification, outer: np.ndarray) -> np.ndarray:
+    """(m,) bool: clustered faces whose cluster escapes more than 4 times (the evidence
+    dominance of :mod:`meshvis.repair.evidence`) as
+    often through the side they show as through the other (from the classification's own
+    rays): the cluster's evidence already speaks for its faces."""
+    from meshvis.repair.evidence import DOMINANCE
+
+    counts = c.counts
+    share = counts.escaped / np.maximum(counts.cast - counts.discarded, 1)
+    node = c.nodes.side_node
+    ok = node[:, 0] >= 0
+    rows = np.flatnonzero(ok)
+    shown = share[node[rows, outer[rows]]]
+    other = share[node[rows, 1 - outer[rows]]]
+    clear = np.zeros(len(outer), bool)
+    clear[rows] = shown > DOMINANCE * other
+    return clear
+
+
+def _visible_sides(
+    c: Classification, p: Patches, outer: np.ndarray, movable: np.ndarray, seed: int
+) -> tuple[np.ndarray, int, int]:
+    """Let the side a viewer sees win (in place): every movable face of an open patch is
+    tested on its own (:func:`meshvis.repair.evidence.seen_side`) and turned where its
+    evidence is decisive and shows the other side.  Faces of closed patches are left to
+    their patch: a closed patch bounds a volume, and a face of it whose back pokes out
+    through the surface is a self-intersection, not a face turned the wrong way.
+
+    Returns the faces turned, the number of faces tested and the rays cast.
+    """
+    from meshvis.repair import evidence
+
+    test = np.flatnonzero(movable & ~p.closed & ~_clearly_one_sided(c, outer))
+    turned = np.zeros(len(outer), bool)
+    if len(test) == 0:
+        return turned, 0, 0
+    # a generator of its own (seeded from the classification's seed), so that the test
+    # does not shift the random numbers of anything else
+    rng = np.random.default_rng([seed, 0x5EE9])
+    side, sure, rays = evidence.seen_side(c.soup, c.caster, test, outer[test], rng)
+    turned[test[sure & (side != outer[test])]] = True
+    outer[turned] = 1 - outer[turned]
+    return turned, len(test), rays
+
+
 def orient(
     model: Any,
     *,
@@ -230,55 +457,18 @@ def orient(
     _check("semantics", semantics, ("layer", "cavity"))
     _check("conflicts", conflicts, ("majority", "duplicate"))
     c = classification or classify(model, **classify_kw)
-    soup = c.soup
-    m = soup.n_faces
-    o = c.outside
-    out0, out1 = o[:, 0] > 0, o[:, 1] > 0
-    full0, full1 = o[:, 0] >= 1, o[:, 1] >= 1
-    agree = (np.isin(o[:, 0], (0.0, 1.0))) & (np.isin(o[:, 1], (0.0, 1.0)))
-
-    status = np.full(m, ONE_SIDED, np.int8)
-    status[agree & full0 & full1] = TWO_SIDED
-    status[~out0 & ~out1] = HIDDEN
-    status[~agree & (out0 | out1)] = CONFLICT
-    status[c.degenerate] = DEGENERATE
-
-    outer = np.zeros(m, np.int8)  # side that should become the front
-    outer[(status == ONE_SIDED) & full1] = 1
-    conflict = status == CONFLICT
-    outer[conflict] = (o[conflict, 1] > o[conflict, 0]).astype(np.int8)
-    if two_sided == "strongest":
-        ts = status == TWO_SIDED
-        outer[ts] = strongest_side(c)[ts]
-
-    lay = None
-    n_parity = 0
-    hidden = status == HIDDEN
-    if hidden.any():
-        lay = layers(soup, classification=c)
-        side = lay.outer_side[hidden]
-        side = np.where(side == 2, -1, side)
-        own = side >= 0  # one-sided at its own layer
-        outer[hidden] = np.maximum(side, 0)
-        decided = status == ONE_SIDED
-        decided[np.flatnonzero(hidden)[own]] = True
-        vote, decisive = surface_vote(c, outer, decided)
-        # a shell faces outward as a whole: where the face's patch has a clear vote it wins
-        # over the face's own side (contact faces between touching solids see both ways)
-        side = np.where(decisive[hidden], vote[hidden], np.maximum(side, 0))
-        outer[hidden] = side
-        # faces two-sided at their layer on a patch without a vote (a sliver of surface cut
-        # off by non-manifold edges where solids touch): ray parity against their own body
-        open_ = np.zeros(m, bool)
-        open_[np.flatnonzero(hidden)[~own]] = True
-        open_ &= ~decisive
-        n_parity = int(open_.sum())
-        if n_parity:
-            outer[open_] = parity_side(c, np.flatnonzero(open_), seed=int(c.params.get("seed", 0)))
-        if semantics == "cavity":
-            even = hidden & (lay.layer % 2 == 0)
-            outer[even] = 1 - outer[even]
-
+    m = c.soup.n_faces
+    status, outer = _own_sides(c, two_sided)
+    lay, own_layer, n_parity = _hidden_sides(c, status, outer, semantics)
+    # kept two-sided faces follow their patch and what a viewer sees; the other options
+    # decided them on purpose, and degenerate faces have no side
+    movable = (status != DEGENERATE) & ((status != TWO_SIDED) | (two_sided == "keep"))
+    # both copies of a sheet stored twice with opposite winding stay as they are
+    paired = in_opposite_copy(c.pre.faces_welded)
+    movable &= ~paired
+    p = patches(c)
+    voted, n_patch = _whole_patches(c, p, status, outer, own_layer, movable)
+    seen, n_tested, n_rays = _visible_sides(c, p, outer, movable, int(c.params.get("seed", 0)))
     flip = outer == 1
     if front == "cw":
         flip = ~flip
@@ -286,12 +476,15 @@ def orient(
     if two_sided == "duplicate":
         dup |= status == TWO_SIDED
     if conflicts == "duplicate":
-        dup |= conflict
-    keep_as_is = (status == TWO_SIDED) & (two_sided == "keep") | (status == DEGENERATE)
-    flip[keep_as_is] = False  # kept two-sided and degenerate faces are written untouched
-
+        dup |= status == CONFLICT
+    # degenerate faces, and kept two-sided faces that neither their patch nor a viewer
+    # decided, are written untouched
+    untouched = (status == TWO_SIDED) & (two_sided == "keep") & ~voted & ~seen
+    flip[untouched | paired | (status == DEGENERATE)] = False
     extra = np.flatnonzero(dup)
     source = np.concatenate([np.arange(m), extra])
-    out_flip = np.concatenate([flip, ~flip[extra]])
-    out = soup.subset(source).flipped(out_flip)
-    return OrientResult(out, source, flip, dup, status, c, lay, n_parity)
+    out = c.soup.subset(source).flipped(np.concatenate([flip, ~flip[extra]]))
+    visibility = {"tested": n_tested, "turned": int(seen.sum()), "rays": n_rays}
+    return OrientResult(
+        out, source, flip, dup, status, c, lay, n_parity, n_patch, visibility, int(paired.sum())
+    )

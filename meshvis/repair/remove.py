@@ -1,7 +1,9 @@
 """Inside removal (appendix H §5, "Inside Removal").
 
 One classification; every face with an outside side — or, for faces classified through
-sample points, at least one outside sample point — is kept, the rest is removed.
+sample points, at least one outside sample point — is kept, the rest is removed.  Of a
+sheet stored twice with opposite winding (:mod:`meshvis.geometry.duplicates`) whose one
+side is hidden, only the copy facing the seen side is kept.
 Every input face ends up in exactly one of the two outputs.
 """
 
@@ -13,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from meshvis import _validate
+from meshvis.geometry.duplicates import hidden_copies, opposite_copies
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.soup import Soup
 
@@ -78,5 +81,8 @@ def remove_interior(
     """
     _validate.repair_args(classification, Classification, classify_kw, classify)
     c = classification or classify(model, **classify_kw)
-    keep = np.any(c.outside > 0, axis=1)
+    keep = (c.outside > 0).any(axis=1)
+    # a sheet stored twice with opposite winding keeps only the copy facing the viewer
+    # where its other side is hidden
+    keep &= ~hidden_copies(opposite_copies(c.pre.faces_welded), c.outside)
     return RemovalResult(c.soup.subset(keep), c.soup.subset(~keep), keep, c)
