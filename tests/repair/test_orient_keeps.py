@@ -8,14 +8,17 @@ winding: each closed patch is turned as a whole.
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 
-from meshvis.eval.generators import real_models_dir
 from meshvis.io import load
 from meshvis.repair import evidence
 from meshvis.repair.orient import orient
 from meshvis.soup import Soup
+
+REAL = Path(__file__).resolve().parents[3] / "shared" / "models" / "real"
 
 CLOSED = ["cow.obj", "spot.obj", "nested.glb", "pyvista__ant.ply", "pins.glb", "busted.STL"]
 OPEN = ["stanford-bunny.obj", "suzanne.obj", "teapot.obj", "bunny10k_textured.obj", "CesiumMilkTruck.glb"]
@@ -24,7 +27,7 @@ LARGE = ["dm_control__SKINbody.stl", "dm_control__BONEMergedSkull.stl"]
 
 
 def _model(name: str) -> Soup:
-    path = real_models_dir() / name
+    path = REAL / name
     if not path.exists():
         pytest.skip(f"{path} is not there")
     return load(path)

@@ -39,6 +39,7 @@ import numpy as np
 from meshvis.eval.baselines import BASELINES
 from meshvis.eval.bench import cases as C
 from meshvis.eval.bench.accuracy import prepare_out
+from meshvis.eval.bench.real_models import DEFAULT_MODELS, add_models_argument, models_folder
 
 #: share of the faces turned over in the soup inputs
 FLIP = 0.3
@@ -76,12 +77,12 @@ class Run:
     pairs_broken: int = 0  # of them, written with the same winding (one side lost)
 
 
-def model_paths(names: str | None, quick: bool) -> list[str]:
-    """The real model files, smallest first; ``names`` (comma-separated file names or
-    stems) selects some of them."""
-    from meshvis.eval.generators import real_models_dir
+def model_paths(names: str | None, quick: bool, models_dir: str | os.PathLike = DEFAULT_MODELS) -> list[str]:
+    """The real model files of ``models_dir`` and its sibling ``real2``, smallest first.
 
-    root = real_models_dir()
+    ``names`` (comma-separated file names or stems) selects some of them.
+    """
+    root = models_folder(models_dir)
     paths = []
     for sub in (root, root.parent / "real2"):
         if sub.is_dir():
@@ -363,7 +364,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--out", required=True, metavar="DIR", help="folder for the CSV, chart and table (created)"
     )
     p.add_argument("--quick", action="store_true", help=f"only {', '.join(QUICK)} and a one-point sweep")
-    p.add_argument("--models", metavar="A,B,...", help="model files (names or stems) to run; default: all")
+    p.add_argument("--only", metavar="A,B,...", help="model files (names or stems) to run; default: all")
+    add_models_argument(p)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument(
         "--cache", default=DEFAULT_CACHE, metavar="DIR", help="folder of the cached references (created)"
@@ -373,7 +375,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    paths = model_paths(args.models, args.quick)
+    paths = model_paths(args.only, args.quick, args.models_dir)
     prepare_out(args.out, OUTPUTS, args.force)
     log = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
     machine = C.machine()
