@@ -213,13 +213,7 @@ def plot_task(path: str, task: str, points: list[C.Point]) -> None:
         ax.grid(True, which="both", alpha=0.25)
     for ax in axes.ravel()[len(case_names) :]:
         ax.axis("off")
-    handles, names = [], []
-    for ax in axes.ravel():
-        for h, lab in zip(*ax.get_legend_handles_labels()):
-            if lab not in names:
-                handles.append(h)
-                names.append(lab)
-    fig.legend(handles, names, loc="lower center", ncol=min(4, max(len(names), 1)), fontsize=9, frameon=False)
+    C.shared_legend(fig, axes, fontsize=9)
     fig.suptitle(
         f"{C.TASK_TITLES[task]}: error against time (error 0 drawn at {FLOOR:g}, dotted line)", fontsize=11
     )

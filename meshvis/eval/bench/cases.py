@@ -352,6 +352,21 @@ def machine_lines(m: dict) -> list[str]:
     ]
 
 
+def shared_legend(fig, axes, fontsize: int, ncol: int | None = None) -> None:
+    """One legend below the panels of ``fig``: every labelled line of ``axes`` once, in order.
+
+    ``ncol`` columns (default: one per entry, at most 4).
+    """
+    handles, names = [], []
+    for ax in axes.ravel():
+        for h, lab in zip(*ax.get_legend_handles_labels()):
+            if lab not in names:
+                handles.append(h)
+                names.append(lab)
+    ncol = min(4, max(len(names), 1)) if ncol is None else ncol
+    fig.legend(handles, names, loc="lower center", ncol=ncol, fontsize=fontsize, frameon=False)
+
+
 def fmt_err(x: float) -> str:
     """An error for a table: '–' when the run failed, '0' when exact."""
     if x is None or np.isnan(x):

@@ -342,13 +342,7 @@ def plot(path: str, runs: list[Run]) -> None:
         ax.grid(True, which="both", alpha=0.25)
     for ax in axes.ravel()[len(panels) :]:
         ax.axis("off")
-    handles, names = [], []
-    for ax in axes.ravel():
-        for h, lab in zip(*ax.get_legend_handles_labels()):
-            if lab not in names:
-                handles.append(h)
-                names.append(lab)
-    fig.legend(handles, names, loc="lower center", ncol=4, fontsize=8, frameon=False)
+    C.shared_legend(fig, axes, ncol=4, fontsize=8)
     fig.tight_layout(rect=(0, 0.6 / (3.4 * rows + 0.6), 1, 1))
     buf = io.BytesIO()
     fig.savefig(buf, format="png", dpi=80)
