@@ -52,6 +52,8 @@ _LAZY = {
     "orient": "meshvis.repair.orient",
     "remove_interior": "meshvis.repair.remove",
     "layers": "meshvis.repair.layers",
+    "visible_from": "meshvis.visibility.visible",
+    "parse_region": "meshvis.visibility.regions",
 }
 
 __all__ = [
