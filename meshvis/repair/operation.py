@@ -35,7 +35,13 @@ CLASSIFY_DEFAULTS: dict[str, Any] = {
 OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
     "classify": {},
     "orient": {"front": "ccw", "two_sided": "keep", "semantics": "layer", "conflicts": "majority"},
-    "remove-interior": {},
+    "remove-interior": {
+        "visibility": "both",
+        "from_region": "outside",
+        "level": "face",
+        "keep_border": 0,
+        "up": "auto",
+    },
     "layers": {"max_layers": None},
 }
 #: where results go (None: not written)
@@ -77,6 +83,21 @@ def classify_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
     )
 
 
+def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
+    """Keyword arguments of :func:`meshvis.remove_interior` from operation options."""
+    from meshvis.rays.camera import up_axis
+
+    o = {**default_options("remove-interior"), **_options(options)}
+    return dict(
+        visibility=o["visibility"],
+        region=o["from_region"],
+        level=o["level"],
+        keep_border=int(o["keep_border"]),
+        up=up_axis(o["up"], [soup.path] if soup.path else []),
+        seed=int(o["seed"]),
+    )
+
+
 def run_operation(
     op: str,
     soup,
@@ -108,8 +129,10 @@ def run_operation(
 
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
     tell = say or (lambda text: None)
-    c = classify(soup, progress=progress, **classify_kwargs(o))
-    tell(c.summary())
+    c = None
+    if op != "remove-interior" or o["visibility"] != "view":  # sight alone needs no cut
+        c = classify(soup, progress=progress, **classify_kwargs(o))
+        tell(c.summary())
     if op == "classify":
         report = c.report()
         if o["graphml"]:
@@ -137,7 +160,7 @@ def run_operation(
         if o["preview"]:
             save_png(render(r.soup, color_by="side").image, o["preview"])
     elif op == "remove-interior":
-        r = remove_interior(soup, classification=c)
+        r = remove_interior(soup, classification=c, **removal_kwargs(o, soup))
         save(r.kept, o["output"])
         if o["removed"]:
             save(r.removed, o["removed"])

@@ -174,6 +174,7 @@ def visible_from(
     method: str = "guided",
     up=(0.0, 0.0, 1.0),
     per_side: bool = False,
+    faces: np.ndarray | None = None,
     min_new: float = MIN_NEW_PER_MILLION,
     caster: RayCaster | None = None,
 ) -> Visibility:
@@ -198,6 +199,9 @@ def visible_from(
         Keep seeding a face until both of its sides are seen (for orientation); by default a
         face gets no more seed rays once either side is seen (enough to know it is visible,
         and much cheaper: most faces have one hidden side).
+    faces : (k,) int or (m,) bool, optional
+        Only these faces get seed rays (the question is about them); propagation still
+        records every face it meets.  Default: all faces.
     min_new : float
         Stop after a round that finds fewer new faces than this per million rays.
     caster : RayCaster, optional
@@ -229,12 +233,20 @@ def visible_from(
     caster = caster or RayCaster(soup, offset=ORIGIN_OFFSET)
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new)
+    asked = np.ones(soup.n_faces, bool)
+    if faces is not None:
+        faces = np.asarray(faces)
+        asked = faces.astype(bool) if faces.dtype == bool else np.isin(np.arange(soup.n_faces), faces)
+        if asked.shape != (soup.n_faces,):
+            raise ParameterError(f"faces must be {soup.n_faces} booleans or face indices")
     skipped = _presee(state, soup, region)
-    stopped = _run_rounds(state, caster, region, rng, method == "guided", per_side)
+    if faces is not None:
+        skipped["not asked about (no seed rays)"] = int((~asked).sum())
+    stopped = _run_rounds(state, caster, region, rng, method == "guided", per_side, asked)
     skipped.update(
         {
             "seen before any seed ray (found by propagation)": int(
-                (state.seen_side.any(axis=1) & (state.seed_rays == 0)).sum()
+                (state.seen_side.any(axis=1) & (state.seed_rays == 0) & asked).sum()
             )
             - skipped.get("inside the region (seen without rays)", 0),
             "mutated rays refused (no viewer of the region on their line)": state.refused,
@@ -266,9 +278,9 @@ def _presee(state: _State, soup, region: Region) -> dict:
     return skipped
 
 
-def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool) -> str:
+def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool, asked: np.ndarray) -> str:
     m = len(state.area)
-    usable = state.area > 0
+    usable = (state.area > 0) & asked
 
     def unseen(faces):
         s = state.seen_side[faces]
