@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|labeling|labeling-sweep``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|real|labeling|labeling-sweep``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -26,7 +26,7 @@ def add_parser(sub) -> None:
     c.set_defaults(func=run_classify)
 
     outside = {"labeling": "meshvis.labeling.bench", "labeling-sweep": "meshvis.labeling.sweep"}
-    for name in ("accuracy", "stability", "labeling", "labeling-sweep", "compare"):
+    for name in ("accuracy", "stability", "labeling", "labeling-sweep", "compare", "real"):
         try:
             mod = __import__(outside.get(name, f"meshvis.eval.bench.{name}"), fromlist=["add_arguments"])
         except ModuleNotFoundError:

@@ -32,9 +32,9 @@ from meshvis.visibility.regions import Region
 #: unit-size Embree scene (~1e-7), far below any gap users care about
 ENLARGE = 2e-5
 #: band edges are not halved below this length (fraction of the diagonal) ...
-MIN_SEGMENT = 2e-5
+MIN_SEGMENT = 1e-4
 #: ... nor more often than this
-MAX_DEPTH = 12
+MAX_DEPTH = 8
 #: a band ray that stops this much (fraction of the diagonal) before its face's plane met an occluder
 DISCONTINUITY = 1e-3
 #: reverse-sampling points sit this far (fraction of the diagonal) beyond the occluder's edge
@@ -219,19 +219,22 @@ def reverse_sampling(
         Mutated rays dropped because no viewer of the region lies on their line.
     """
     soup = caster.soup
-    n_t = caster.normals[parent.face]
-    v0 = soup.vertices[soup.faces[parent.face, 0]]
-    denom = np.einsum("ij,ij->i", band.direction, n_t)
+    # only rays that ended on another face can have met an occluder
+    idx = np.flatnonzero(band.face != parent.face)
+    n_t = caster.normals[parent.face[idx]]
+    v0 = soup.triangles[parent.face[idx], 0]
+    o, d = band.origin[idx], band.direction[idx]
+    denom = np.einsum("ij,ij->i", d, n_t)
     steep = np.abs(denom) > 1e-6
-    t_pred = np.full(len(denom), -np.inf)
-    t_pred[steep] = np.einsum("ij,ij->i", v0[steep] - band.origin[steep], n_t[steep]) / denom[steep]
-    t_hit = np.einsum("ij,ij->i", band.point - band.origin, band.direction)
-    jump = (band.face != parent.face) & (t_pred - t_hit > DISCONTINUITY * caster.diagonal)
+    t_pred = np.full(len(idx), -np.inf)
+    t_pred[steep] = np.einsum("ij,ij->i", v0[steep] - o[steep], n_t[steep]) / denom[steep]
+    t_hit = np.einsum("ij,ij->i", band.point[idx] - o, d)
+    jump = t_pred - t_hit > DISCONTINUITY * caster.diagonal
     if not jump.any():
         return Sightings.empty(), 0, 0
-    idx = np.flatnonzero(jump)
+    t_pred, idx = t_pred[jump], idx[jump]
     hx, old, o, d = band.point[idx], parent.point[idx], band.origin[idx], band.direction[idx]
-    predicted = o + d * t_pred[idx, None]
+    predicted = o + d * t_pred[:, None]
     if region.at_infinity:
         plane = np.cross(d, old - hx)
     else:

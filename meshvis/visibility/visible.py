@@ -31,10 +31,12 @@ SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
 FIRST_ROUND_CHUNKS = 16
 #: default stop rule: fewer new faces than this per million rays in a round (GVS §3.5 uses 50)
 MIN_NEW_PER_MILLION = 50.0
-#: the stop rule is judged over at least this many rays (GVS counts new faces per million rays)
+#: the stop rule is judged over at least this many rays (GVS counts new faces per million
+#: rays) or, on small models, this many rays per face, whichever is fewer
 STOP_WINDOW = 1_000_000
+STOP_WINDOW_PER_FACE = 64
 #: default budget: rays per face of the model
-DEFAULT_RAYS_PER_FACE = 1024
+DEFAULT_RAYS_PER_FACE = 128
 #: push of seed origins off their face, as a fraction of the diagonal (as the reference)
 ORIGIN_OFFSET = 1e-6
 #: sightings propagated in one batch (bounded memory: ~100 rays each)
@@ -56,6 +58,9 @@ class Visibility:
         Random seed rays aimed at each face.
     area : (m,) float64
         Face areas.
+    first_seen : (m,) int64
+        Rays cast up to the end of the batch that first saw the face (-1: never seen); the faces
+        seen with at most ``r`` rays are ``(first_seen >= 0) & (first_seen <= r)``.
     history : dict of lists
         ``rays``, ``visible_area``, ``faces_seen``, ``seconds`` after every batch: the
         visible area found against rays cast.
@@ -75,6 +80,7 @@ class Visibility:
     rays_seen: np.ndarray
     seed_rays: np.ndarray
     area: np.ndarray
+    first_seen: np.ndarray
     history: dict
     rays: dict
     skipped: dict
@@ -131,6 +137,7 @@ class _State:
         self.seen_side = np.zeros((m, 2), bool)
         self.rays_seen = np.zeros((m, 2), np.int64)
         self.seed_rays = np.zeros(m, np.int64)
+        self.first_seen = np.full(m, -1, np.int64)
         self.rays = {"random": 0, "border": 0, "reverse": 0}
         self.refused = 0
         self.budget = budget
@@ -154,7 +161,9 @@ class _State:
         self.seen_side[s.face, s.side] = True
         fresh = ~seen_before[s.face]
         _, first = np.unique(s.face[fresh], return_index=True)
-        return s.subset(np.flatnonzero(fresh)[first])
+        new = s.subset(np.flatnonzero(fresh)[first])
+        self.first_seen[new.face] = self.cast
+        return new
 
     def snapshot(self) -> None:
         seen = self.seen_side.any(axis=1)
@@ -188,7 +197,7 @@ def visible_from(
         ``"outside"``, ``"upper-hemisphere"``, ``"box:x0,y0,z0,x1,y1,z1"``,
         ``"points:x,y,z;..."``, ``"path:FILE.json"``.
     budget : int, optional
-        Most rays to trace (default ``1024 x`` the number of faces).
+        Most rays to trace (default ``128 x`` the number of faces).
     seed : int
         Seed of the one random generator; same model, region and seed give the same result.
     method : {"guided", "random"}
@@ -257,6 +266,7 @@ def visible_from(
         rays_seen=state.rays_seen,
         seed_rays=state.seed_rays,
         area=soup.areas.copy(),
+        first_seen=state.first_seen,
         history=state.history,
         rays={**state.rays, "total": state.cast},
         skipped=skipped,
@@ -274,6 +284,7 @@ def _presee(state: _State, soup, region: Region) -> dict:
     inside = region.contains_faces(soup.triangles)
     if inside.any():
         state.seen_side[inside] = True
+        state.first_seen[inside] = 0
         skipped["inside the region (seen without rays)"] = int(inside.sum())
     return skipped
 
@@ -316,7 +327,7 @@ def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool
             return "all seen"
         if state.left <= 0:
             return "budget"
-        if state.cast - window_rays >= STOP_WINDOW:
+        if state.cast - window_rays >= min(STOP_WINDOW, STOP_WINDOW_PER_FACE * m):
             if (n_found() - window_found) * 1e6 < state.min_new * (state.cast - window_rays):
                 return "few new faces"
             window_found, window_rays = n_found(), state.cast

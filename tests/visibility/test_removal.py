@@ -82,10 +82,18 @@ def test_cli_flags_of_remove_interior_and_visible(scenes, tmp_path, capsys):
     assert main(argv + ["--from", "box:1,2", "--force"]) == 2
     assert "expected 6 comma-separated numbers" in capsys.readouterr().err
     vis_rep, png = tmp_path / "v.json", tmp_path / "v.png"
-    assert main(["visible", str(src), "--report", str(vis_rep), "--preview", str(png), "-q", "--budget", "50000"]) == 0
+    assert (
+        main(
+            ["visible", str(src), "--report", str(vis_rep), "--preview", str(png), "-q", "--budget", "50000"]
+        )
+        == 0
+    )
     v = json.loads(vis_rep.read_text())
     seen = np.array(v["per_face"]["seen_front"]) | np.array(v["per_face"]["seen_back"])
     np.testing.assert_array_equal(seen, truth.any(axis=1))
     assert png.stat().st_size > 1000
-    assert main(["visible", str(src), "--from", "upper-hemisphere", "--up", "z", "--method", "random", "-q"]) == 0
+    assert (
+        main(["visible", str(src), "--from", "upper-hemisphere", "--up", "z", "--method", "random", "-q"])
+        == 0
+    )
     assert main(["visible", str(src), "--from", "nowhere", "-q"]) == 2
