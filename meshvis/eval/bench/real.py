@@ -19,7 +19,7 @@ from pathlib import Path
 import numpy as np
 
 from meshvis.eval.baselines import pymeshlab_ao
-from meshvis.eval.false_pixels import face_pixels, false_pixels, fibonacci_sphere
+from meshvis.eval.false_pixels import SIZE, VIEWS, face_pixels, false_pixels, fibonacci_sphere
 from meshvis.eval.generators import real_models_dir
 from meshvis.eval.reference import reference
 from meshvis.graphcut.classify import classify
@@ -60,6 +60,10 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=os.path.join(os.path.expanduser("~"), ".cache", "meshvis"),
         help="folder of the cached references and pixel tables (default ~/.cache/meshvis)",
     )
+    p.add_argument(
+        "--views", type=int, default=VIEWS, help=f"viewpoints of the false pixels (default {VIEWS})"
+    )
+    p.add_argument("--size", type=int, default=SIZE, help=f"image size of the false pixels (default {SIZE})")
     p.add_argument("--curve", metavar="PNG", help="plot false pixels against rays, guided and random")
     p.add_argument("--worst", metavar="FOLDER", help="pictures of the worst view of 'both' per model")
     p.add_argument("--json", metavar="FILE", help="also write every number as JSON")
@@ -72,7 +76,16 @@ def main(args: argparse.Namespace) -> int:
     os.makedirs(args.cache, exist_ok=True)
     results = []
     for path, up, ground in todo:
-        r = run_model(path, AXES[up], ground, seed=args.seed, cache=args.cache, worst=args.worst)
+        r = run_model(
+            path,
+            AXES[up],
+            ground,
+            seed=args.seed,
+            cache=args.cache,
+            worst=args.worst,
+            views=args.views,
+            size=args.size,
+        )
         print(format_model(r), flush=True)
         results.append(r)
     if args.curve:
@@ -109,13 +122,22 @@ def _machine() -> dict:
 
 
 def run_model(
-    path: str, up, ground: bool, *, seed: int = 0, cache: str = ".", worst: str | None = None
+    path: str,
+    up,
+    ground: bool,
+    *,
+    seed: int = 0,
+    cache: str = ".",
+    worst: str | None = None,
+    views: int = VIEWS,
+    size: int = SIZE,
 ) -> dict:
     """Every method on one model; one dict of rows and curves."""
     soup = load(path)
     stem = Path(path).stem
     ref = reference(soup, seed=seed, cache=os.path.join(cache, f"{stem}.seed{seed}.npz"))
-    table = face_pixels(soup, cache=os.path.join(cache, f"{stem}.pixels.npz"))
+    suffix = "" if (views, size) == (VIEWS, SIZE) else f".{views}x{size}"
+    table = face_pixels(soup, views=views, size=size, cache=os.path.join(cache, f"{stem}.pixels{suffix}.npz"))
     ref_hidden = ~ref.seen
     rows = {"reference (dense random)": (ref.seen, int(ref.rays.sum()), ref.seconds)}
 
@@ -259,7 +281,7 @@ def worst_view_picture(soup, removed: np.ndarray, table, path: str, size: int = 
     from meshvis.rays.render import render, save_png
 
     fp = false_pixels(table, removed)
-    v = max(fp["worst_view"], 0)
+    v = max(fp["worst_view"], 0)  # (the picture is always SIZE wide; the view is the table's)
     d = fibonacci_sphere(len(table.model_pixels))[v]
     lo, hi = soup.bounds
     center, radius = 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
