@@ -19,7 +19,9 @@ def add_parser(sub) -> None:
         "points:x,y,z;..., path:CAMERAS.json",
     )
     p.add_argument("--method", choices=("guided", "random"), default="guided")
-    p.add_argument("--budget", type=positive_int, help="most rays to trace (default 128 per face)")
+    p.add_argument(
+        "--budget", type=positive_int, help="most rays to trace (default 128 per face, at least 2**22)"
+    )
     p.add_argument("--per-side", action="store_true", help="keep looking until both sides of a face are seen")
     p.add_argument(
         "--up", choices=("auto", "x", "y", "z"), default="auto", help="up axis of upper-hemisphere"

@@ -35,8 +35,10 @@ MIN_NEW_PER_MILLION = 50.0
 #: rays) or, on small models, this many rays per face, whichever is fewer
 STOP_WINDOW = 1_000_000
 STOP_WINDOW_PER_FACE = 64
-#: default budget: rays per face of the model
+#: default budget: rays per face of the model, and at least this many rays (small models are
+#: cheap, and faces seen through rare gaps need rays whatever the model's size)
 DEFAULT_RAYS_PER_FACE = 128
+DEFAULT_MIN_BUDGET = 1 << 22
 #: push of seed origins off their face, as a fraction of the diagonal (as the reference)
 ORIGIN_OFFSET = 1e-6
 #: sightings propagated in one batch (bounded memory: ~100 rays each)
@@ -197,7 +199,7 @@ def visible_from(
         ``"outside"``, ``"upper-hemisphere"``, ``"box:x0,y0,z0,x1,y1,z1"``,
         ``"points:x,y,z;..."``, ``"path:FILE.json"``.
     budget : int, optional
-        Most rays to trace (default ``128 x`` the number of faces).
+        Most rays to trace (default ``128 x`` the number of faces, at least 2**22).
     seed : int
         Seed of the one random generator; same model, region and seed give the same result.
     method : {"guided", "random"}
@@ -236,7 +238,7 @@ def visible_from(
         raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     soup = as_soup(model)
     region = parse_region(region, up=up).bind(soup)
-    budget = DEFAULT_RAYS_PER_FACE * soup.n_faces if budget is None else int(budget)
+    budget = max(DEFAULT_RAYS_PER_FACE * soup.n_faces, DEFAULT_MIN_BUDGET) if budget is None else int(budget)
     if budget < 0:
         raise ParameterError(f"budget must be at least 0, got {budget}")
     caster = caster or RayCaster(soup, offset=ORIGIN_OFFSET)
