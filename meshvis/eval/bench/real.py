@@ -275,24 +275,39 @@ def plot_curves(results: list[dict], path: str) -> None:
     plt.close(fig)
 
 
-def worst_view_picture(soup, removed: np.ndarray, table, path: str, size: int = 512) -> dict:
-    """The original model from the view with the most false pixels, deleted faces in red."""
+def worst_view_picture(soup, removed: dict, table, path: str, size: int = 512) -> dict:
+    """The original model from the view with the most false pixels of each removal, side by side.
+
+    Parameters
+    ----------
+    removed : dict of (m,) bool
+        Method name -> deleted faces; each panel shows its own worst view, the deleted faces
+        that show there in red, marked with a ring (single pixels are too small to see).
+    """
+    from scipy import ndimage
+
     from meshvis.rays.camera import Camera
     from meshvis.rays.render import render, save_png
 
-    fp = false_pixels(table, removed)
-    v = max(fp["worst_view"], 0)  # (the picture is always SIZE wide; the view is the table's)
-    d = fibonacci_sphere(len(table.model_pixels))[v]
     lo, hi = soup.bounds
     center, radius = 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
-    up = (0.0, 0.0, 1.0) if abs(d[2]) < 0.9 else (0.0, 1.0, 0.0)
-    cam = Camera(center + 3 * radius * d, center, up, orthographic=True, ortho_height=2 * radius)
-    r = render(soup, cam, size=(size, size), color_by=None)
-    img = r.image.copy()
-    bad = (r.face >= 0) & removed[np.maximum(r.face, 0)]
-    img[bad] = (230, 40, 40)
-    save_png(img, path)
-    return {"path": path, "view": v, "false_pixels": fp["worst"]}
+    panels, info = [], {}
+    for name, gone in removed.items():
+        fp = false_pixels(table, gone)
+        v = max(fp["worst_view"], 0)
+        d = fibonacci_sphere(len(table.model_pixels))[v]
+        up = (0.0, 0.0, 1.0) if abs(d[2]) < 0.9 else (0.0, 1.0, 0.0)
+        cam = Camera(center + 3 * radius * d, center, up, orthographic=True, ortho_height=2 * radius)
+        r = render(soup, cam, size=(size, size), color_by=None)
+        img = r.image.copy()
+        bad = (r.face >= 0) & gone[np.maximum(r.face, 0)]
+        ring = ndimage.binary_dilation(bad, iterations=6) & ~ndimage.binary_dilation(bad, iterations=4)
+        img[ring] = (240, 150, 30)
+        img[bad] = (230, 30, 30)
+        panels.append(img)
+        info[name] = {"view": v, "false_pixels": fp["worst"]}
+    save_png(np.concatenate(panels, axis=1), path)
+    return {"path": path, **info}
 
 
 def format_model(r: dict) -> str:
