@@ -202,7 +202,7 @@ def run_model(
     if worst:
         os.makedirs(worst, exist_ok=True)
         result["worst_picture"] = worst_view_picture(
-            soup, ~both.keep, table, os.path.join(worst, f"{stem}.png")
+            soup, {"object": ~obj.keep, "both": ~both.keep}, table, os.path.join(worst, f"{stem}.png")
         )
     return result
 
