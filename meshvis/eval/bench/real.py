@@ -65,7 +65,9 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     )
     p.add_argument("--size", type=int, default=SIZE, help=f"image size of the false pixels (default {SIZE})")
     p.add_argument("--curve", metavar="PNG", help="plot false pixels against rays, guided and random")
-    p.add_argument("--worst", metavar="FOLDER", help="pictures of the worst view of 'both' per model")
+    p.add_argument(
+        "--worst", metavar="FOLDER", help="pictures of the worst views of object and both per model"
+    )
     p.add_argument("--json", metavar="FILE", help="also write every number as JSON")
 
 
