@@ -53,8 +53,10 @@ def test_patch_level_and_keep_border(scenes):
     assert r.keep.sum() == 2
     assert remove_interior(cube, visibility="view", region="points:5,0,0", level="patch", seed=0).keep.all()
     ring = remove_interior(cube, visibility="view", region="points:5,0,0", keep_border=1, seed=0)
-    # the faces sharing an edge with the +x pair: both triangles of the 4 side faces touch it
-    assert ring.keep.sum() > 2 and not ring.keep[names == "-x"].all()
+    # one ring: each of the 4 edges of the +x square borders one triangle of a side face
+    assert ring.keep.sum() == 6 and not ring.keep[names == "-x"].any()
+    two = remove_interior(cube, visibility="view", region="points:5,0,0", keep_border=2, seed=0)
+    assert two.keep.sum() > 6
     assert "kept: next to a kept face (keep_border)" in ring.reason
 
 
