@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|labeling|labeling-sweep``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -28,7 +28,16 @@ def add_parser(sub) -> None:
     add_models_argument(c)
     c.set_defaults(func=run_classify)
 
-    for name in ("accuracy", "stability", "labeling", "labeling-sweep", "compare", "scale", "orientation"):
+    for name in (
+        "accuracy",
+        "stability",
+        "labeling",
+        "labeling-sweep",
+        "compare",
+        "scale",
+        "orientation",
+        "real",
+    ):
         try:
             mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])
         except ModuleNotFoundError:

@@ -116,6 +116,45 @@ def algorithm_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--solver", choices=("pymaxflow", "scipy"), default=d["solver"])
 
 
+def removal_options(p: argparse.ArgumentParser) -> None:
+    """Add the options of inside removal by sight (shared with ``meshvis batch``)."""
+    d = OPERATION_DEFAULTS["remove-interior"]
+    p.add_argument(
+        "--visibility",
+        choices=("object", "view", "both"),
+        default=d["visibility"],
+        help="remove what the cut calls hidden (object), what no view from --from reaches (view), "
+        "or only what both call hidden (default both)",
+    )
+    p.add_argument(
+        "--from",
+        dest="from_region",
+        default=d["from_region"],
+        metavar="REGION",
+        help="where viewers are: outside (default), upper-hemisphere[:ux,uy,uz], "
+        "box:x0,y0,z0,x1,y1,z1, points:x,y,z;..., path:CAMERAS.json",
+    )
+    p.add_argument(
+        "--level",
+        choices=("face", "patch", "part"),
+        default=d["level"],
+        help="remove single faces, or whole patches / parts whose faces are all hidden",
+    )
+    p.add_argument(
+        "--keep-border",
+        type=int,
+        default=d["keep_border"],
+        metavar="N",
+        help="keep N rings of hidden faces next to kept ones (default 0)",
+    )
+    p.add_argument(
+        "--up",
+        choices=("auto", "x", "y", "z"),
+        default=d["up"],
+        help="up axis of upper-hemisphere (auto: y for glTF, z otherwise)",
+    )
+
+
 def add_parser(sub) -> None:
     p = sub.add_parser("classify", help="classify every triangle side inside/outside (report only)")
     _common(p, needs_output=False)
@@ -149,6 +188,7 @@ def add_parser(sub) -> None:
     p = sub.add_parser("remove-interior", help="remove the faces that cannot be seen from outside")
     _common(p)
     p.add_argument("--removed", metavar="FILE", help="also write the removed faces")
+    removal_options(p)
     p.set_defaults(func=run, op="remove-interior")
 
     p = sub.add_parser("layers", help="peel the model into nested layers")

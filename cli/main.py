@@ -23,6 +23,7 @@ COMMANDS = {
     "orient": "meshvis.cli.cmd_repair",
     "remove-interior": "meshvis.cli.cmd_repair",
     "layers": "meshvis.cli.cmd_repair",
+    "visible": "meshvis.cli.cmd_visible",
     "label": "meshvis.cli.cmd_label",
     "batch": "meshvis.cli.cmd_batch",
     "bench": "meshvis.cli.cmd_bench",

@@ -7,6 +7,7 @@ The package is layered; each subpackage uses only the ones above it in this list
 * :mod:`meshvis.rays` -- the Embree ray caster, random samples, cameras and previews;
 * :mod:`meshvis.geometry` -- connectivity, welding, intersection tests, diagnostics;
 * :mod:`meshvis.graphcut` -- inside/outside by visibility graph cut (appendix H);
+* :mod:`meshvis.visibility` -- from-region visibility by guided sampling (GVS);
 * :mod:`meshvis.repair` -- orientation, inside removal and layers built on the cut;
 * :mod:`meshvis.batch` -- one repair over many files;
 * :mod:`labeling` -- external labels (appendix I), on :mod:`meshvis.rays`;
@@ -52,6 +53,8 @@ _LAZY = {
     "orient": "meshvis.repair.orient",
     "remove_interior": "meshvis.repair.remove",
     "layers": "meshvis.repair.layers",
+    "visible_from": "meshvis.visibility.visible",
+    "parse_region": "meshvis.visibility.regions",
 }
 
 __all__ = [

@@ -36,7 +36,13 @@ CLASSIFY_DEFAULTS: dict[str, Any] = {
 OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
     "classify": {},
     "orient": {"front": "ccw", "two_sided": "keep", "semantics": "layer", "conflicts": "majority"},
-    "remove-interior": {},
+    "remove-interior": {
+        "visibility": "both",
+        "from_region": "outside",
+        "level": "face",
+        "keep_border": 0,
+        "up": "auto",
+    },
     "layers": {"max_layers": None},
 }
 #: where results go (None: not written)
@@ -146,7 +152,7 @@ def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     from meshvis.rays.render import render, save_png
     from meshvis.repair.remove import remove_interior
 
-    r = remove_interior(soup, classification=c)
+    r = remove_interior(soup, classification=c, **removal_kwargs(o, soup))
     save(r.kept, o["output"])
     wrote_removed = bool(o["removed"]) and r.removed.n_faces > 0
     if wrote_removed:
@@ -188,6 +194,21 @@ _OUTPUTS = {
 }
 
 
+def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
+    """Keyword arguments of :func:`meshvis.remove_interior` from operation options."""
+    from meshvis.rays.camera import up_axis
+
+    o = {**default_options("remove-interior"), **_options(options)}
+    return dict(
+        visibility=o["visibility"],
+        region=o["from_region"],
+        level=o["level"],
+        keep_border=int(o["keep_border"]),
+        up=up_axis(o["up"], [soup.path] if soup.path else []),
+        seed=int(o["seed"]),
+    )
+
+
 def run_operation(
     op: str,
     soup,
@@ -227,8 +248,10 @@ def run_operation(
         import_extra("networkx", "GraphML export (--graphml)")
     tell = say or (lambda text: None)
     up = up_axis(o.get("up") or "auto", [soup.path] if soup.path else [])  # of the preview
-    c = classify(soup, progress=progress, **classify_kwargs(o))
-    tell(c.summary())
+    c = None
+    if op != "remove-interior" or o["visibility"] != "view":  # sight alone needs no cut
+        c = classify(soup, progress=progress, **classify_kwargs(o))
+        tell(c.summary())
     report = _OUTPUTS[op](soup, c, o, tell, up)
     report["operation"] = op
     report["seed"] = o["seed"]

@@ -1,10 +1,17 @@
-"""Inside removal (appendix H §5, "Inside Removal").
+"""Inside removal (appendix H §5, "Inside Removal"), by the cut, by sight, or by both.
 
-One classification; every face with an outside side — or, for faces classified through
-sample points, at least one outside sample point — is kept, the rest is removed.  Of a
-sheet stored twice with opposite winding (:mod:`meshvis.geometry.duplicates`) whose one
-side is hidden, only the copy facing the seen side is kept.
-Every input face ends up in exactly one of the two outputs.
+* ``visibility="object"``: one classification; every face with an outside side -- or, for
+  faces classified through sample points, at least one outside sample point -- is kept.
+  Of a sheet stored twice with opposite winding (:mod:`meshvis.geometry.duplicates`) whose
+  one side is hidden, only the copy facing the seen side counts as kept by the cut.
+* ``visibility="view"``: every face that no line of sight from the region reached is removed
+  (:func:`meshvis.visible_from`, DESIGN.md §9).
+* ``visibility="both"``: a face is removed only when the cut calls it hidden *and* a guided
+  search for a view of it (seed rays aimed at these faces only) failed.
+
+``level="patch"`` or ``"part"`` removes a connected patch (faces sharing edges) or a named
+part only when all its faces are hidden; ``keep_border=N`` keeps N rings of hidden faces
+around kept ones.  Every input face ends up in exactly one of the two outputs, with a reason.
 """
 
 from __future__ import annotations
@@ -15,9 +22,29 @@ from typing import Any
 import numpy as np
 
 from meshvis import _validate
+from meshvis.errors import ParameterError
+from meshvis.geometry.adjacency import components, edges, face_adjacency, weld
 from meshvis.geometry.duplicates import hidden_copies, opposite_copies
 from meshvis.graphcut.classify import Classification, classify
+from meshvis.io import as_soup
 from meshvis.soup import Soup
+from meshvis.visibility import Visibility, visible_from
+
+VISIBILITY_MODES = ("object", "view", "both")
+LEVELS = ("face", "patch", "part")
+
+#: reason of each face, by code
+REASONS = (
+    "kept: an outside side by the cut",
+    "kept: seen from the region",
+    "kept: hidden by the cut, but a view of it was found",
+    "kept: its patch or part has a face that is kept",
+    "kept: next to a kept face (keep_border)",
+    "removed: no outside side by the cut",
+    "removed: not seen from the region",
+    "removed: hidden by the cut and no view of it was found",
+)
+_KEPT_CUT, _KEPT_SEEN, _KEPT_RESCUED, _KEPT_GROUP, _KEPT_BORDER, _GONE_CUT, _GONE_VIEW, _GONE_BOTH = range(8)
 
 
 @dataclass
@@ -28,47 +55,94 @@ class RemovalResult:
     ----------
     kept, removed : Soup, the faces kept and removed (attributes preserved)
     keep : (m,) bool per input face
+    classification : Classification or None (``visibility="view"`` needs none)
+    visibility : Visibility or None, the from-region search (``"view"`` and ``"both"``)
+    reason_code : (m,) int8, index into :data:`REASONS` per input face
+    mode : str, the ``visibility`` used
+    soup : Soup, the input model
     """
 
     kept: Soup
     removed: Soup
     keep: np.ndarray
-    classification: Classification
+    classification: Classification | None
+    visibility: Visibility | None
+    reason_code: np.ndarray
+    mode: str
+    soup: Soup
+
+    @property
+    def reason(self) -> list[str]:
+        """Why each input face was kept or removed."""
+        return [REASONS[c] for c in self.reason_code]
 
     def report(self, per_face: bool = True) -> dict:
-        d = {
+        soup = self.soup
+        d: dict[str, Any] = {
+            "visibility": self.mode,
             "input_faces": int(len(self.keep)),
             "kept_faces": int(self.keep.sum()),
             "removed_faces": int((~self.keep).sum()),
-            "removed_area_fraction": float(
-                (self.classification.soup.areas * ~self.keep).sum()
-                / max(self.classification.soup.total_area, 1e-300)
-            ),
-            "classification": self.classification.report(per_face=False),
+            "removed_area_fraction": float((soup.areas * ~self.keep).sum() / max(soup.total_area, 1e-300)),
+            "reasons": {REASONS[c]: int(n) for c, n in zip(*np.unique(self.reason_code, return_counts=True))},
         }
+        if self.classification is not None:
+            d["classification"] = self.classification.report(per_face=False)
+        if self.visibility is not None:
+            d["view"] = self.visibility.report(per_face=False)
         if per_face:
-            d["per_face"] = {
-                "keep": self.keep,
-                "outside_front": self.classification.outside[:, 0],
-                "outside_back": self.classification.outside[:, 1],
-            }
+            d["per_face"] = {"keep": self.keep, "reason": self.reason}
+            if self.classification is not None:
+                d["per_face"]["outside_front"] = self.classification.outside[:, 0]
+                d["per_face"]["outside_back"] = self.classification.outside[:, 1]
+            if self.visibility is not None:
+                d["per_face"]["seen"] = self.visibility.seen
         return d
 
 
 def remove_interior(
-    model: Any, *, classification: Classification | None = None, **classify_kw: Any
+    model: Any,
+    *,
+    classification: Classification | None = None,
+    visibility: str = "object",
+    region="outside",
+    level: str = "face",
+    keep_border: int = 0,
+    budget: int | None = None,
+    up=(0.0, 0.0, 1.0),
+    view: Visibility | None = None,
+    **classify_kw: Any,
 ) -> RemovalResult:
-    """Remove the faces that cannot be seen from outside.
+    """Remove the faces that cannot be seen from outside (or from ``region``).
 
     Parameters
     ----------
     model : anything :func:`meshvis.classify` accepts
     classification : reuse an existing classification of the same model
+    visibility : {"object", "view", "both"}
+        The graph cut alone, sight from ``region`` alone, or both must call a face hidden.
+    region : str or Region
+        Where viewers may be, for ``"view"`` and ``"both"`` (see :func:`meshvis.parse_region`).
+    level : {"face", "patch", "part"}
+        Remove single faces, or whole edge-connected patches / named parts whose faces are all hidden.
+    keep_border : int
+        Rings of hidden faces (sharing an edge) kept around the kept faces.
+    budget : int, optional
+        Ray budget of the from-region search (default: :func:`meshvis.visible_from`'s).
+    up : (3,) float
+        Up direction of an ``"upper-hemisphere"`` region.
+    view : Visibility, optional
+        Reuse a from-region search of the same model (``"view"`` only).
     **classify_kw : passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...)
 
     Returns
     -------
     RemovalResult
+
+    Raises
+    ------
+    ParameterError
+        Unknown mode or level, negative ``keep_border``.
 
     Examples
     --------
@@ -78,11 +152,69 @@ def remove_interior(
     >>> r = remove_interior((v, f), seed=0)
     >>> r.kept.n_faces, r.removed.n_faces
     (320, 320)
+    >>> remove_interior((v, f), visibility="view", seed=0).removed.n_faces
+    320
     """
     _validate.repair_args(classification, Classification, classify_kw, classify)
-    c = classification or classify(model, **classify_kw)
+    if visibility not in VISIBILITY_MODES:
+        raise ParameterError(
+            f"unknown visibility {visibility!r}; choose one of {', '.join(VISIBILITY_MODES)}"
+        )
+    if level not in LEVELS:
+        raise ParameterError(f"unknown level {level!r}; choose one of {', '.join(LEVELS)}")
+    if int(keep_border) < 0:
+        raise ParameterError(f"keep_border must be at least 0, got {keep_border}")
+    seed = int(classify_kw.get("seed", 0))
+    c: Classification | None = None
+    vis: Visibility | None = None
+    if visibility == "view":
+        soup = as_soup(model)
+        vis = view or visible_from(soup, region, budget=budget, seed=seed, up=up)
+        keep = vis.seen.copy()
+        code = np.where(keep, _KEPT_SEEN, _GONE_VIEW)
+    else:
+        c = classification or classify(model, **classify_kw)
+        soup = c.soup
+        by_cut = _kept_by_cut(c)
+        if visibility == "object":
+            keep = by_cut
+            code = np.where(keep, _KEPT_CUT, _GONE_CUT)
+        else:
+            vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut)
+            keep = by_cut | vis.seen
+            code = np.where(by_cut, _KEPT_CUT, np.where(vis.seen, _KEPT_RESCUED, _GONE_BOTH))
+    code = code.astype(np.int8)
+    keep = _widen(soup, keep, code, level, int(keep_border))
+    return RemovalResult(soup.subset(keep), soup.subset(~keep), keep, c, vis, code, visibility, soup)
+
+
+def _kept_by_cut(c: Classification) -> np.ndarray:
+    """Faces with an outside side; of a sheet stored twice with opposite winding whose one
+    side is hidden, only the copy facing the seen side."""
     keep = (c.outside > 0).any(axis=1)
-    # a sheet stored twice with opposite winding keeps only the copy facing the viewer
-    # where its other side is hidden
-    keep &= ~hidden_copies(opposite_copies(c.pre.faces_welded), c.outside)
-    return RemovalResult(c.soup.subset(keep), c.soup.subset(~keep), keep, c)
+    return keep & ~hidden_copies(opposite_copies(c.pre.faces_welded), c.outside)
+
+
+def _widen(soup: Soup, keep: np.ndarray, code: np.ndarray, level: str, keep_border: int) -> np.ndarray:
+    """Apply ``level`` and ``keep_border`` to ``keep`` (and ``code``, in place)."""
+    if level == "face" and keep_border == 0:
+        return keep
+    _, welded = weld(soup.vertices, soup.faces)
+    pairs = face_adjacency(edges(welded), manifold_only=False)
+    if level != "face":
+        group = soup.part_id if level == "part" else components(soup.n_faces, pairs)[1]
+        any_kept = np.zeros(int(group.max()) + 1 if len(group) else 0, bool)
+        any_kept[group[keep]] = True
+        rescued = ~keep & any_kept[group]
+        code[rescued] = _KEPT_GROUP
+        keep = keep | rescued
+    for _ in range(keep_border):
+        near = np.zeros(len(keep), bool)
+        near[pairs[keep[pairs[:, 0]], 1]] = True
+        near[pairs[keep[pairs[:, 1]], 0]] = True
+        ring = near & ~keep
+        if not ring.any():
+            break
+        code[ring] = _KEPT_BORDER
+        keep = keep | ring
+    return keep

@@ -53,7 +53,10 @@ def test_remove_interior_cli_removes_hidden_keeps_visible(sphere_pair_soup, tmp_
     truth, path = sphere_pair_soup
     out, removed, rep = tmp_path / "k.obj", tmp_path / "r.obj", tmp_path / "k.json"
     assert (
-        main(["remove-interior", path, "-o", str(out), "--removed", str(removed), "--report", str(rep), "-q"])
+        main(
+            ["remove-interior", path, "-o", str(out), "--removed", str(removed), "--report", str(rep), "-q"]
+            + ["--visibility", "object"]
+        )
         == 0
     )
     report = json.loads(rep.read_text())

@@ -1,0 +1,70 @@
+"""``meshvis visible``: which face sides a viewer in a region can see (a report, no output model)."""
+
+from __future__ import annotations
+
+import argparse
+
+from .common import check_output, positive_int, say, write_json
+
+
+def add_parser(sub) -> None:
+    p = sub.add_parser("visible", help="which faces can be seen from a region (GVS guided sampling)")
+    p.add_argument("input", help="input model (OBJ, PLY, STL, OFF, glTF/GLB, 3MF)")
+    p.add_argument(
+        "--from",
+        dest="from_region",
+        default="outside",
+        metavar="REGION",
+        help="outside (default), upper-hemisphere[:ux,uy,uz], box:x0,y0,z0,x1,y1,z1, "
+        "points:x,y,z;..., path:CAMERAS.json",
+    )
+    p.add_argument("--method", choices=("guided", "random"), default="guided")
+    p.add_argument(
+        "--budget", type=positive_int, help="most rays to trace (default 128 per face, at least 2**22)"
+    )
+    p.add_argument("--per-side", action="store_true", help="keep looking until both sides of a face are seen")
+    p.add_argument(
+        "--up", choices=("auto", "x", "y", "z"), default="auto", help="up axis of upper-hemisphere"
+    )
+    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--report", metavar="REPORT.json", help="write per-face results and the history")
+    p.add_argument(
+        "--preview", metavar="PICTURE.png", help="the model with unseen faces in red, and them alone"
+    )
+    p.add_argument("--force", action="store_true", help="overwrite existing outputs")
+    p.add_argument("--quiet", "-q", action="store_true", help="print nothing but errors")
+    p.set_defaults(func=run)
+
+
+def run(args: argparse.Namespace) -> int:
+    from meshvis.io import load
+    from meshvis.rays.camera import up_axis
+    from meshvis.rays.render import save_png
+    from meshvis.visibility import visible_from
+    from meshvis.visibility.preview import preview
+
+    for path in (args.report, args.preview):
+        if path:
+            check_output(path, [args.input], args.force)
+    soup = load(args.input)
+    vis = visible_from(
+        soup,
+        args.from_region,
+        budget=args.budget,
+        seed=args.seed,
+        method=args.method,
+        up=up_axis(args.up, [args.input]),
+        per_side=args.per_side,
+    )
+    r = vis.report(per_face=bool(args.report))
+    say(
+        args,
+        f"{args.input}: {r['seen_faces']} of {r['faces']} faces seen ({100 * r['seen_area_fraction']:.1f} % of the area) "
+        f"from {args.from_region}; {r['rays']['total']} rays, stopped: {r['stopped']}, {vis.seconds:.1f} s",
+    )
+    if args.report:
+        r["input"] = args.input
+        write_json(args.report, r)
+    if args.preview:
+        save_png(preview(soup, vis), args.preview)
+    return 0

@@ -1,0 +1,261 @@
+"""The ray strategies of from-region visibility, each one vectorised over a batch.
+
+* **random seeds** (GVS §3.1): from area-uniform points on faces to random viewers of the
+  region; a free segment certifies the side of the face that looks at the viewer;
+* **adaptive border sampling** (GVS §3.2): a face just proven visible from a viewer is
+  enlarged by a thin band in the plane across the viewing ray (9 points, 3 per corner:
+  across each adjacent edge and along the bisector, GVS Eq. 1 in spirit); the viewer casts
+  rays to those points, and every band edge whose two ends hit different faces is halved
+  until its ends agree or it gets shorter than :data:`MIN_SEGMENT`;
+* **reverse sampling** (GVS §3.3): a band ray stopped much closer than the plane of its
+  face predicts met an occluder; the plane through the viewer, the stopping point and the
+  face's certificate cuts the occluder along a segment; just beyond each end of it the
+  line towards the predicted point passes beside the occluder, and a viewer of the region
+  on that line gets a ray.
+
+Every traced ray's first hit is visible from where it started, so every ray of the last two
+strategies certifies its first hit (the records are :class:`Sightings`).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from meshvis.rays.caster import Hits, RayCaster
+from meshvis.rays.samples import uniform_in_triangles
+from meshvis.visibility.regions import Region
+
+#: half-width of the band around a face, as a fraction of the diagonal (viewers at
+#: infinity) or of the viewing distance (finite viewers): far above float32 round-off of the
+#: unit-size Embree scene (~1e-7), far below any gap users care about
+ENLARGE = 2e-5
+#: band edges are not halved below this length (fraction of the diagonal) ...
+MIN_SEGMENT = 1e-4
+#: ... nor more often than this
+MAX_DEPTH = 8
+#: a band ray that stops this much (fraction of the diagonal) before its face's plane met an occluder
+DISCONTINUITY = 1e-3
+#: reverse-sampling points sit this far (fraction of the diagonal) beyond the occluder's edge
+PASS_BY = 2e-5
+
+
+@dataclass
+class Sightings:
+    """Rays that certify their first hit: face, side, and the viewer ray that saw it.
+
+    Attributes
+    ----------
+    face : (n,) int64
+    side : (n,) int8
+    origin, direction : (n, 3) float64, the ray from the viewer
+    point : (n, 3) float64, where the ray hit
+    """
+
+    face: np.ndarray
+    side: np.ndarray
+    origin: np.ndarray
+    direction: np.ndarray
+    point: np.ndarray
+
+    @classmethod
+    def empty(cls) -> Sightings:
+        z = np.zeros((0, 3))
+        return cls(np.zeros(0, np.int64), np.zeros(0, np.int8), z, z, z)
+
+    @classmethod
+    def concat(cls, parts: list[Sightings]) -> Sightings:
+        parts = [p for p in parts if len(p.face)] or [cls.empty()]
+        return cls(*(np.concatenate([getattr(p, k) for p in parts]) for k in cls.__dataclass_fields__))
+
+    def subset(self, index: np.ndarray) -> Sightings:
+        return Sightings(*(getattr(self, k)[index] for k in self.__dataclass_fields__))
+
+
+def trace(caster: RayCaster, origin: np.ndarray, direction: np.ndarray) -> tuple[Sightings, Hits]:
+    """Trace viewer rays; the sightings of the rays that hit, and all the hits."""
+    hits = caster.intersect(origin, direction)
+    hit = hits.hit
+    point = origin[hit] + direction[hit] * hits.distance[hit, None]
+    return Sightings(hits.face[hit], hits.side[hit], origin[hit], direction[hit], point), hits
+
+
+def random_seeds(
+    caster: RayCaster,
+    region: Region,
+    faces: np.ndarray,
+    rng: np.random.Generator,
+    want: np.ndarray | None = None,
+) -> tuple[Sightings, int]:
+    """One random seed ray per entry of ``faces`` (repeat a face for more rays).
+
+    Parameters
+    ----------
+    want : (n,) int8, optional
+        The side each seed should look at (-1: either); seeds whose random viewer is on the
+        other side are dropped before tracing.
+
+    Returns
+    -------
+    Sightings
+        The seeds whose segment from the face to the viewer is free.
+    rays : int
+        Seeds traced.
+    """
+    points = uniform_in_triangles(caster.soup.triangles[faces], rng)
+    origin, direction = region.seed_viewers(points, rng)
+    side = (np.einsum("ij,ij->i", direction, caster.normals[faces]) >= 0).astype(np.int8)
+    if want is not None:
+        keep = (want < 0) | (want == side)
+        faces, side, points, origin, direction = (x[keep] for x in (faces, side, points, origin, direction))
+    blocked = caster.occluded(caster.push_off(points, faces, side), origin)
+    free = ~blocked
+    return Sightings(faces[free], side[free], origin[free], direction[free], points[free]), len(faces)
+
+
+def border_band(caster: RayCaster, region: Region, seen: Sightings) -> np.ndarray:
+    """(k, 9, 3) points of the band around each seen face, in order around it.
+
+    For corner i the three points lie across edge (i-1, i), on the bisector, and across
+    edge (i, i+1), each pushed out in the plane perpendicular to the viewing ray.
+    """
+    tri = caster.soup.triangles[seen.face]  # (k, 3, 3)
+    if region.at_infinity:
+        view = np.broadcast_to(seen.direction[:, None, :], tri.shape)
+        width = np.full((len(tri), 3), ENLARGE * caster.diagonal)
+    else:
+        view = tri - seen.origin[:, None, :]
+        dist = np.linalg.norm(view, axis=2)
+        view = view / np.maximum(dist, 1e-300)[:, :, None]
+        width = np.maximum(ENLARGE * dist, 0.05 * ENLARGE * caster.diagonal)
+    nxt, prv, opp = np.roll(tri, -1, axis=1), np.roll(tri, 1, axis=1), np.roll(tri, -2, axis=1)
+    across_next = _outward(np.cross(view, nxt - tri), opp - tri)
+    across_prev = _outward(np.cross(view, tri - prv), nxt - tri)
+    bisector = across_prev + across_next
+    radial = tri - tri.mean(axis=1, keepdims=True)
+    radial -= view * np.einsum("kij,kij->ki", radial, view)[:, :, None]
+    weak = np.linalg.norm(bisector, axis=2) < 0.5  # sliver corner: the two normals nearly cancel
+    bisector[weak] = radial[weak]
+    bisector = _unit(bisector)
+    band = np.stack([across_prev, bisector, across_next], axis=2) * width[:, :, None, None]
+    return (tri[:, :, None, :] + band).reshape(len(tri), 9, 3)
+
+
+def _unit(v: np.ndarray) -> np.ndarray:
+    n = np.linalg.norm(v, axis=-1, keepdims=True)
+    return v / np.where(n > 0, n, 1.0)
+
+
+def _outward(normal: np.ndarray, towards_inside: np.ndarray) -> np.ndarray:
+    n = _unit(normal)
+    flip = np.einsum("kij,kij->ki", n, towards_inside) > 0
+    return np.where(flip[:, :, None], -n, n)
+
+
+def border_sampling(caster: RayCaster, region: Region, seen: Sightings) -> tuple[Sightings, Sightings, int]:
+    """Adaptive border sampling around every face of ``seen`` from its own viewer.
+
+    Returns
+    -------
+    band : Sightings
+        First hits of every band ray.
+    parent : Sightings
+        For each entry of ``band``, the sighting it was grown from.
+    rays : int
+        Rays traced.
+    """
+    k = len(seen.face)
+    targets = border_band(caster, region, seen)  # (k, 9, 3)
+    owner = np.repeat(np.arange(k), 9)
+    flat = targets.reshape(-1, 3)
+    face, found, rays = _cast_targets(caster, region, seen, owner, flat)
+    collected = [found]
+    # band edges (point j -> point j+1, closed), halved while their ends see different faces
+    ends = face.reshape(k, 9)
+    a_pt, b_pt = targets, np.roll(targets, -1, axis=1)
+    a_f, b_f = ends, np.roll(ends, -1, axis=1)
+    seg_owner = np.repeat(np.arange(k), 9)
+    a_pt, b_pt, a_f, b_f = (x.reshape(len(seg_owner), *x.shape[2:]) for x in (a_pt, b_pt, a_f, b_f))
+    min_len = MIN_SEGMENT * caster.diagonal
+    for _ in range(MAX_DEPTH):
+        split = (a_f != b_f) & (np.linalg.norm(b_pt - a_pt, axis=1) > min_len)
+        if not split.any():
+            break
+        seg_owner, a_pt, b_pt, a_f, b_f = (x[split] for x in (seg_owner, a_pt, b_pt, a_f, b_f))
+        mid = 0.5 * (a_pt + b_pt)
+        m_f, found, n = _cast_targets(caster, region, seen, seg_owner, mid)
+        collected.append(found)
+        rays += n
+        seg_owner = np.concatenate([seg_owner, seg_owner])
+        a_pt, b_pt = np.concatenate([a_pt, mid]), np.concatenate([mid, b_pt])
+        a_f, b_f = np.concatenate([a_f, m_f]), np.concatenate([m_f, b_f])
+    band = Sightings.concat([c[0] for c in collected])
+    parent = seen.subset(np.concatenate([c[1] for c in collected]))
+    return band, parent, rays
+
+
+def _cast_targets(caster, region, seen: Sightings, owner: np.ndarray, targets: np.ndarray):
+    """Rays from the viewers of ``seen[owner]`` to ``targets``: hit face per ray (-1 miss),
+    the sightings with their owners, and the ray count."""
+    origin, direction = region.border_origins(seen.origin[owner], seen.direction[owner], targets)
+    origin = np.broadcast_to(origin, targets.shape).copy()
+    found, hits = trace(caster, origin, direction)
+    return hits.face, (found, owner[hits.hit]), len(targets)
+
+
+def reverse_sampling(
+    caster: RayCaster, region: Region, band: Sightings, parent: Sightings
+) -> tuple[Sightings, int, int]:
+    """Reverse-sampling rays for the band rays stopped well before their face's plane.
+
+    Returns
+    -------
+    Sightings
+        First hits of the mutated rays.
+    rays : int
+        Rays traced.
+    refused : int
+        Mutated rays dropped because no viewer of the region lies on their line.
+    """
+    soup = caster.soup
+    # only rays that ended on another face can have met an occluder
+    idx = np.flatnonzero(band.face != parent.face)
+    n_t = caster.normals[parent.face[idx]]
+    v0 = soup.triangles[parent.face[idx], 0]
+    o, d = band.origin[idx], band.direction[idx]
+    denom = np.einsum("ij,ij->i", d, n_t)
+    steep = np.abs(denom) > 1e-6
+    t_pred = np.full(len(idx), -np.inf)
+    t_pred[steep] = np.einsum("ij,ij->i", v0[steep] - o[steep], n_t[steep]) / denom[steep]
+    t_hit = np.einsum("ij,ij->i", band.point[idx] - o, d)
+    jump = t_pred - t_hit > DISCONTINUITY * caster.diagonal
+    if not jump.any():
+        return Sightings.empty(), 0, 0
+    t_pred, idx = t_pred[jump], idx[jump]
+    hx, old, o, d = band.point[idx], parent.point[idx], band.origin[idx], band.direction[idx]
+    predicted = o + d * t_pred[:, None]
+    if region.at_infinity:
+        plane = np.cross(d, old - hx)
+    else:
+        plane = np.cross(hx - o, old - o)
+    plane = _unit(plane)
+    usable = np.linalg.norm(plane, axis=1) > 0
+    tri = soup.triangles[band.face[idx]]  # the occluder
+    s = np.einsum("kij,kj->ki", tri - hx[:, None, :], plane)
+    s_next = np.roll(s, -1, axis=1)
+    cross = (s * s_next < 0) & usable[:, None]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        frac = np.where(cross, s / (s - s_next), 0.0)
+    edge_point = tri + (np.roll(tri, -1, axis=1) - tri) * frac[:, :, None]  # (k, 3, 3)
+    step = _unit(edge_point - hx[:, None, :]) * (PASS_BY * caster.diagonal)
+    beside = (edge_point + step)[cross]
+    target = np.repeat(predicted, 3, axis=0).reshape(-1, 3, 3)[cross]
+    direction = _unit(target - beside)
+    ok_dir = np.linalg.norm(direction, axis=1) > 0
+    origin, ok = region.origin_on_line(beside, direction)
+    ok &= ok_dir
+    if not ok.any():
+        return Sightings.empty(), 0, int((~ok).sum())
+    found, _ = trace(caster, origin[ok], direction[ok])
+    return found, int(ok.sum()), int((~ok).sum())

@@ -1,0 +1,352 @@
+"""From-region visibility: which face sides can a viewer in a region see (DESIGN.md §9).
+
+:func:`visible_from` runs rounds.  Each round gives every face that is not seen yet a few
+random seed rays (more per face in every round); ``method="guided"`` then propagates every
+new sighting by adaptive border sampling and reverse sampling (GVS §3.4) until no new face
+turns up, ``method="random"`` does not (the baseline).  The first round visits the faces in
+a random order in chunks, so that faces found by propagation from an earlier chunk need no
+seed rays at all.  It stops when a round finds fewer than ``min_new`` new faces per million
+rays (GVS §3.5, judged over at least a million rays), when every face is seen, or at the ray budget.
+
+A seen side is certain (a free line of sight was traced); an unseen one is an upper bound on
+"hidden".
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from meshvis.errors import ParameterError
+from meshvis.io import as_soup
+from meshvis.rays.caster import RayCaster
+from meshvis.visibility.regions import Region, parse_region
+from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling
+
+#: seed rays per unseen face in successive rounds
+SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
+#: the first round visits the faces in this many chunks (propagation runs after each)
+FIRST_ROUND_CHUNKS = 16
+#: default stop rule: fewer new faces than this per million rays in a round (GVS §3.5 uses 50)
+MIN_NEW_PER_MILLION = 50.0
+#: the stop rule is judged over at least this many rays (GVS counts new faces per million
+#: rays) or, on small models, this many rays per face, whichever is fewer
+STOP_WINDOW = 1_000_000
+STOP_WINDOW_PER_FACE = 64
+#: default budget: rays per face of the model, and at least this many rays (small models are
+#: cheap, and faces seen through rare gaps need rays whatever the model's size)
+DEFAULT_RAYS_PER_FACE = 128
+DEFAULT_MIN_BUDGET = 1 << 22
+#: push of seed origins off their face, as a fraction of the diagonal (as the reference)
+ORIGIN_OFFSET = 1e-6
+#: sightings propagated in one batch (bounded memory: ~100 rays each)
+PROPAGATE_BATCH = 1 << 15
+METHODS = ("guided", "random")
+
+
+@dataclass
+class Visibility:
+    """Result of :func:`visible_from`.
+
+    Attributes
+    ----------
+    seen_side : (m, 2) bool
+        Per input face and side (0 front, 1 back): a ray from the region saw it.
+    rays_seen : (m, 2) int64
+        Rays that saw each side.
+    seed_rays : (m,) int64
+        Random seed rays aimed at each face.
+    area : (m,) float64
+        Face areas.
+    first_seen : (m,) int64
+        Rays cast up to the end of the batch that first saw the face (-1: never seen); the faces
+        seen with at most ``r`` rays are ``(first_seen >= 0) & (first_seen <= r)``.
+    history : dict of lists
+        ``rays``, ``visible_area``, ``faces_seen``, ``seconds`` after every batch: the
+        visible area found against rays cast.
+    rays : dict
+        Rays traced per strategy (``random``, ``border``, ``reverse``) and in total.
+    skipped : dict
+        Faces that got no rays, by reason, and mutated rays refused by the region.
+    region : Region
+    method : str
+    seed : int
+    seconds : float
+    stopped : str
+        Why sampling stopped: ``"all seen"``, ``"few new faces"``, ``"budget"``, ``"rounds done"``.
+    """
+
+    seen_side: np.ndarray
+    rays_seen: np.ndarray
+    seed_rays: np.ndarray
+    area: np.ndarray
+    first_seen: np.ndarray
+    history: dict
+    rays: dict
+    skipped: dict
+    region: Region
+    method: str
+    seed: int
+    seconds: float
+    stopped: str = ""
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def seen(self) -> np.ndarray:
+        """(m,) bool: some side of the face was seen."""
+        return np.asarray(self.seen_side.any(axis=1))
+
+    @property
+    def visible_area(self) -> float:
+        return float(self.area[self.seen].sum())
+
+    def report(self, per_face: bool = True) -> dict:
+        """JSON-ready summary (and per-face arrays when ``per_face``)."""
+        total = max(float(self.area.sum()), 1e-300)
+        d = {
+            "region": self.region.describe(),
+            "method": self.method,
+            "seed": self.seed,
+            "faces": int(len(self.area)),
+            "seen_faces": int(self.seen.sum()),
+            "seen_area_fraction": self.visible_area / total,
+            "rays": self.rays,
+            "skipped": self.skipped,
+            "stopped": self.stopped,
+            "seconds": self.seconds,
+            "history": self.history,
+        }
+        if per_face:
+            d["per_face"] = {
+                "seen_front": self.seen_side[:, 0],
+                "seen_back": self.seen_side[:, 1],
+                "rays_seen_front": self.rays_seen[:, 0],
+                "rays_seen_back": self.rays_seen[:, 1],
+                "seed_rays": self.seed_rays,
+            }
+        return d
+
+
+class _State:
+    """What the sampling loop accumulates."""
+
+    def __init__(self, soup, budget: int, min_new: float):
+        m = soup.n_faces
+        self.min_new = float(min_new)
+        self.area = soup.areas
+        self.seen_side = np.zeros((m, 2), bool)
+        self.rays_seen = np.zeros((m, 2), np.int64)
+        self.seed_rays = np.zeros(m, np.int64)
+        self.first_seen = np.full(m, -1, np.int64)
+        self.rays = {"random": 0, "border": 0, "reverse": 0}
+        self.refused = 0
+        self.budget = budget
+        self.history: dict[str, list] = {"rays": [], "visible_area": [], "faces_seen": [], "seconds": []}
+        self.start = time.perf_counter()
+
+    @property
+    def cast(self) -> int:
+        return sum(self.rays.values())
+
+    @property
+    def left(self) -> int:
+        return self.budget - self.cast
+
+    def record(self, s: Sightings) -> Sightings:
+        """Count the sightings; return the first sighting of each face seen for the first time."""
+        if len(s.face) == 0:
+            return s
+        seen_before = np.asarray(self.seen_side.any(axis=1))
+        np.add.at(self.rays_seen, (s.face, s.side.astype(np.int64)), 1)
+        self.seen_side[s.face, s.side] = True
+        fresh = ~seen_before[s.face]
+        _, first = np.unique(s.face[fresh], return_index=True)
+        new = s.subset(np.flatnonzero(fresh)[first])
+        self.first_seen[new.face] = self.cast
+        return new
+
+    def snapshot(self) -> None:
+        seen = self.seen_side.any(axis=1)
+        h = self.history
+        h["rays"].append(self.cast)
+        h["visible_area"].append(float(self.area[seen].sum()))
+        h["faces_seen"].append(int(seen.sum()))
+        h["seconds"].append(time.perf_counter() - self.start)
+
+
+def visible_from(
+    model,
+    region: str | Region = "outside",
+    *,
+    budget: int | None = None,
+    seed: int = 0,
+    method: str = "guided",
+    up=(0.0, 0.0, 1.0),
+    per_side: bool = False,
+    faces: np.ndarray | None = None,
+    min_new: float = MIN_NEW_PER_MILLION,
+    caster: RayCaster | None = None,
+) -> Visibility:
+    """Which sides of the model's faces a viewer in ``region`` can see.
+
+    Parameters
+    ----------
+    model : Soup or anything :func:`meshvis.io.as_soup` accepts
+    region : str or Region
+        Where viewers may be (see :func:`meshvis.visibility.regions.parse_region`):
+        ``"outside"``, ``"upper-hemisphere"``, ``"box:x0,y0,z0,x1,y1,z1"``,
+        ``"points:x,y,z;..."``, ``"path:FILE.json"``.
+    budget : int, optional
+        Most rays to trace (default ``128 x`` the number of faces, at least 2**22).
+    seed : int
+        Seed of the one random generator; same model, region and seed give the same result.
+    method : {"guided", "random"}
+        GVS guided sampling, or plain random sampling (the baseline).
+    up : (3,) float
+        Up direction of ``"upper-hemisphere"`` when the region text gives none.
+    per_side : bool
+        Keep seeding a face until both of its sides are seen (for orientation); by default a
+        face gets no more seed rays once either side is seen (enough to know it is visible,
+        and much cheaper: most faces have one hidden side).
+    faces : (k,) int or (m,) bool, optional
+        Only these faces get seed rays (the question is about them); propagation still
+        records every face it meets.  Default: all faces.
+    min_new : float
+        Stop after a round that finds fewer new faces than this per million rays.
+    caster : RayCaster, optional
+        A caster of the same model to reuse (its offset is not changed).
+
+    Returns
+    -------
+    Visibility
+
+    Raises
+    ------
+    ParameterError
+        Unknown method or region, negative budget.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> vis = visible_from(trimesh.creation.box(), seed=0)
+    >>> vis.seen_side[:, 0].all(), vis.seen_side[:, 1].any()
+    (True, False)
+    """
+    if method not in METHODS:
+        raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    soup = as_soup(model)
+    region = parse_region(region, up=up).bind(soup)
+    budget = max(DEFAULT_RAYS_PER_FACE * soup.n_faces, DEFAULT_MIN_BUDGET) if budget is None else int(budget)
+    if budget < 0:
+        raise ParameterError(f"budget must be at least 0, got {budget}")
+    caster = caster or RayCaster(soup, offset=ORIGIN_OFFSET)
+    rng = np.random.default_rng(seed)
+    state = _State(soup, budget, min_new)
+    asked = np.ones(soup.n_faces, bool)
+    if faces is not None:
+        faces = np.asarray(faces)
+        asked = faces.astype(bool) if faces.dtype == bool else np.isin(np.arange(soup.n_faces), faces)
+        if asked.shape != (soup.n_faces,):
+            raise ParameterError(f"faces must be {soup.n_faces} booleans or face indices")
+    skipped = _presee(state, soup, region)
+    if faces is not None:
+        skipped["not asked about (no seed rays)"] = int((~asked).sum())
+    stopped = _run_rounds(state, caster, region, rng, method == "guided", per_side, asked)
+    skipped.update(
+        {
+            "seen before any seed ray (found by propagation)": int(
+                (state.seen_side.any(axis=1) & (state.seed_rays == 0) & asked).sum()
+            )
+            - skipped.get("inside the region (seen without rays)", 0),
+            "mutated rays refused (no viewer of the region on their line)": state.refused,
+        }
+    )
+    return Visibility(
+        seen_side=state.seen_side,
+        rays_seen=state.rays_seen,
+        seed_rays=state.seed_rays,
+        area=soup.areas.copy(),
+        first_seen=state.first_seen,
+        history=state.history,
+        rays={**state.rays, "total": state.cast},
+        skipped=skipped,
+        region=region,
+        method=method,
+        seed=int(seed),
+        seconds=time.perf_counter() - state.start,
+        stopped=stopped,
+    )
+
+
+def _presee(state: _State, soup, region: Region) -> dict:
+    """Faces that need no rays: zero area (nothing to see), inside the region (seen)."""
+    skipped = {"zero area": int((soup.areas <= 0).sum())}
+    inside = region.contains_faces(soup.triangles)
+    if inside.any():
+        state.seen_side[inside] = True
+        state.first_seen[inside] = 0
+        skipped["inside the region (seen without rays)"] = int(inside.sum())
+    return skipped
+
+
+def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool, asked: np.ndarray) -> str:
+    m = len(state.area)
+    usable = (state.area > 0) & asked
+
+    def unseen(faces):
+        s = state.seen_side[faces]
+        return ~s.all(axis=1) if per_side else ~s.any(axis=1)
+
+    def n_found() -> int:
+        return int(state.seen_side.sum() if per_side else state.seen_side.any(axis=1).sum())
+
+    window_found, window_rays = n_found(), state.cast
+    for r, per_face in enumerate(SEED_ROUNDS):
+        order = rng.permutation(m) if r == 0 else np.arange(m)
+        chunks = np.array_split(order, FIRST_ROUND_CHUNKS if (r == 0 and guided) else 1)
+        for chunk in chunks:
+            todo = chunk[usable[chunk] & unseen(chunk)]
+            if len(todo) == 0:
+                continue
+            todo = todo[: max(0, state.left // per_face)]
+            if len(todo) == 0:
+                return "budget"
+            todo = np.sort(todo)
+            faces = np.repeat(todo, per_face)
+            # the side still to find: -1 (either) unless exactly one side is seen already
+            one = state.seen_side[faces]
+            want = np.where(one.any(axis=1), np.argmin(one, axis=1), -1).astype(np.int8) if per_side else None
+            found, n_traced = random_seeds(caster, region, faces, rng, want)
+            state.rays["random"] += n_traced
+            state.seed_rays[todo] += per_face
+            fresh = state.record(found)
+            state.snapshot()
+            if guided:
+                _propagate(state, caster, region, fresh)
+        if not (usable & unseen(np.arange(m))).any():
+            return "all seen"
+        if state.left <= 0:
+            return "budget"
+        if state.cast - window_rays >= min(STOP_WINDOW, STOP_WINDOW_PER_FACE * m):
+            if (n_found() - window_found) * 1e6 < state.min_new * (state.cast - window_rays):
+                return "few new faces"
+            window_found, window_rays = n_found(), state.cast
+    return "rounds done"
+
+
+def _propagate(state: _State, caster, region, fresh: Sightings) -> None:
+    """Border and reverse sampling from every new sighting, until nothing new turns up."""
+    queue = fresh
+    while len(queue.face) and state.left > 0:
+        batch = queue.subset(np.arange(min(len(queue.face), PROPAGATE_BATCH, max(1, state.left // 64))))
+        rest = queue.subset(np.arange(len(batch.face), len(queue.face)))
+        band, parent, n_band = border_sampling(caster, region, batch)
+        state.rays["border"] += n_band
+        mutated, n_rev, refused = reverse_sampling(caster, region, band, parent)
+        state.rays["reverse"] += n_rev
+        state.refused += refused
+        new = state.record(Sightings.concat([band, mutated]))
+        state.snapshot()
+        queue = Sightings.concat([rest, new])

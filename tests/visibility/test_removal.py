@@ -1,0 +1,101 @@
+"""Inside removal by sight: visibility object | view | both, levels, kept borders, reasons."""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+from meshvis.cli.main import main
+from meshvis.errors import ParameterError
+from meshvis.io import load, save
+from meshvis.repair.remove import REASONS, remove_interior
+
+
+def test_view_removes_exactly_the_sealed_pocket(scenes):
+    soup, bottom, truth = scenes.sealed_pocket()
+    r = remove_interior(soup, visibility="view", seed=0, budget=100_000)
+    np.testing.assert_array_equal(r.keep, truth.any(axis=1))
+    assert r.classification is None and r.removed.n_faces == len(bottom)
+    assert set(r.reason) == {"kept: seen from the region", "removed: not seen from the region"}
+
+
+def test_both_keeps_a_large_triangle_passing_into_a_closed_box(scenes):
+    soup, truth = scenes.pierced_box()
+    r = remove_interior(soup, visibility="both", seed=0, budget=100_000)
+    assert r.keep[12]  # the triangle shows a tip outside the box
+    assert r.keep.all()  # the box itself is all outside
+    obj = remove_interior(soup, visibility="object", seed=0)
+    assert not (r.keep < obj.keep).any()  # both never removes what object keeps
+
+
+def test_object_mode_is_the_default_result_unchanged(scenes):
+    soup, _, _ = scenes.slot_box()
+    a = remove_interior(soup, seed=0)
+    b = remove_interior(soup, seed=0, visibility="object")
+    np.testing.assert_array_equal(a.keep, b.keep)
+    assert a.mode == "object" and a.visibility is None
+
+
+def test_part_level_keeps_a_part_with_one_seen_face(scenes):
+    soup, bottom, truth = scenes.sealed_pocket()
+    by_face = remove_interior(soup, visibility="view", seed=0, budget=100_000)
+    by_part = remove_interior(soup, visibility="view", level="part", seed=0, budget=100_000)
+    assert by_face.removed.n_faces == 2 and by_part.removed.n_faces == 0
+    assert by_part.reason[bottom[0]] == "kept: its patch or part has a face that is kept"
+
+
+def test_patch_level_and_keep_border(scenes):
+    cube, names = scenes.unit_cube()
+    # viewers at one point in front of +x see only that face; the rest is one welded patch
+    r = remove_interior(cube, visibility="view", region="points:5,0,0", seed=0, budget=20_000)
+    assert r.keep.sum() == 2
+    assert remove_interior(cube, visibility="view", region="points:5,0,0", level="patch", seed=0).keep.all()
+    ring = remove_interior(cube, visibility="view", region="points:5,0,0", keep_border=1, seed=0)
+    # one ring: each of the 4 edges of the +x square borders one triangle of a side face
+    assert ring.keep.sum() == 6 and not ring.keep[names == "-x"].any()
+    two = remove_interior(cube, visibility="view", region="points:5,0,0", keep_border=2, seed=0)
+    assert two.keep.sum() > 6
+    assert "kept: next to a kept face (keep_border)" in ring.reason
+
+
+def test_bad_removal_arguments(scenes):
+    cube, _ = scenes.unit_cube()
+    for kw in ({"visibility": "sight"}, {"level": "object"}, {"keep_border": -1}):
+        with pytest.raises(ParameterError):
+            remove_interior(cube, **kw)
+    assert len(REASONS) == 8
+
+
+def test_cli_flags_of_remove_interior_and_visible(scenes, tmp_path, capsys):
+    soup, bottom, truth = scenes.sealed_pocket()
+    src = tmp_path / "pocket.obj"
+    save(soup, str(src))
+    out, rep = tmp_path / "kept.obj", tmp_path / "r.json"
+    argv = ["remove-interior", str(src), "-o", str(out), "--report", str(rep), "-q", "--visibility", "view"]
+    assert main(argv + ["--from", "outside", "--level", "face", "--keep-border", "0"]) == 0
+    report = json.loads(rep.read_text())
+    assert report["visibility"] == "view" and report["removed_faces"] == 2
+    assert len(report["per_face"]["reason"]) == soup.n_faces
+    assert load(str(out)).n_faces == soup.n_faces - 2
+    assert main(argv + ["--level", "part", "--force"]) == 0
+    assert json.loads(rep.read_text())["removed_faces"] == 0
+    assert main(argv + ["--from", "box:1,2", "--force"]) == 2
+    assert "expected 6 comma-separated numbers" in capsys.readouterr().err
+    vis_rep, png = tmp_path / "v.json", tmp_path / "v.png"
+    assert (
+        main(
+            ["visible", str(src), "--report", str(vis_rep), "--preview", str(png), "-q", "--budget", "50000"]
+        )
+        == 0
+    )
+    v = json.loads(vis_rep.read_text())
+    seen = np.array(v["per_face"]["seen_front"]) | np.array(v["per_face"]["seen_back"])
+    np.testing.assert_array_equal(seen, truth.any(axis=1))
+    assert png.stat().st_size > 1000
+    assert (
+        main(["visible", str(src), "--from", "upper-hemisphere", "--up", "z", "--method", "random", "-q"])
+        == 0
+    )
+    assert main(["visible", str(src), "--from", "nowhere", "-q"]) == 2
