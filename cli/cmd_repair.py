@@ -30,7 +30,8 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
         "--up",
         choices=("auto", "x", "y", "z"),
         default="auto",
-        help="the model's up axis in the preview (default auto: y for glTF/GLB and OBJ, z otherwise)",
+        help="the model's up axis, for the preview and the upper-hemisphere region "
+        "(default auto: y for glTF/GLB and OBJ, z otherwise)",
     )
     algorithm_options(p)
     p.add_argument(
@@ -146,12 +147,6 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         default=d["keep_border"],
         metavar="N",
         help="keep N rings of hidden faces next to kept ones (default 0)",
-    )
-    p.add_argument(
-        "--up",
-        choices=("auto", "x", "y", "z"),
-        default=d["up"],
-        help="up axis of upper-hemisphere (auto: y for glTF, z otherwise)",
     )
 
 

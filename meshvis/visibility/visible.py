@@ -231,7 +231,7 @@ def visible_from(
     --------
     >>> import trimesh
     >>> vis = visible_from(trimesh.creation.box(), seed=0)
-    >>> vis.seen_side[:, 0].all(), vis.seen_side[:, 1].any()
+    >>> bool(vis.seen_side[:, 0].all()), bool(vis.seen_side[:, 1].any())
     (True, False)
     """
     if method not in METHODS:

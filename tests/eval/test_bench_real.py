@@ -3,17 +3,19 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import pytest
 
 from meshvis.cli.main import main
-from meshvis.eval.generators import real_models_dir
+
+REAL = Path(__file__).resolve().parents[3] / "shared" / "models" / "real"
 
 
-@pytest.mark.skipif(not (real_models_dir() / "nested.glb").is_file(), reason="shared real models not present")
+@pytest.mark.skipif(not (REAL / "nested.glb").is_file(), reason="shared real models not present")
 def test_bench_real_judges_every_method_on_a_small_model(tmp_path, capsys):
     out, curve = tmp_path / "r.json", tmp_path / "c.png"
-    argv = ["bench", "real", "--models", str(real_models_dir() / "nested.glb"), "--cache", str(tmp_path)]
+    argv = ["bench", "real", "--only", str(REAL / "nested.glb"), "--cache", str(tmp_path)]
     argv += ["--views", "16", "--size", "64"]
     assert main(argv + ["--json", str(out), "--curve", str(curve), "--worst", str(tmp_path / "w")]) == 0
     r = json.loads(out.read_text())["results"][0]

@@ -12,6 +12,7 @@ import resource
 import struct
 import subprocess
 import sys
+import tempfile
 import time
 import zipfile
 
@@ -59,6 +60,7 @@ def _limited_run(argv: list[str], gigabytes: float = 3.0) -> subprocess.Complete
         text=True,
         preexec_fn=limit,
         timeout=120,
+        cwd=tempfile.gettempdir(),  # the installed package, not a meshvis/ folder in the working one
     )
 
 

@@ -11,6 +11,7 @@ import os
 import signal
 import subprocess
 import sys
+import tempfile
 import time
 
 import numpy as np
@@ -21,8 +22,9 @@ import meshvis.io as mio
 import meshvis.io.mtl as mtl_module
 from meshvis.cli.main import main
 
-ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
-ENV = dict(os.environ, PYTHONPATH=ROOT + os.pathsep + os.environ.get("PYTHONPATH", ""))
+#: child commands run from the temporary folder: the installed package, not a meshvis/ folder
+#: in the working one
+CWD = tempfile.gettempdir()
 
 
 def _png() -> bytes:
@@ -160,7 +162,8 @@ def test_sigterm_to_a_running_command(tmp_path):
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,
-        env=dict(ENV, PYTHONUNBUFFERED="1"),  # the first line arrives when printed
+        env=dict(os.environ, PYTHONUNBUFFERED="1"),  # the first line arrives when printed
+        cwd=CWD,
     )
     try:
         first = proc.stdout.readline()
@@ -197,7 +200,7 @@ def test_a_fifo_named_like_a_model_is_refused_not_waited_for(tmp_path, capsys):
         ],
         capture_output=True,
         text=True,
-        env=ENV,
+        cwd=CWD,
         timeout=120,
     )
     assert r.returncode == 1 and "is not a regular file" in r.stdout

@@ -65,10 +65,14 @@ _SOURCE_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(o
 
 
 def default_model() -> tuple[Any, str]:
-    """The project's engine-like assembly (``models/assembly.obj`` of the source tree, else the generator)."""
-    path = os.path.join(_SOURCE_ROOT, "models", "assembly.obj")
-    if os.path.exists(path):
-        return load_models(path), path
+    """The project's engine-like assembly: ``models/assembly.obj`` of the current folder (the
+    repository root) or of the source tree, else the generator that made it."""
+    for path in (
+        os.path.join("models", "assembly.obj"),
+        os.path.join(_SOURCE_ROOT, "models", "assembly.obj"),
+    ):
+        if os.path.exists(path):
+            return load_models(path), path
     from meshvis.eval.generators import assembly
 
     return assembly().soup, "meshvis.eval.generators.assembly()"

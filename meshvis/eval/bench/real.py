@@ -19,8 +19,8 @@ from pathlib import Path
 import numpy as np
 
 from meshvis.eval.baselines import pymeshlab_ao
+from meshvis.eval.bench.real_models import add_models_argument, models_folder
 from meshvis.eval.false_pixels import SIZE, VIEWS, face_pixels, false_pixels, fibonacci_sphere
-from meshvis.eval.generators import real_models_dir
 from meshvis.eval.reference import reference
 from meshvis.graphcut.classify import classify
 from meshvis.io import load
@@ -52,7 +52,13 @@ CURVE_RANDOM_FACTOR = 4
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
-    p.add_argument("--models", nargs="*", help="model files (default: the real scenes with hidden geometry)")
+    p.add_argument(
+        "--only",
+        nargs="*",
+        metavar="MODEL",
+        help="model files or names (default: the real scenes with hidden geometry)",
+    )
+    add_models_argument(p)
     p.add_argument("--quick", action="store_true", help="four small models only")
     p.add_argument("--seed", type=int, default=0)
     p.add_argument(
@@ -98,11 +104,11 @@ def main(args: argparse.Namespace) -> int:
 
 
 def _selection(args) -> list[tuple[str, str, bool]]:
-    folder = Path(real_models_dir()).parent
+    folder = models_folder(args.models_dir).parent
     known = {name: (up, ground) for name, up, ground in MODELS}
-    if args.models:
+    if args.only:
         out = []
-        for m in args.models:
+        for m in args.only:
             name = next((k for k in known if k.endswith(os.path.basename(m))), None)
             up, ground = known.get(name, ("z", False))
             out.append((m if os.path.isfile(m) else str(folder / m), up, ground))
