@@ -120,6 +120,7 @@ class Classification:
 
     @property
     def n_rays(self) -> int:
+        """Rays cast in all: node rays, reverse (confirmation) rays and hint rays."""
         return int(self.counts.rays + self.counts.reverse_rays + self.params.get("hint_rays", 0))
 
     def report(self, per_face: bool = True) -> dict:

@@ -154,6 +154,7 @@ class VisibilityGraph:
 
     @property
     def n_edges(self) -> int:
+        """Number of node-node edges of the graph."""
         return len(self.weights.edges_i)
 
     def cut(self, solver: str = "pymaxflow", tie_to_source: np.ndarray | None = None) -> Cut:

@@ -98,8 +98,11 @@ def _instances(doc: dict) -> list[tuple[int, np.ndarray]]:
 # ---------------------------------------------------------------------------- checks
 # (before trimesh sees the file: what it may read, how far it may expand, what must index what)
 def check_document(doc: dict, path: str, label: str) -> None:
-    """Refuse a glTF document that reads outside its folder, expands past the caps of
-    :mod:`meshvis.limits`, or whose accessors point at nothing (raises :class:`ModelFormatError`)."""
+    """Refuse a glTF document that is unsafe or broken (raises :class:`ModelFormatError`).
+
+    Unsafe: it reads outside its folder or expands past the caps of :mod:`meshvis.limits`;
+    broken: its accessors point at nothing.
+    """
     _check_uris(doc, path, label)
     _check_accessors(doc, label)
     _check_node_graph(doc, label)
@@ -169,8 +172,10 @@ def _check_accessors(doc: dict, label: str) -> None:
 
 
 def _check_node_graph(doc: dict, label: str) -> None:
-    """Count node instances and instanced triangles by the paths through the node graph
-    (memoised, so a graph that doubles at every level is counted in linear time)."""
+    """Count node instances and instanced triangles by the paths through the node graph.
+
+    Memoised, so a graph that doubles at every level is counted in linear time.
+    """
     from meshvis import limits
 
     nodes, meshes, accessors = (_list(doc, k, label) for k in ("nodes", "meshes", "accessors"))
@@ -443,7 +448,7 @@ def write_gltf(
 
 
 def _materials(soup: Soup, buf: _Buffer) -> tuple[list, list, list]:
-    """glTF materials, images and textures of the soup's materials (images into ``buf``)."""
+    """GlTF materials, images and textures of the soup's materials (images into ``buf``)."""
     mat_names = unique_names([m.name for m in soup.materials], "material")
     gl_materials, images, textures = [], [], []
     image_cache: dict[bytes, int] = {}

@@ -94,8 +94,10 @@ class MtlSource:
         return out
 
     def texture_path(self, fname: str, warn: bool = True) -> str | None:
-        """The file of texture ``fname``, or None (with a :class:`TextureWarning`) when it is
-        outside the model's folder or missing."""
+        """The file of texture ``fname``, or None.
+
+        None (with a :class:`TextureWarning`) when it is outside the model's folder or missing.
+        """
         root = self.root if self.root is not None else self.folder
         full = os.path.normpath(os.path.join(self.folder, fname))
         who = f"{self.label}: " if self.label else ""

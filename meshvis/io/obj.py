@@ -1,4 +1,4 @@
-"""Wavefront OBJ (+ MTL) reader and writer.
+r"""Wavefront OBJ (+ MTL) reader and writer.
 
 The reader keeps what trimesh's loader loses: the file's face order, the polygon each
 triangle came from, parts from ``o``/``g``, materials from ``usemtl`` (with the MTL text,
@@ -220,7 +220,7 @@ def read_obj(path: str, label: str | None = None) -> Soup:
 
 
 def _read_lines(path: str, label: str) -> list[str]:
-    """The file's text lines (UTF-8 or Latin-1, ``\\`` continuations joined)."""
+    r"""The file's text lines (UTF-8 or Latin-1, ``\\`` continuations joined)."""
     with open(path, "rb") as fh:
         data = fh.read()
     if b"\x00" in data[:65536]:

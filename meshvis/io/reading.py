@@ -1,5 +1,7 @@
-"""Reading models: :func:`load` checks the path, recognises the format, dispatches to the
-format's reader and turns every failure into a one-line :class:`~meshvis.errors.ModelError`.
+"""Reading models.
+
+:func:`load` checks the path, recognises the format, dispatches to the format's reader and
+turns every failure into a one-line :class:`~meshvis.errors.ModelError`.
 
 Each format module declares what it reads in a ``READERS`` mapping (format name ->
 ``reader(path, label) -> Soup``); this module collects them, so formats never import it.
@@ -182,9 +184,11 @@ def _read(fmt: str, path: str, label: str) -> Soup:
 
 
 def check_zip(path: str, label: str) -> None:
-    """Refuse a zip archive with more entries or more inflated bytes than the caps of
-    :mod:`meshvis.limits` (the sizes its directory declares, which :mod:`zipfile` enforces
-    while inflating)."""
+    """Refuse a zip archive with more entries or inflated bytes than :mod:`meshvis.limits` allows.
+
+    The sizes are those its directory declares, which :mod:`zipfile` enforces while
+    inflating.
+    """
     import zipfile
 
     from meshvis import limits

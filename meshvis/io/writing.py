@@ -1,5 +1,7 @@
-"""Writing models: :func:`save` checks the output path and the per-face arrays, then hands
-the soup to the format's writer.
+"""Writing models.
+
+:func:`save` checks the output path and the per-face arrays, then hands the soup to the
+format's writer.
 
 Each format module declares what it writes in a ``WRITERS`` mapping (format name ->
 ``writer(soup, path, groups, group_names, face_values)``); this module collects them.

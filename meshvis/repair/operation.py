@@ -1,5 +1,6 @@
-"""One repair operation on one loaded model, with its outputs: the unit of work shared by
-the single-file commands and ``meshvis batch``.
+"""One repair operation on one loaded model, with its outputs.
+
+The unit of work shared by the single-file commands and ``meshvis batch``.
 
 Options are a plain mapping (an ``argparse.Namespace`` works too) whose keys and
 defaults are :func:`default_options`; the command line takes its defaults from here, so a

@@ -89,6 +89,7 @@ class OrientResult:
     double_sided: int = 0
 
     def report(self, per_face: bool = True) -> dict:
+        """The JSON-ready report: counts, the classification's summary, per-face arrays."""
         counts = np.bincount(self.status, minlength=len(STATUS_NAMES))
         d = {
             "input_faces": int(len(self.status)),
@@ -258,8 +259,10 @@ def patches(c: Classification) -> Patches:
 
 
 def _closed_body(c: Classification) -> np.ndarray:
-    """(m,) bool: the face's body (its component over all welded edges, non-manifold ones
-    included) has no boundary edge."""
+    """(m,) bool: the face's body has no boundary edge.
+
+    The body is the face's component over all welded edges, non-manifold ones included.
+    """
     from meshvis.geometry.adjacency import components, edges, face_adjacency
 
     table = edges(c.pre.faces_welded)
@@ -340,8 +343,9 @@ def _whole_patches(
     own_layer: np.ndarray,
     movable: np.ndarray,
 ) -> tuple[np.ndarray, int]:
-    """Turn every patch as a whole (in place): each face of a patch with a clear vote takes
-    the patch's side.  Voters: one-sided faces with their area, flagged faces whose sample
+    """Turn every patch as a whole (in place).
+
+    Each face of a patch with a clear vote takes the patch's side.  Voters: one-sided faces with their area, flagged faces whose sample
     points disagree with their area times the margin; only where none of them votes, the
     faces one-sided at their own layer (hidden faces) with their area.
     Returns the faces of patches with a clear vote, and how many of them changed side.
@@ -373,10 +377,12 @@ def _whole_patches(
 
 
 def _clearly_one_sided(c: Classification, outer: np.ndarray) -> np.ndarray:
-    """(m,) bool: clustered faces whose cluster escapes more than 4 times (the evidence
-    dominance of :mod:`meshvis.repair.evidence`) as
-    often through the side they show as through the other (from the classification's own
-    rays): the cluster's evidence already speaks for its faces."""
+    """(m,) bool: clustered faces whose cluster's own rays already speak for them.
+
+    The cluster escapes more than 4 times (the evidence dominance of
+    :mod:`meshvis.repair.evidence`) as often through the side they show as through the other (from the classification's own
+    rays): the cluster's evidence already speaks for its faces.
+    """
     from meshvis.repair.evidence import DOMINANCE
 
     counts = c.counts
@@ -394,8 +400,9 @@ def _clearly_one_sided(c: Classification, outer: np.ndarray) -> np.ndarray:
 def _visible_sides(
     c: Classification, p: Patches, outer: np.ndarray, movable: np.ndarray, seed: int
 ) -> tuple[np.ndarray, int, int]:
-    """Let the side a viewer sees win (in place): every movable face of an open patch is
-    tested on its own (:func:`meshvis.repair.evidence.seen_side`) and turned where its
+    """Let the side a viewer sees win (in place).
+
+    Every movable face of an open patch is tested on its own (:func:`meshvis.repair.evidence.seen_side`) and turned where its
     evidence is decisive and shows the other side.  Faces of closed patches are left to
     their patch: a closed patch bounds a volume, and a face of it whose back pokes out
     through the surface is a self-intersection, not a face turned the wrong way.

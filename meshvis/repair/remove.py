@@ -77,6 +77,7 @@ class RemovalResult:
         return [REASONS[c] for c in self.reason_code]
 
     def report(self, per_face: bool = True) -> dict:
+        """The JSON-ready report: counts, reasons, the classification and view summaries."""
         soup = self.soup
         d: dict[str, Any] = {
             "visibility": self.mode,
@@ -189,8 +190,11 @@ def remove_interior(
 
 
 def _kept_by_cut(c: Classification) -> np.ndarray:
-    """Faces with an outside side; of a sheet stored twice with opposite winding whose one
-    side is hidden, only the copy facing the seen side."""
+    """Faces with an outside side by the cut.
+
+    Of a sheet stored twice with opposite winding whose one side is hidden, only the copy
+    facing the seen side.
+    """
     keep = (c.outside > 0).any(axis=1)
     return keep & ~hidden_copies(opposite_copies(c.pre.faces_welded), c.outside)
 
