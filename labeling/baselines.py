@@ -90,8 +90,10 @@ def _text_artists(ax, reference: LayoutResult) -> list:
 
 
 def _adjusted_labels(labs: Sequence[Label], texts: list, renderer, h: int) -> list[Label]:
-    """The labels where adjustText left their texts, each with a straight leader from its
-    anchor to the nearest point of its box."""
+    """Return the labels at the places where adjustText left their texts.
+
+    Each label gets a straight leader from its anchor to the nearest point of its box.
+    """
     out = []
     for lab, txt in zip(labs, texts):
         bb = txt.get_bbox_patch().get_window_extent(renderer)

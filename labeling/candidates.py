@@ -145,8 +145,10 @@ _MIN_D_MAX = 1e-9
 
 
 def _window(full: np.ndarray) -> tuple[int, int, int, int]:
-    """Rows ``r0:r1`` and columns ``c0:c1`` of the bounding box of ``A_I`` plus a pixel
-    (the whole grid when it is empty)."""
+    """Rows ``r0:r1`` and columns ``c0:c1`` of the bounding box of ``A_I`` plus a pixel.
+
+    When ``A_I`` is empty the window is the whole grid.
+    """
     hp, wp = full.shape
     rows, cols = np.flatnonzero(full.any(axis=1)), np.flatnonzero(full.any(axis=0))
     if len(rows):
@@ -155,8 +157,11 @@ def _window(full: np.ndarray) -> tuple[int, int, int, int]:
 
 
 def _shortest(area: InternalArea, sides: tuple[int, ...], window: tuple[int, int, int, int]) -> tuple:
-    """Per pixel of the window: the shortest leader over ``sides`` (length, endpoint, endpoint
-    key on the padded grid, side code); the first side listed wins ties."""
+    """Find the shortest leader over ``sides`` for each pixel of the window.
+
+    Returns its length, endpoint, endpoint key on the padded grid and side code; the first
+    side listed wins ties.
+    """
     full = area.mask
     hp, wp = full.shape
     p = area.pad

@@ -87,9 +87,11 @@ _F5_FLOOR = 1e-6
 
 
 def _infeasible_pick(rest: np.ndarray, f5a: np.ndarray, w5: float, d_e: float) -> int:
-    """Candidate of an area whose candidates are all infeasible: keep to endpoints nobody
-    uses, then the rest; ``rest`` = the candidates' memberships other than f5, ``f5a`` =
-    their f5."""
+    """Pick the candidate of an area whose candidates are all infeasible.
+
+    Endpoints nobody uses come first, then the rest; ``rest`` holds the candidates'
+    memberships other than f5 and ``f5a`` their f5.
+    """
     tie = rest * np.maximum(f5a, _F5_FLOOR) ** w5
     tie = np.where(f5a > 0, tie + 1.0, tie) if d_e > 0 else tie
     return int(np.argmax(tie))
@@ -105,8 +107,10 @@ def _lower_f4(
     f4w: np.ndarray,
     S: np.ndarray,
 ) -> None:
-    """Lower f4 of the candidates ``near`` to ``new`` (in place), and the sums ``S`` of their
-    (area, endpoint) cells with it."""
+    """Lower f4 of the candidates ``near`` to ``new`` in place.
+
+    The sums ``S`` of their (area, endpoint) cells are lowered with it.
+    """
     if len(near):
         new_w = new**w4 if w4 != 1 else new
         delta = static[near] * (new_w - f4w[near])

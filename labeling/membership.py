@@ -49,6 +49,7 @@ class Weights:
                 raise ParameterError(f"weight {k} must be in [0, 1], got {v}")
 
     def as_dict(self) -> dict[str, float]:
+        """The weights as a dict keyed by field name."""
         return asdict(self)
 
 

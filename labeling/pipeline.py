@@ -90,9 +90,12 @@ def _fit_font(
 def _previous_frame(
     previous: LayoutResult, slot: np.ndarray, n: int
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The previous frame's anchor (n, 2), endpoint (n, 2) and box centre along each of the
-    west, east, north and south sides (n, 4; y for west/east, x for north/south) of every
-    label of this frame; NaN where the label was absent or on another side."""
+    """The previous frame's anchor, endpoint and box centres of every label of this frame.
+
+    Anchor and endpoint are (n, 2); the box centre along each of the west, east, north and
+    south sides is (n, 4; y for west/east, x for north/south). Entries are NaN where the
+    label was absent or on another side.
+    """
     anchor, endpoint, box = np.full((n, 2), np.nan), np.full((n, 2), np.nan), np.full((n, 4), np.nan)
     for lab in previous.labels:
         s = slot[lab.part] if lab.part < len(slot) else -1
@@ -157,8 +160,11 @@ def _check_arguments(
 
 
 def _sort_parts(idbuf: IdBuffer, texts: Sequence[str], min_pixels: int) -> tuple[list, list, np.ndarray]:
-    """(part id, name) of the invisible parts and of the visible ones without a text; the
-    ids of the parts to label."""
+    """Sort the parts into those to skip and those to label.
+
+    Returns (part id, name) of the invisible parts, (part id, name) of the visible ones
+    without a text, and the ids of the parts to label.
+    """
     names = idbuf.part_names
     visible = idbuf.visible(min_pixels)
     invisible = [(int(p), names[p]) for p in idbuf.invisible(min_pixels)]
@@ -274,8 +280,11 @@ def _fuzzy_picks(
     clock: _Stopwatch,
     t: float,
 ) -> tuple[tuple[np.ndarray, ...], float]:
-    """Memberships (Eq. 11, with the coherence terms f6, f7 given ``previous``) and the greedy
-    loop: the area order, each area's pick, feasibility and priority; and the clock."""
+    """Compute the memberships and run the greedy loop.
+
+    The memberships follow Eq. 11, with the coherence terms f6, f7 given ``previous``.
+    Returns the area order, each area's pick, feasibility and priority, and the clock.
+    """
     static = weighted(f2_length(px.length, cand.d_max), weights.w2) * weighted(
         f3_salience(px.sal, cand.d_max), weights.w3
     )
@@ -292,8 +301,10 @@ def _fuzzy_picks(
 
 
 def _two_step_picks(px: _Pixels, n: int, clock: _Stopwatch, t: float) -> tuple[tuple[np.ndarray, ...], float]:
-    """The classic baseline: the most salient pixel of each area (first in row-major order on
-    ties); no feasibility or priority (NaN)."""
+    """The classic baseline: pick the most salient pixel of each area.
+
+    Ties go to the first pixel in row-major order; there is no feasibility or priority (NaN).
+    """
     t = clock.tick("memberships", t)
     key = np.lexsort((px.pix, -px.sal, px.area_of))
     first = np.searchsorted(px.area_of[key], np.arange(n))
@@ -305,8 +316,11 @@ def _two_step_picks(px: _Pixels, n: int, clock: _Stopwatch, t: float) -> tuple[t
 def _endpoint_threshold(
     d_e: float | None, d_s: float, style: TextStyle, widths: np.ndarray, layout: str, spacing: Spacing
 ) -> float:
-    """``d_e`` of Eq. 6 in pixels; by default the box height (west/east layouts) or the mean box
-    width (others) plus the box gap, as the paper recommends (§7.2)."""
+    """``d_e`` of Eq. 6 in pixels.
+
+    By default it is the box height (west/east layouts) or the mean box width (others) plus
+    the box gap, as the paper recommends (§7.2).
+    """
     if d_e is None:
         return (style.box_height if is_horizontal(layout) else float(widths.mean())) + spacing.gap
     return d_e * d_s
@@ -323,8 +337,11 @@ def _place_labels(
     previous: LayoutResult | None,
     layout: str,
 ) -> tuple:
-    """Boxes and leaders of the picked candidates (Step 8): each area's rank in the greedy
-    order, anchor and endpoint, its placement (None: left out) and the correction counts."""
+    """Place the boxes and leaders of the picked candidates (Step 8).
+
+    Returns each area's rank in the greedy order, its anchor and endpoint, its placement
+    (None when left out) and the correction counts.
+    """
     areas_in_order, picks = order[0], order[1]
     n = len(widths)
     rank = np.empty(n, np.int64)
@@ -354,9 +371,12 @@ def _place_labels(
 def _view_maps(
     idbuf: IdBuffer, area: str, margin: float | None, layout: str, clock: _Stopwatch, t: float
 ) -> tuple:
-    """The internal area ``A_I`` (stage ``area``), every pixel's leader candidate
-    (``candidates``, Steps 2-3) and the distance to its area's silhouette (``salience``,
-    Step 4); and the clock."""
+    """Compute the internal area, the leader candidates and the salience, timing each stage.
+
+    Returns the internal area ``A_I`` (stage ``area``), every pixel's leader candidate
+    (``candidates``, Steps 2-3), the distance to its area's silhouette (``salience``,
+    Step 4), and the clock.
+    """
     ia = internal_area(idbuf.model_mask, area, margin)
     t = clock.tick("area", t)
     cand = leader_candidates(ia, layout)
@@ -537,8 +557,11 @@ def solve(
 
 
 def warm_up() -> None:
-    """Import the modules and load the font the layout stages use lazily (about 0.2 s
-    once per process), so that they count as set-up, not as the first frame's layout."""
+    """Import the modules and load the font that the layout stages would use lazily.
+
+    This takes about 0.2 s once per process; doing it here makes it count as set-up, not as
+    the first frame's layout.
+    """
     import scipy.spatial  # noqa: F401 - the convex hull of the internal area
 
     from .text import font

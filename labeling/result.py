@@ -53,6 +53,8 @@ class Label:
         return self.leader[-1]
 
     def to_json(self) -> dict[str, Any]:
+        """The label as a JSON-ready dict (points rounded to 3 decimals)."""
+
         def pt(v: np.ndarray) -> list[float]:
             return [round(float(x), 3) for x in np.ravel(v)]
 
@@ -132,6 +134,7 @@ class LayoutResult:
         return float(np.floor(x0)), float(np.floor(y0)), float(np.ceil(x1)), float(np.ceil(y1))
 
     def by_part(self) -> dict[int, Label]:
+        """The labels keyed by part id."""
         return {lab.part: lab for lab in self.labels}
 
     def to_json(self) -> dict[str, Any]:

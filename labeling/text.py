@@ -50,10 +50,12 @@ class TextStyle:
 
     @property
     def ascent(self) -> float:
+        """Font ascent in pixels."""
         return float(font(self.font_size).getmetrics()[0])
 
     @property
     def descent(self) -> float:
+        """Font descent in pixels."""
         return float(font(self.font_size).getmetrics()[1])
 
     @property
@@ -67,4 +69,5 @@ class TextStyle:
         return np.array([f.getlength(t) + 2 * self.pad_x for t in texts], np.float64)
 
     def text_width(self, text: str) -> float:
+        """Width of ``text`` in pixels, without padding."""
         return float(font(self.font_size).getlength(text))

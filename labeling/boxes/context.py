@@ -75,6 +75,7 @@ class Context:
 
     # geometry of one label in a column / row
     def column_box(self, k: int, side: int, y: np.ndarray) -> np.ndarray:
+        """Column box (x0, y0, x1, y1) of label k on ``side`` centred at height ``y``."""
         x = self.col_x[side]
         w, h = self.widths[k], self.height
         y = np.asarray(y, np.float64)
@@ -99,6 +100,7 @@ class Context:
         return np.stack([x0, y0, x0 + w, y1], axis=-1)
 
     def row_leader(self, k: int, side: int, x: float, tier: int) -> np.ndarray:
+        """Leader polyline of label k in a row: anchor, port at ``x`` and, beyond tier 0, the box edge."""
         box = self.row_box(k, side, np.array(x), np.array(tier))
         port = (x, self.row_y[side])
         pts = [self.anchors[k], port]
@@ -143,9 +145,11 @@ class Context:
 
     @property
     def ray_length(self) -> float:
-        """Length of a label's push-out ray in the tests against boxes: longer than any
-        push-out the search may choose plus the widest box (a box beyond a ray's end
-        would count as leaving it free)."""
+        """Length of a label's push-out ray in the tests against boxes.
+
+        It is longer than any push-out the search may choose plus the widest box, since a
+        box beyond a ray's end would count as leaving the ray free.
+        """
         return RAY_REACHES * self.reach + float(self.widths.max()) + self.height
 
     def future_insides(self, k: int) -> np.ndarray:

@@ -1,5 +1,8 @@
-"""The candidate search of a column or row label: cheapest valid place on its side, then
-on the layout's other side; silhouette labels go to :mod:`.silhouette`."""
+"""The candidate search of a column or row label.
+
+The search takes the cheapest valid place on the label's side, then on the layout's other
+side; silhouette labels are handled by :mod:`.silhouette`.
+"""
 
 from __future__ import annotations
 

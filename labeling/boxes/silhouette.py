@@ -1,5 +1,8 @@
-"""The silhouette layout: boxes pushed out along the normals of ``A_I`` (appendix I,
-Fig. 4b), in ring order, with parted, rotated and uncrossed endpoints."""
+"""The silhouette layout.
+
+Boxes are pushed out along the normals of ``A_I`` (appendix I, Fig. 4b), in ring order,
+with parted, rotated and uncrossed endpoints.
+"""
 
 from __future__ import annotations
 
@@ -32,8 +35,11 @@ _ATTACH = np.array([[1, 0], [-1, 0], [0, 1], [0, -1], [1, 1], [1, -1], [-1, 1], 
 
 
 def _facing(normals: np.ndarray, offsets: np.ndarray) -> np.ndarray:
-    """Cosine between a ray ``normals[..., :]`` and the direction of each box-centre offset
-    ``offsets[..., :]`` from the port (broadcast): 1 = the box sits straight on the ray."""
+    """Cosine between a ray and the direction of each box-centre offset from the port.
+
+    The ray is ``normals[..., :]`` and the offsets are ``offsets[..., :]`` (broadcast);
+    1 means the box sits straight on the ray.
+    """
     return np.einsum("...j,...j->...", normals, offsets) / np.hypot(offsets[..., 0], offsets[..., 1])
 
 

@@ -1,6 +1,9 @@
-"""Stacking along a side: shift boxes apart (pool-adjacent-violators), swap crossing
-leaders (appendix I, §5.5), keep the order of neighbours between frames; the west/east
-columns and the north/south rows of flag boxes."""
+"""Stacking of boxes along a side.
+
+Boxes are shifted apart (pool-adjacent-violators), crossing leaders are swapped
+(appendix I, §5.5) and the order of neighbours is kept between frames; this covers the
+west/east columns and the north/south rows of flag boxes.
+"""
 
 from __future__ import annotations
 
@@ -75,11 +78,11 @@ def uncross(anchors: np.ndarray, ports: np.ndarray, max_swaps: int | None = None
 
 
 def coherent_order(desired: np.ndarray, previous: np.ndarray, pitch: float) -> np.ndarray:
-    """Order of the boxes of one side: by ``desired``, but neighbours closer than ``pitch``
-    keep the order they had in the previous frame.
+    """Order of the boxes of one side, by ``desired`` but coherent with the previous frame.
 
-    Boxes whose desired places are less than one box pitch apart are stacked next to each
-    other whatever their order, so their order is free to follow the previous frame
+    Neighbours closer than ``pitch`` keep the order they had in the previous frame: boxes
+    whose desired places are less than one box pitch apart are stacked next to each other
+    whatever their order, so their order is free to follow the previous frame
     (``previous``: their coordinate along the same side then, NaN when a label was not on
     this side).  Adjacent such pairs are swapped back until none is left (bubble passes
     over the few labels of a side); crossings this creates are undone by :func:`uncross`.

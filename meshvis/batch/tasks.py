@@ -69,6 +69,7 @@ class BatchResult:
 
     @property
     def counts(self) -> dict[str, int]:
+        """Number of rows per status."""
         out: dict[str, int] = {}
         for r in self.rows:
             out[r["status"]] = out.get(r["status"], 0) + 1

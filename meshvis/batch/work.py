@@ -1,6 +1,7 @@
 """One file of a batch: load, repair, write the output and its report, and the resume check.
 
-:func:`run_file` never raises for a bad file: the row it returns says what went wrong."""
+:func:`run_file` never raises for a bad file: the row it returns says what went wrong.
+"""
 
 from __future__ import annotations
 
@@ -28,9 +29,11 @@ def _resolve(runner: str) -> Callable:
 
 
 def operation_args(task: FileTask) -> dict:
-    """Every option of the task's operation: the library defaults
-    (:func:`meshvis.repair.operation.default_options`, which the single-file command uses too)
-    updated with the task's options, plus its input and output paths."""
+    """Every option of the task's operation, with its input and output paths.
+
+    The library defaults (:func:`meshvis.repair.operation.default_options`, which the
+    single-file command uses too) are updated with the task's options.
+    """
     from meshvis.repair.operation import default_options
 
     ns = {**default_options(task.op), **task.options}

@@ -3,7 +3,8 @@
 The main process watches every worker: one that exceeds the time limit is terminated (then
 killed) and replaced, one that dies is reported ``"crashed"`` and replaced.
 (``concurrent.futures.ProcessPoolExecutor`` cannot cancel a running task and breaks entirely
-when one worker dies, hence this small scheduler.)"""
+when one worker dies, hence this small scheduler.)
+"""
 
 from __future__ import annotations
 
@@ -149,8 +150,11 @@ def _wait(workers: list[_Worker], time_limit: float | None) -> None:
 
 
 def _news(w: _Worker, time_limit: float | None, now: float) -> tuple[str | None, Any]:
-    """What happened to ``w``: ``("ready" | "done", payload)``, ``("dead" | "timeout", None)``,
-    or ``(None, None)`` while it works within its deadline."""
+    """What happened to worker ``w``.
+
+    Returns ``("ready" | "done", payload)``, ``("dead" | "timeout", None)``, or
+    ``(None, None)`` while it works within its deadline.
+    """
     kind = payload = None
     try:
         if w.conn.poll():

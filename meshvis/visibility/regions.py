@@ -100,6 +100,7 @@ class Region:
         return np.zeros(len(triangles), bool)
 
     def describe(self) -> dict:
+        """The region as a JSON-ready dict."""
         return {"kind": self.kind}
 
 
@@ -139,6 +140,7 @@ class UpperHemisphere(Region):
         return direction @ self.up <= 0
 
     def describe(self):
+        """The region as a JSON-ready dict."""
         return {"kind": self.kind, "up": self.up.tolist()}
 
 
@@ -164,10 +166,12 @@ class Box(Region):
             raise ParameterError(f"box region needs finite corners with min <= max, got {self.lo}, {self.hi}")
 
     def seed_viewers(self, points, rng):
+        """One viewer per point at a uniform random place in the box, aimed at the point."""
         origins = self.lo + rng.random((len(points), 3)) * (self.hi - self.lo)
         return _aimed(origins, points)
 
     def origin_on_line(self, through, direction):
+        """The middle of the half line's stretch inside the box; ``(origins, ok)``, ok False if it misses."""
         # slab test on the half line through - s * direction, s > 0; the viewer sits in the middle
         with np.errstate(divide="ignore", invalid="ignore"):
             a = (through - self.lo) / direction
@@ -181,6 +185,7 @@ class Box(Region):
         return through - direction * s[:, None], ok
 
     def contains_faces(self, triangles):
+        """(m,) bool: faces with a corner, the centroid or an edge midpoint inside the box."""
         # a corner, the centroid or an edge midpoint inside the box
         probes = np.concatenate(
             [
@@ -194,6 +199,7 @@ class Box(Region):
         return inside.any(axis=1)
 
     def describe(self):
+        """The region as a JSON-ready dict."""
         return {"kind": self.kind, "lo": self.lo.tolist(), "hi": self.hi.tolist()}
 
 
@@ -216,15 +222,18 @@ class Points(Region):
             raise ParameterError("a points region needs at least one finite point")
 
     def seed_viewers(self, points, rng):
+        """One viewer per point, picked at random among the region's points, aimed at the point."""
         return _aimed(self._pick(len(points), rng), points)
 
     def _pick(self, n, rng):
         return self.points[rng.integers(0, len(self.points), n)]
 
     def origin_on_line(self, through, direction):
+        """The lines' own ``through`` points; ``(origins, ok)`` with ok all False."""
         return through.copy(), np.zeros(len(through), bool)
 
     def describe(self):
+        """The region as a JSON-ready dict."""
         return {"kind": self.kind, "points": self.points.tolist()}
 
 

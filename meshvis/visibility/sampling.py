@@ -61,15 +61,18 @@ class Sightings:
 
     @classmethod
     def empty(cls) -> Sightings:
+        """No sightings."""
         z = np.zeros((0, 3))
         return cls(np.zeros(0, np.int64), np.zeros(0, np.int8), z, z, z)
 
     @classmethod
     def concat(cls, parts: list[Sightings]) -> Sightings:
+        """The sightings of ``parts`` one after another."""
         parts = [p for p in parts if len(p.face)] or [cls.empty()]
         return cls(*(np.concatenate([getattr(p, k) for p in parts]) for k in cls.__dataclass_fields__))
 
     def subset(self, index: np.ndarray) -> Sightings:
+        """The sightings at ``index``."""
         return Sightings(*(getattr(self, k)[index] for k in self.__dataclass_fields__))
 
 
@@ -196,8 +199,11 @@ def border_sampling(caster: RayCaster, region: Region, seen: Sightings) -> tuple
 
 
 def _cast_targets(caster, region, seen: Sightings, owner: np.ndarray, targets: np.ndarray):
-    """Rays from the viewers of ``seen[owner]`` to ``targets``: hit face per ray (-1 miss),
-    the sightings with their owners, and the ray count."""
+    """Cast rays from the viewers of ``seen[owner]`` to ``targets``.
+
+    Returns the hit face per ray (-1 for a miss), the sightings with their owners, and the
+    ray count.
+    """
     origin, direction = region.border_origins(seen.origin[owner], seen.direction[owner], targets)
     origin = np.broadcast_to(origin, targets.shape).copy()
     found, hits = trace(caster, origin, direction)

@@ -100,6 +100,7 @@ class Visibility:
 
     @property
     def visible_area(self) -> float:
+        """Total area of the faces seen."""
         return float(self.area[self.seen].sum())
 
     def report(self, per_face: bool = True) -> dict:
