@@ -36,6 +36,7 @@ def add_parser(sub) -> None:
         "compare",
         "scale",
         "orientation",
+        "indoor",
         "real",
     ):
         try:

@@ -178,6 +178,14 @@ def add_parser(sub) -> None:
         default=od["conflicts"],
         help="intersected faces whose samples disagree: area majority or both orientations",
     )
+    p.add_argument(
+        "--from",
+        dest="from_region",
+        default=od["from_region"],
+        metavar="REGION",
+        help="orient every face toward the side seen from REGION instead of the outside "
+        "(indoor scenes): box:x0,y0,z0,x1,y1,z1, points:x,y,z;..., path:CAMERAS.json, ...",
+    )
     p.set_defaults(func=run, op="orient")
 
     p = sub.add_parser("remove-interior", help="remove the faces that cannot be seen from outside")

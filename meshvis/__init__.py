@@ -51,6 +51,7 @@ _LAZY = {
     "Classification": "meshvis.graphcut.classify",
     "Hints": "meshvis.graphcut.hints",
     "orient": "meshvis.repair.orient",
+    "orient_from": "meshvis.repair.orient",
     "remove_interior": "meshvis.repair.remove",
     "layers": "meshvis.repair.layers",
     "visible_from": "meshvis.visibility.visible",

@@ -36,7 +36,14 @@ CLASSIFY_DEFAULTS: dict[str, Any] = {
 #: options of each operation on top of the classification
 OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
     "classify": {},
-    "orient": {"front": "ccw", "two_sided": "keep", "semantics": "layer", "conflicts": "majority"},
+    "orient": {
+        "front": "ccw",
+        "two_sided": "keep",
+        "semantics": "layer",
+        "conflicts": "majority",
+        "from_region": None,  # a region: orient toward what its viewers see (no cut)
+        "up": "auto",
+    },
     "remove-interior": {
         "visibility": "both",
         "from_region": "outside",
@@ -126,16 +133,19 @@ def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     """``orient``: the oriented model and its preview."""
     from meshvis.io import save
     from meshvis.rays.render import render, save_png
-    from meshvis.repair.orient import orient
+    from meshvis.repair.orient import orient, orient_from
 
-    r = orient(
-        soup,
-        classification=c,
-        front=o["front"],
-        two_sided=o["two_sided"],
-        semantics=o["semantics"],
-        conflicts=o["conflicts"],
-    )
+    if o["from_region"]:
+        r = orient_from(soup, o["from_region"], front=o["front"], seed=int(o["seed"]), up=up)
+    else:
+        r = orient(
+            soup,
+            classification=c,
+            front=o["front"],
+            two_sided=o["two_sided"],
+            semantics=o["semantics"],
+            conflicts=o["conflicts"],
+        )
     save(r.soup, o["output"])
     report = r.report()
     tell(
@@ -250,7 +260,10 @@ def run_operation(
     tell = say or (lambda text: None)
     up = up_axis(o.get("up") or "auto", [soup.path] if soup.path else [])  # of the preview
     c = None
-    if op != "remove-interior" or o["visibility"] != "view":  # sight alone needs no cut
+    by_sight = (op == "remove-interior" and o["visibility"] == "view") or (
+        op == "orient" and o["from_region"]
+    )
+    if not by_sight:  # sight alone needs no cut
         c = classify(soup, progress=progress, **classify_kwargs(o))
         tell(c.summary())
     report = _OUTPUTS[op](soup, c, o, tell, up)

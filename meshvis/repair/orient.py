@@ -74,6 +74,8 @@ class OrientResult:
         to show the side a viewer sees, ``rays`` cast
     double_sided : int, faces kept as they are because they are one copy of a sheet stored
         twice with opposite winding (:mod:`meshvis.geometry.duplicates`)
+    view : Visibility or None, the from-region visibility of :func:`orient_from` (then
+        ``classification`` is None)
     """
 
     soup: Soup
@@ -81,12 +83,13 @@ class OrientResult:
     flipped: np.ndarray
     duplicated: np.ndarray
     status: np.ndarray
-    classification: Classification
+    classification: Classification | None
     layers: LayerResult | None
     parity_faces: int = 0
     patch_faces: int = 0
     visibility: dict | None = None
     double_sided: int = 0
+    view: Any = None  # the :class:`meshvis.visibility.Visibility` of :func:`orient_from`
 
     def report(self, per_face: bool = True) -> dict:
         """The JSON-ready report: counts, the classification's summary, per-face arrays."""
@@ -97,8 +100,19 @@ class OrientResult:
             "flipped": int(self.flipped.sum()),
             "duplicated": int(self.duplicated.sum()),
             "status_counts": {n: int(c) for n, c in zip(STATUS_NAMES, counts)},
-            "classification": self.classification.report(per_face=False),
         }
+        if self.view is not None:  # oriented toward a region (:func:`orient_from`): no cut
+            d["view"] = self.view.report(per_face=False)
+            if per_face:
+                d["per_face"] = {
+                    "flipped": self.flipped,
+                    "status": np.asarray(STATUS_NAMES)[self.status],
+                    "seen_front": self.view.seen_side[:, 0],
+                    "seen_back": self.view.seen_side[:, 1],
+                }
+            return d
+        assert self.classification is not None  # every result without a view has a cut
+        d["classification"] = self.classification.report(per_face=False)
         if self.layers is not None:
             d["layers"] = self.layers.report(per_face=False)
         else:
@@ -494,4 +508,74 @@ def orient(
     visibility = {"tested": n_tested, "turned": int(seen.sum()), "rays": n_rays}
     return OrientResult(
         out, source, flip, dup, status, c, lay, n_parity, n_patch, visibility, int(paired.sum())
+    )
+
+
+def orient_from(
+    model: Any,
+    region: Any = "outside",
+    *,
+    front: str = "ccw",
+    budget: int | None = None,
+    seed: int = 0,
+    up: Any = None,
+) -> OrientResult:
+    """Turn every face toward the side that viewers in ``region`` see.
+
+    For scenes meant to be seen from inside (a level, a room) the outside of the graph cut
+    is the wrong reference: the viewers are in a region.  Every face seen from the region
+    through one side only gets that side as its front; faces seen through both sides
+    (``two-sided``) or through neither (``hidden``) keep their winding.  No classification
+    is run.
+
+    Parameters
+    ----------
+    model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model.
+    region : str or region object
+        Where the viewers are (:func:`meshvis.visibility.regions.parse_region`), e.g.
+        ``"box:x0,y0,z0,x1,y1,z1"``.
+    front : {"ccw", "cw"}
+        Winding of the front side.
+    budget : int, optional
+        Ray budget of :func:`meshvis.visible_from` (default: its own).
+    seed : int
+        Seed of the one random generator.
+    up : (3,) float, optional
+        Up direction for an ``upper-hemisphere`` region.
+
+    Returns
+    -------
+    OrientResult
+        ``view`` holds the visibility; ``classification`` is None.
+
+    Examples
+    --------
+    >>> import numpy as np, trimesh
+    >>> room = trimesh.creation.box(extents=(4, 4, 4))  # faces wound outward
+    >>> r = orient_from((room.vertices, room.faces), "box:-0.5,-0.5,-0.5,0.5,0.5,0.5", seed=0)
+    >>> bool(r.flipped.all())  # seen from inside the room, every wall turns to face in
+    True
+    """
+    from meshvis.io import as_soup
+    from meshvis.visibility import visible_from
+
+    _check("front", front, ("ccw", "cw"))
+    soup = as_soup(model)
+    vis = visible_from(soup, region, budget=budget, seed=seed, up=up, per_side=True)
+    seen = np.asarray(vis.seen_side)
+    only_front, only_back = seen[:, 0] & ~seen[:, 1], seen[:, 1] & ~seen[:, 0]
+    status = np.where(seen.all(axis=1), TWO_SIDED, np.where(seen.any(axis=1), ONE_SIDED, HIDDEN))
+    status[soup.areas <= 0] = DEGENERATE
+    flip = only_front if front == "cw" else only_back
+    m = soup.n_faces
+    return OrientResult(
+        soup.flipped(flip),
+        np.arange(m),
+        flip,
+        np.zeros(m, bool),
+        status.astype(np.int8),
+        None,
+        None,
+        view=vis,
     )
