@@ -117,6 +117,18 @@ def algorithm_options(p: argparse.ArgumentParser) -> None:
     p.add_argument("--solver", choices=("pymaxflow", "scipy"), default=d["solver"])
 
 
+def region_option(p: argparse.ArgumentParser, default: str | None, what: str) -> None:
+    """The ``--from REGION`` option: where the viewers are."""
+    p.add_argument(
+        "--from",
+        dest="from_region",
+        default=default,
+        metavar="REGION",
+        help=f"{what}; regions: outside, upper-hemisphere[:ux,uy,uz], box:x0,y0,z0,x1,y1,z1, "
+        "points:x,y,z;..., path:CAMERAS.json",
+    )
+
+
 def removal_options(p: argparse.ArgumentParser) -> None:
     """Add the options of inside removal by sight (shared with ``meshvis batch``)."""
     d = OPERATION_DEFAULTS["remove-interior"]
@@ -127,14 +139,7 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         help="remove what the cut calls hidden (object), what no view from --from reaches (view), "
         "or only what both call hidden (default both)",
     )
-    p.add_argument(
-        "--from",
-        dest="from_region",
-        default=d["from_region"],
-        metavar="REGION",
-        help="where viewers are: outside (default), upper-hemisphere[:ux,uy,uz], "
-        "box:x0,y0,z0,x1,y1,z1, points:x,y,z;..., path:CAMERAS.json",
-    )
+    region_option(p, d["from_region"], "where viewers are: outside (default)")
     p.add_argument(
         "--level",
         choices=("face", "patch", "part"),
@@ -178,13 +183,8 @@ def add_parser(sub) -> None:
         default=od["conflicts"],
         help="intersected faces whose samples disagree: area majority or both orientations",
     )
-    p.add_argument(
-        "--from",
-        dest="from_region",
-        default=od["from_region"],
-        metavar="REGION",
-        help="orient every face toward the side seen from REGION instead of the outside "
-        "(indoor scenes): box:x0,y0,z0,x1,y1,z1, points:x,y,z;..., path:CAMERAS.json, ...",
+    region_option(
+        p, od["from_region"], "orient every face toward the side seen from REGION instead of the outside"
     )
     p.set_defaults(func=run, op="orient")
 
