@@ -292,11 +292,17 @@ def _check_one(path: str, inputs: list[str], force: bool, what: str = "") -> Non
         raise OutputError(f"output path{note} is a folder", path)
     if os.path.exists(path) and not force:
         raise OutputError(f"exists{note}; use --force to overwrite", path)
+    check_folder(path)
+
+
+def check_folder(path: str) -> None:
+    """Refuse an output path whose folder is missing or not writable (:class:`OutputError`
+    naming the path)."""
     folder = os.path.dirname(os.path.abspath(path))
     if not os.path.isdir(folder):
-        raise OutputError("output folder does not exist", folder)
+        raise OutputError("output folder does not exist", path)
     if not os.access(folder, os.W_OK):
-        raise OutputError("output folder is not writable", folder)
+        raise OutputError("output folder is not writable", path)
 
 
 def ensure_folder(out_dir: str) -> None:

@@ -18,6 +18,7 @@ import numpy as np
 from meshvis import _validate
 from meshvis.errors import OutputError, ParameterError
 from meshvis.io import gltf, obj, off, ply, stl
+from meshvis.io._common import check_folder
 from meshvis.io.convert import as_soup
 from meshvis.soup import Material, Soup
 
@@ -84,11 +85,7 @@ def save(
     if ext not in WRITE_FORMATS:
         known = ", ".join(sorted(WRITE_FORMATS))
         raise OutputError(f"cannot write '{ext or '(no extension)'}' files; known: {known}", path)
-    folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
-        raise OutputError("output folder does not exist", path)
-    if not os.access(folder, os.W_OK):
-        raise OutputError("output folder is not writable", path)
+    check_folder(path)
     m = soup.n_faces
     groups = None
     if face_groups is not None:

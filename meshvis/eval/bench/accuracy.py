@@ -263,13 +263,7 @@ def dominance(points: list[C.Point], task: str, case: str) -> tuple[list[str], l
 
 def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: str, seconds: float) -> str:
     """The report: machine, command, one table per task, and the curve check."""
-    lines = ["# meshvis bench accuracy", "", f"Command: `{command}` — {seconds:.0f} s in all.", ""]
-    lines += C.machine_lines(machine) + [
-        f"- load average at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}",
-        "",
-    ]
-    if skipped:
-        lines += ["Skipped cases:", ""] + [f"- {s}" for s in skipped] + [""]
+    lines = C.report_head("meshvis bench accuracy", command, seconds, machine, skipped)
     for task in TASKS:
         pts = [p for p in points if p.task == task]
         if not pts:

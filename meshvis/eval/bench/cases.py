@@ -367,6 +367,18 @@ def shared_legend(fig, axes, fontsize: int, ncol: int | None = None) -> None:
     fig.legend(handles, names, loc="lower center", ncol=ncol, fontsize=fontsize, frameon=False)
 
 
+def report_head(title: str, command: str, seconds: float, machine: dict, skipped: list[str]) -> list[str]:
+    """The first lines of a benchmark's Markdown report: title, command, machine, skipped cases."""
+    lines = [f"# {title}", "", f"Command: `{command}` — {seconds:.0f} s in all.", ""]
+    lines += machine_lines(machine) + [
+        f"- load average at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}",
+        "",
+    ]
+    if skipped:
+        lines += ["Skipped cases:", ""] + [f"- {s}" for s in skipped] + [""]
+    return lines
+
+
 def fmt_err(x: float) -> str:
     """An error for a table: '–' when the run failed, '0' when exact."""
     if x is None or np.isnan(x):

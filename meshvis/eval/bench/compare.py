@@ -127,13 +127,7 @@ def checks(points: list[C.Point], case: str) -> list[str]:
 
 
 def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: str, seconds: float) -> str:
-    lines = ["# meshvis bench compare", "", f"Command: `{command}` — {seconds:.0f} s in all.", ""]
-    lines += C.machine_lines(machine) + [
-        f"- load average at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}",
-        "",
-    ]
-    if skipped:
-        lines += ["Skipped cases:", ""] + [f"- {s}" for s in skipped] + [""]
+    lines = C.report_head("meshvis bench compare", command, seconds, machine, skipped)
     lines += [
         "| case | faces | task | method | error | hidden-shell error | precision | recall | time (s) "
         "| time / meshvis | load |",
