@@ -10,9 +10,9 @@ The package is layered; each subpackage uses only the ones above it in this list
 * :mod:`meshvis.visibility` -- from-region visibility by guided sampling (GVS);
 * :mod:`meshvis.repair` -- orientation, inside removal and layers built on the cut;
 * :mod:`meshvis.batch` -- one repair over many files;
-* :mod:`labeling` -- external labels (appendix I), on :mod:`meshvis.rays`;
+* :mod:`meshvis.labeling` -- external labels (appendix I), on :mod:`meshvis.rays`;
 * :mod:`meshvis.eval` -- generated models with known answers, baselines, benchmarks;
-* :mod:`cli` -- the ``meshvis`` command.
+* :mod:`meshvis.cli` -- the ``meshvis`` command.
 
 The public API below is imported lazily, so that ``import meshvis`` stays fast.
 
