@@ -19,6 +19,7 @@ from typing import Any
 
 from meshvis.errors import MeshvisError, OutputError
 from meshvis.io import one_line
+from meshvis.io._common import temp_prefix
 
 from .tasks import ERROR, OK, SKIPPED, FileTask, empty_row
 
@@ -98,8 +99,14 @@ def discard_partial(task: FileTask) -> None:
     ``.<name>.<op>`` in the output's folder.
     """
     folder = os.path.dirname(task.output) or "."
-    stem = glob.escape(os.path.splitext(os.path.basename(task.output))[0])
-    for pattern in (f".{stem}.*.tmp", f".{stem}_*.tmp"):
+    stem = os.path.splitext(os.path.basename(task.output))[0]
+    # a long name is cut to the same length in every temporary name of the folder
+    kept = len(temp_prefix(task.output)) - 2
+    if len(stem) >= kept:
+        patterns = [f".{glob.escape(stem[:kept])}.*.tmp"]
+    else:
+        patterns = [f".{glob.escape(stem)}.*.tmp", f".{glob.escape(stem)}_*.tmp"]
+    for pattern in patterns:
         for p in glob.glob(os.path.join(folder, pattern)):
             _remove(p)
     rep = report_status(task.report)

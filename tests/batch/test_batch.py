@@ -578,3 +578,27 @@ def test_largest_files_start_first(tmp_path):
     tasks.append(mb.FileTask(files[3], "missing", "x", "y", "orient"))
     assert mb.largest_first(tasks, [0, 1, 2, 3]) == [1, 2, 0, 3]
     assert mb.largest_first(tasks, [3, 0]) == [0, 3]
+
+
+@pytest.mark.parametrize("stem_length", [8, 240])
+def test_discard_partial_finds_the_temporary_files_of_long_names(tmp_path, stem_length):
+    from meshvis.batch.work import discard_partial
+    from meshvis.io._common import temp_prefix
+
+    stem = "m" * stem_length
+    output = tmp_path / f"{stem}.orient.obj"
+    other = tmp_path / "n.orient.obj"
+    task = mb.FileTask(
+        input=str(tmp_path / "in.obj"),
+        name=stem,
+        output=str(output),
+        report=str(tmp_path / f"{stem}.orient.json"),
+        op="orient",
+    )
+    leftovers = [tmp_path / (temp_prefix(str(p)) + "x1y2z3.tmp") for p in (output, task.report)]
+    keep = tmp_path / (temp_prefix(str(other)) + "x1y2z3.tmp")
+    for p in [*leftovers, keep]:
+        p.write_text("partial")
+    discard_partial(task)
+    assert not any(p.exists() for p in leftovers)
+    assert keep.exists()
