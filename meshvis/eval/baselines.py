@@ -303,8 +303,13 @@ def libigl_peel(model: Any, *, timeout: float = 300.0) -> BaselineResult:
         np.savez(src, V=V, F=F)
         code = f"from meshvis.eval.baselines import _peel_main; _peel_main({src!r}, {dst!r})"
         try:
+            # run in the temporary folder: "python -c" puts its working folder on sys.path
             run = subprocess.run(
-                [sys.executable, "-c", code], capture_output=True, text=True, timeout=timeout
+                [sys.executable, "-c", code],
+                capture_output=True,
+                text=True,
+                timeout=timeout,
+                cwd=tmp,
             )
         except subprocess.TimeoutExpired:
             return BaselineResult(
