@@ -45,6 +45,17 @@ def _algorithm_dests() -> list[str]:
 
 
 def add_parser(sub) -> None:
+    """Add the ``batch`` subcommand to the ``meshvis`` parser.
+
+    Its options are the inputs, ``--op``, ``--out``, ``--jobs``, ``--resume``,
+    ``--time-limit``, ``--dask-scheduler``, the graph-cut options of
+    :func:`meshvis.cli.cmd_repair.algorithm_options` and ``--quiet``.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
+    """
     from meshvis.batch import OPERATIONS
 
     from .cmd_repair import algorithm_options
@@ -197,6 +208,34 @@ def _summary_table(result, out_dir: str, limit: int = 60):
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``meshvis batch``: one repair operation over many files, locally or on Dask.
+
+    Every file's output and report go into ``--out`` (created when missing), together with
+    ``summary.csv`` and ``summary.json``.  A status line per file is printed on standard
+    error (with a progress bar on a terminal) and, unless ``--quiet``, a summary table and
+    the errors in full on standard output.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options: ``inputs``, ``op``, ``out``, ``jobs``, ``resume``,
+        ``time_limit``, ``dask_scheduler``, the graph-cut options, ``quiet``.
+
+    Returns
+    -------
+    int
+        Exit status: 0 when every file succeeded or was skipped by ``--resume``, 1 when a
+        file failed (error, time limit, crashed worker), 130 after Ctrl-C, 143 after SIGTERM.
+
+    Raises
+    ------
+    ParameterError
+        ``--jobs`` with ``--dask-scheduler``, a graph-cut option out of its range, inputs not
+        found, an output that would overwrite an input, no Dask or no connection to the
+        scheduler.
+    OutputError
+        ``--out`` is a file or cannot be created or written.
+    """
     from meshvis import _validate
     from meshvis.batch import default_jobs, plan, run_batch, write_summary
     from meshvis.errors import ParameterError

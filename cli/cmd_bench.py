@@ -10,6 +10,18 @@ from .common import positive_int, write_json
 
 
 def add_parser(sub) -> None:
+    """Add the ``bench`` subcommand and its benchmarks to the ``meshvis`` parser.
+
+    ``rays`` and ``classify`` are set up here; every other benchmark is a module of
+    :mod:`meshvis.eval.bench` with ``add_arguments(parser)`` and ``main(args)``, whose help is
+    the first line of its module docstring (a module that is not there is left out).
+    ``meshvis bench`` without a benchmark prints the help and returns 2.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subcommands of the ``meshvis`` parser.
+    """
     p = sub.add_parser("bench", help="benchmarks (speed as ratios measured in one run)")
     bs = p.add_subparsers(dest="bench", metavar="BENCH", required=True)
 
@@ -51,6 +63,26 @@ def add_parser(sub) -> None:
 
 
 def run_rays(args: argparse.Namespace) -> int:
+    """Run ``meshvis bench rays``: ray throughput of the backend next to raw embreex.
+
+    Prints the table of :func:`meshvis.eval.bench.rays.format`.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options: ``model``, ``rays`` (rays per measurement), ``repeat`` (the best
+        of this many runs counts), ``json`` (optional file for the numbers).
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    ModelError
+        The model cannot be read (see :func:`meshvis.load`).
+    """
     from meshvis.eval.bench import rays
     from meshvis.io import load
 
@@ -62,6 +94,29 @@ def run_rays(args: argparse.Namespace) -> int:
 
 
 def run_classify(args: argparse.Namespace) -> int:
+    """Run ``meshvis bench classify``: per-stage times of the classification of large models.
+
+    Prints the summary of every model (:func:`meshvis.eval.bench.classify.format`).
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options: ``models`` (files; default the monastery and the skin + rib cage
+        of ``models_dir``), ``rays_per_node``, ``seed``, ``json`` (optional file for the
+        numbers), ``models_dir``.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    ParameterError
+        Without model files, when ``--models`` is not a folder.
+    ModelError
+        A model cannot be read.
+    """
     from meshvis.eval.bench import classify as bc
 
     results = bc.run(

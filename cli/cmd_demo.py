@@ -11,6 +11,13 @@ from .common import say
 
 
 def add_parser(sub) -> None:
+    """Add the ``demo`` subcommand to the ``meshvis`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
+    """
     p = sub.add_parser("demo", help="run all three repairs on a bundled model and write results + previews")
     p.add_argument("--out", default="meshvis-demo", help="folder to write into (default ./meshvis-demo)")
     p.add_argument("--seed", type=int, default=0)
@@ -21,6 +28,28 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``meshvis demo``: orient, remove-interior and layers on the bundled model.
+
+    The folder ``--out`` (created when missing) receives the models, their PNG previews and
+    ``report.json`` (:data:`meshvis.eval.demo.DEMO_FILES`); a line per step is printed unless
+    ``--quiet``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options: ``out``, ``seed``, ``size`` (preview pixels), ``force``, ``quiet``.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    OutputError
+        ``--out`` exists and is not a folder, or it already holds one of the demo files and
+        ``--force`` is not given.
+    """
     from meshvis.eval.demo import DEMO_FILES, run_demo
 
     if os.path.exists(args.out) and not os.path.isdir(args.out):

@@ -9,6 +9,13 @@ from meshvis.errors import ParameterError
 
 
 def add_parser(sub) -> None:
+    """Add the ``info`` subcommand to the ``meshvis`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
+    """
     p = sub.add_parser(
         "info",
         help="diagnose a model: components, holes, non-manifold edges, winding, "
@@ -31,6 +38,29 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``meshvis info``: diagnose a model and print the counts and timings.
+
+    Prints the text report, or the same numbers as JSON with ``--json``; on a terminal a
+    progress bar on standard error follows the stages.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options: ``model``, ``json``, ``eps`` (tolerance of the intersection tests,
+        a fraction of the diagonal), ``no_intersections``.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    ParameterError
+        ``--eps`` outside [1e-9, 1).
+    ModelError
+        The model cannot be read (see :func:`meshvis.load`).
+    """
     from meshvis.geometry.diagnostics import diagnose, format_report
     from meshvis.io import load
 

@@ -11,6 +11,13 @@ UP_AXES = ("auto", "x", "y", "z")
 
 
 def add_parser(sub) -> None:
+    """Add the ``label`` subcommand to the ``meshvis`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
+    """
     from meshvis.labeling.candidates import LAYOUTS
     from meshvis.labeling.internal_area import SHAPES
 
@@ -89,7 +96,7 @@ def _camera_arguments(cam: argparse._ArgumentGroup) -> None:
 
 
 def _optimisation_arguments(opt: argparse._ArgumentGroup) -> None:
-    """The thresholds and weights of the fuzzy-greedy optimisation, font and visibility."""
+    """Add the thresholds and weights of the fuzzy-greedy optimisation, font and visibility."""
     opt.add_argument(
         "--d-a", type=float, default=0.05, help="anchor distance threshold, fraction of d_S (default 0.05)"
     )
@@ -137,7 +144,7 @@ def _frame_paths(output: str, n: int) -> list[str]:
 
 
 def _cameras(args: argparse.Namespace, soup) -> list:
-    """The cameras of the frames: an orbit, a camera path, one camera file or one fitted view."""
+    """Build the cameras of the frames: an orbit, a camera path, one camera file or one fitted view."""
     import json
 
     from meshvis.errors import ParameterError
@@ -180,7 +187,7 @@ def _cameras(args: argparse.Namespace, soup) -> list:
 
 
 def _write_outputs(args: argparse.Namespace, results: list, ext: str) -> None:
-    """The picture(s) or GIF, the optional PNG of the first frame and the JSON."""
+    """Write the picture(s) or GIF, the optional PNG of the first frame and the JSON."""
     from meshvis.labeling import output as out
     from meshvis.labeling.metrics import sequence_metrics
 
@@ -225,6 +232,37 @@ def _report(args: argparse.Namespace, results: list, paths: list[str]) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``meshvis label``: lay out external labels for the visible parts and write the pictures.
+
+    The input files are combined into one model (a single-part file is named after its
+    file).  There is a frame per camera (``--orbit``, ``--camera-path``, ``--camera``, or one
+    view fitted to the model); several frames are written as ``NAME_000.svg``, ... or as one
+    GIF.  The pictures, the PNG of ``--png`` and the JSON of ``--json`` appear together or
+    not at all.  Prints what was written and the first frame's quality (and the motion of a
+    sequence) unless ``--quiet``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of ``meshvis label`` (inputs, output, layout, camera and
+        optimisation options).
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    OutputError
+        The output is not ``.svg``, ``.png`` or ``.gif``, or an output path is refused (see
+        :func:`meshvis.io.check_output`).
+    ParameterError
+        ``--weights`` is not six numbers, the ``--camera`` file cannot be read, or a
+        ``--texts`` entry names no part.
+    ModelError
+        A model cannot be read (see :func:`meshvis.load`).
+    """
     from meshvis.errors import OutputError
     from meshvis.labeling import frames as fr
     from meshvis.labeling.inputs import load_models, read_texts

@@ -8,6 +8,13 @@ from .common import check_output, positive_int, say
 
 
 def add_parser(sub) -> None:
+    """Add the ``render`` subcommand to the ``meshvis`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
+    """
     p = sub.add_parser("render", help="render a shaded preview image (front sides blue, back sides orange)")
     p.add_argument("input", help="input model")
     p.add_argument("-o", "--output", required=True, help="PNG file to write")
@@ -33,6 +40,30 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``meshvis render``: write a shaded PNG preview of a model.
+
+    The camera is fitted to the model from ``--azimuth`` and ``--elevation`` about the up
+    axis.  With ``--color-by layer`` the layer peeling runs first (seeded by ``--seed``) and
+    each face is coloured by its layer.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options: ``input``, ``output``, ``color_by``, ``azimuth``, ``elevation``,
+        ``up``, ``size`` (width, height), ``seed``, ``force``, ``quiet``.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    OutputError
+        The output path is refused (see :func:`meshvis.io.check_output`).
+    ModelError
+        The model cannot be read (see :func:`meshvis.load`).
+    """
     from meshvis.io import load
     from meshvis.rays.camera import Camera, up_axis
     from meshvis.rays.render import render, save_png

@@ -75,7 +75,23 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
 
 
 def box(text: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
-    """Parse ``x0,y0,z0,x1,y1,z1`` (min corner, max corner)."""
+    """Parse ``x0,y0,z0,x1,y1,z1`` into the min and max corners of a box (an argparse ``type``).
+
+    Parameters
+    ----------
+    text : str
+        Six comma-separated numbers: the min corner, then the max corner.
+
+    Returns
+    -------
+    tuple of two tuple of 3 float
+        The min corner and the max corner.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        Not six numbers, or a min coordinate above its max.
+    """
     try:
         v = [float(t) for t in text.split(",")]
     except ValueError:
@@ -86,7 +102,18 @@ def box(text: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
 
 
 def algorithm_options(p: argparse.ArgumentParser) -> None:
-    """Add the graph-cut options that apply to any model (shared with ``meshvis batch``)."""
+    """Add the graph-cut options that apply to any model (shared with ``meshvis batch``).
+
+    The options are ``--seed``, ``--rays-per-node``, ``--samples-per-face``, ``--no-filter``,
+    ``--no-progressive`` and ``--solver``, with the defaults of
+    :data:`meshvis.repair.operation.CLASSIFY_DEFAULTS`; their ``dest`` names are the keywords
+    of :func:`meshvis.classify`.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The parser to add them to.
+    """
     d = CLASSIFY_DEFAULTS
     p.add_argument("--seed", type=int, default=d["seed"], help=f"random seed (default {d['seed']})")
     p.add_argument(
@@ -118,7 +145,17 @@ def algorithm_options(p: argparse.ArgumentParser) -> None:
 
 
 def region_option(p: argparse.ArgumentParser, default: str | None, what: str) -> None:
-    """The ``--from REGION`` option: where the viewers are."""
+    """Add the ``--from REGION`` option: where the viewers are.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The parser to add it to.
+    default : str or None
+        The region when the option is not given (None: no region).
+    what : str
+        The start of the help text, before the list of region forms.
+    """
     p.add_argument(
         "--from",
         dest="from_region",
@@ -130,7 +167,16 @@ def region_option(p: argparse.ArgumentParser, default: str | None, what: str) ->
 
 
 def removal_options(p: argparse.ArgumentParser) -> None:
-    """Add the options of inside removal by sight (shared with ``meshvis batch``)."""
+    """Add the options of inside removal by sight (shared with ``meshvis batch``).
+
+    The options are ``--visibility``, ``--from``, ``--level`` and ``--keep-border``, with the
+    defaults of ``remove-interior`` in :data:`meshvis.repair.operation.OPERATION_DEFAULTS`.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The parser to add them to.
+    """
     d = OPERATION_DEFAULTS["remove-interior"]
     p.add_argument(
         "--visibility",
@@ -156,6 +202,16 @@ def removal_options(p: argparse.ArgumentParser) -> None:
 
 
 def add_parser(sub) -> None:
+    """Add the ``classify``, ``orient``, ``remove-interior`` and ``layers`` subcommands.
+
+    All four share the input, report, preview, graph-cut and hint options; each adds its
+    own, and sets ``func`` to :func:`run` and ``op`` to its name.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subcommands of the ``meshvis`` parser.
+    """
     p = sub.add_parser("classify", help="classify every triangle side inside/outside (report only)")
     _common(p, needs_output=False)
     p.add_argument("--graphml", metavar="GRAPH.graphml", help="export the visibility graph")
@@ -201,6 +257,34 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run one graph-cut command (``args.op``) on one model and write its outputs.
+
+    The output paths are checked before the model is read.  The outputs appear together at
+    the end, or none of them does (an error, Ctrl-C, SIGTERM).  ``--report -`` writes the
+    report to standard output and silences the other messages.  When ``--removed`` is given
+    and no face was removed, an existing file of that name is deleted, so that it does not
+    pass for this run's result.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options of the subcommand, with ``op`` naming it.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    ParameterError
+        Two outputs share one path, ``--per-face`` without ``--report``, or an option out of
+        its range.
+    OutputError
+        An output path is refused (see :func:`meshvis.io.check_output`).
+    ModelError
+        The model cannot be read (see :func:`meshvis.load`).
+    """
     from meshvis.io import load
 
     from .progress import stage_progress
@@ -242,7 +326,25 @@ def run(args: argparse.Namespace) -> int:
 
 
 def run_op(op: str, soup, args: argparse.Namespace, progress=None) -> dict:
-    """Run one operation on a loaded soup through the library and write its outputs."""
+    """Run one operation on a loaded soup through the library and write its outputs.
+
+    Parameters
+    ----------
+    op : {"classify", "orient", "remove-interior", "layers"}
+        The operation.
+    soup : Soup
+        The loaded model.
+    args : argparse.Namespace
+        The operation's options and output paths (see
+        :func:`meshvis.repair.operation.run_operation`); ``quiet`` silences the summaries.
+    progress : callable, optional
+        ``progress(stage, fraction)`` callback of the classification.
+
+    Returns
+    -------
+    dict
+        The JSON-ready report of the operation.
+    """
     from meshvis.repair.operation import run_operation
 
     return run_operation(op, soup, args, progress, say=lambda text: say(args, text))

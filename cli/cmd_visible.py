@@ -8,6 +8,13 @@ from .common import check_output, positive_int, say, write_json
 
 
 def add_parser(sub) -> None:
+    """Add the ``visible`` subcommand to the ``meshvis`` parser.
+
+    Parameters
+    ----------
+    sub : argparse._SubParsersAction
+        The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
+    """
     p = sub.add_parser("visible", help="which faces can be seen from a region (GVS guided sampling)")
     p.add_argument("input", help="input model (OBJ, PLY, STL, OFF, glTF/GLB, 3MF)")
     p.add_argument(
@@ -37,6 +44,32 @@ def add_parser(sub) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    """Run ``meshvis visible``: search which faces can be seen from the region ``--from``.
+
+    Prints one line (faces and share of the area seen, rays, why the search stopped, time).
+    No model is written; ``--report`` writes the JSON report with per-face results and
+    ``--preview`` a picture with the unseen faces in red.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed options: ``input``, ``from_region``, ``method``, ``budget``, ``per_side``,
+        ``up``, ``seed``, ``report``, ``preview``, ``force``, ``quiet``.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    OutputError
+        A ``--report`` or ``--preview`` path is refused (see :func:`meshvis.io.check_output`).
+    ModelError
+        The model cannot be read (see :func:`meshvis.load`).
+    ParameterError
+        Unknown region or method, or a bad budget (see :func:`meshvis.visible_from`).
+    """
     from meshvis.io import load
     from meshvis.rays.camera import up_axis
     from meshvis.rays.render import save_png

@@ -12,7 +12,23 @@ from meshvis.io.jsonfile import write_json  # noqa: F401  (re-exported for the c
 
 
 def point(text: str) -> tuple[float, float, float]:
-    """Parse ``x,y,z``."""
+    """Parse ``x,y,z`` into a point (an argparse ``type``).
+
+    Parameters
+    ----------
+    text : str
+        Three comma-separated numbers.
+
+    Returns
+    -------
+    tuple of 3 float
+        The point.
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        ``text`` is not three comma-separated numbers.
+    """
     try:
         x, y, z = (float(t) for t in text.split(","))
     except ValueError:
@@ -21,12 +37,39 @@ def point(text: str) -> tuple[float, float, float]:
 
 
 def say(args: argparse.Namespace, *text: Any) -> None:
-    """Print unless ``--quiet``."""
+    """Print to standard output unless ``--quiet`` was given.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments; a namespace without ``quiet`` counts as not quiet.
+    *text : object
+        What to print, separated by spaces as :func:`print` does.
+    """
     if not getattr(args, "quiet", False):
         print(*text)
 
 
 def positive_int(text: str) -> int:
+    """Parse an integer of at least 1 (an argparse ``type``).
+
+    Parameters
+    ----------
+    text : str
+        The option's value.
+
+    Returns
+    -------
+    int
+        The number.
+
+    Raises
+    ------
+    ValueError
+        ``text`` is not an integer (argparse reports it as an invalid value).
+    argparse.ArgumentTypeError
+        The number is below 1.
+    """
     v = int(text)
     if v < 1:
         raise argparse.ArgumentTypeError("must be at least 1")
@@ -34,6 +77,13 @@ def positive_int(text: str) -> int:
 
 
 def stderr(*text: Any) -> None:
+    """Print to standard error.
+
+    Parameters
+    ----------
+    *text : object
+        What to print, separated by spaces as :func:`print` does.
+    """
     print(*text, file=sys.stderr)
 
 

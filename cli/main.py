@@ -31,6 +31,22 @@ COMMANDS = {
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """Build the ``meshvis`` argument parser with one subcommand per module of :data:`COMMANDS`.
+
+    Every subcommand module adds its parser through its ``add_parser(subparsers)``; a module
+    that is not there at all is left out, so the other commands still work.
+
+    Returns
+    -------
+    argparse.ArgumentParser
+        The parser; a parsed subcommand sets ``func``, the handler called with the namespace.
+
+    Raises
+    ------
+    ModuleNotFoundError
+        A subcommand module imports a module that is missing (the module itself being
+        missing is not an error).
+    """
     from meshvis._version import __version__
 
     parser = argparse.ArgumentParser(
@@ -55,6 +71,29 @@ def build_parser() -> argparse.ArgumentParser:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """Run the ``meshvis`` command and turn its failures into an exit status.
+
+    Errors of the user (:class:`~meshvis.errors.MeshvisError`, a refused file operation)
+    print one line on standard error; warnings print as one line without source location.
+
+    Parameters
+    ----------
+    argv : list of str, optional
+        The arguments after the program name; default ``sys.argv[1:]``.
+
+    Returns
+    -------
+    int
+        The handler's exit status (0 on success; ``meshvis batch`` returns 1 when a file
+        failed); 2 without a subcommand (the help is printed), for a ``MeshvisError`` or an
+        ``OSError``; 130 after Ctrl-C; 143 after SIGTERM; 0 when the reader of standard
+        output closed the pipe.
+
+    Raises
+    ------
+    SystemExit
+        From argparse: status 0 after ``--help`` or ``--version``, 2 for bad arguments.
+    """
     from meshvis.errors import MeshvisError
 
     parser = build_parser()

@@ -8,7 +8,23 @@ import sys
 
 @contextlib.contextmanager
 def stage_progress(args):
-    """Yield a ``progress(stage, fraction)`` callback, or None when quiet/not interactive."""
+    """Show a progress bar on standard error while the block runs (a context manager).
+
+    The bar shows the current stage's name and how far it is; it disappears when the block
+    ends.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments; ``quiet`` (when present and True) switches the bar off.
+
+    Yields
+    ------
+    callable or None
+        ``progress(stage, fraction)``, which names the stage and sets the bar to
+        ``fraction`` (clipped to [0, 1]); None with ``--quiet`` or when standard error is not
+        a terminal.
+    """
     if getattr(args, "quiet", False) or not sys.stderr.isatty():
         yield None
         return

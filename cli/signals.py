@@ -1,5 +1,8 @@
-"""SIGTERM as a clean stop: the command unwinds like Ctrl-C (temporary files removed, a
-batch stops its workers and writes its summary) and exits with status 143."""
+"""SIGTERM as a clean stop: the command unwinds like Ctrl-C and exits with status 143.
+
+Temporary files are removed on the way out, and a batch stops its workers and writes its
+summary, as after Ctrl-C.
+"""
 
 from __future__ import annotations
 
@@ -28,7 +31,21 @@ def _raise_terminated(signum, frame) -> None:
 
 @contextlib.contextmanager
 def sigterm_stops() -> Iterator[None]:
-    """Turn SIGTERM into :class:`Terminated` inside the block (main thread only)."""
+    """Turn SIGTERM into :class:`Terminated` inside the block (a context manager).
+
+    Signal handlers can only be set from the main thread: in any other thread the block runs
+    with SIGTERM handling unchanged.  The previous handler is restored when the block ends.
+    The first SIGTERM makes the process ignore further ones, so that the clean-up finishes.
+
+    Yields
+    ------
+    None
+
+    Raises
+    ------
+    Terminated
+        Where the block is running when SIGTERM arrives (main thread only).
+    """
     if threading.current_thread() is not threading.main_thread():
         yield
         return
@@ -41,5 +58,12 @@ def sigterm_stops() -> Iterator[None]:
 
 
 def terminated() -> bool:
-    """Whether a SIGTERM has stopped the command running in this process."""
+    """Tell whether a SIGTERM has stopped the command running in this process.
+
+    Returns
+    -------
+    bool
+        True when SIGTERM arrived since the last :func:`sigterm_stops` block began in the
+        main thread.
+    """
     return _FIRED[0]
