@@ -1,5 +1,8 @@
-"""Geometry the generators are built from: grids, boxes, spheres, solids of revolution,
-cylinders, and the composition of closed pieces into one truth."""
+"""Geometry the generators are built from, and the composition of pieces into one truth.
+
+Grids, boxes, spheres, solids of revolution and cylinders; :func:`_compose` joins closed
+pieces into one :class:`GroundTruth`.
+"""
 
 from __future__ import annotations
 
@@ -90,8 +93,11 @@ def _reverse(tris: np.ndarray) -> np.ndarray:
 def _axis_patch(
     a: int, value: float, sign: int, ub: np.ndarray, vc: np.ndarray, keep: np.ndarray | None = None
 ) -> np.ndarray:
-    """Triangles of an axis-aligned rectangle ``x_a = value`` over the coordinate arrays
-    ``ub`` (along axis a+1) and ``vc`` (along axis a+2), normal ``sign * e_a``."""
+    """Build the triangles of an axis-aligned rectangle ``x_a = value``, normal ``sign * e_a``.
+
+    The grid runs over the coordinate arrays ``ub`` (along axis a+1) and ``vc`` (along axis
+    a+2).
+    """
     b, c = (a + 1) % 3, (a + 2) % 3
     P = np.empty((len(ub), len(vc), 3))
     P[..., a] = value
@@ -106,7 +112,7 @@ def _counts(lo: np.ndarray, hi: np.ndarray, cell: float) -> np.ndarray:
 
 
 def _box_tris(lo, hi, cell: float) -> tuple[np.ndarray, np.ndarray]:
-    """A closed, outward box ``[lo, hi]`` with cells of about ``cell``.
+    """Build a closed, outward box ``[lo, hi]`` with cells of about ``cell``.
 
     Returns the triangles (k, 3, 3) and the box side of each, ``2 * axis + (0 for the low
     side, 1 for the high side)``.  Shared edges use the same coordinate arrays, so the
@@ -131,7 +137,7 @@ def _box(lo, hi, cell: float) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _random_rotation(rng: np.random.Generator) -> np.ndarray:
-    """A uniformly random rotation matrix (QR of a Gaussian matrix, sign-fixed)."""
+    """Draw a uniformly random rotation matrix (QR of a Gaussian matrix, sign-fixed)."""
     q, r = np.linalg.qr(rng.standard_normal((3, 3)))
     q = q * np.sign(np.diag(r))
     if np.linalg.det(q) < 0:
@@ -170,8 +176,11 @@ def _revolve(r: np.ndarray, z: np.ndarray, sections: int) -> np.ndarray:
 
 
 def _cylinder(p0, p1, radius: float, sections: int, cell: float) -> tuple[np.ndarray, np.ndarray]:
-    """A closed, outward cylinder from ``p0`` to ``p1``, subdivided to about ``cell`` along
-    its length and across its caps (so that few triangles straddle an intersection)."""
+    """Build a closed, outward cylinder from ``p0`` to ``p1``.
+
+    It is subdivided to about ``cell`` along its length and across its caps (so that few
+    triangles straddle an intersection).
+    """
     p0, p1 = np.asarray(p0, np.float64), np.asarray(p1, np.float64)
     axis = p1 - p0
     length = float(np.linalg.norm(axis))
@@ -205,10 +214,29 @@ def _orient_from(V: np.ndarray, F: np.ndarray, center) -> np.ndarray:
 
 
 def signed_volume(V: np.ndarray, F: np.ndarray) -> float:
-    """Signed volume enclosed by a closed triangle mesh (positive when it faces outward).
+    """Compute the signed volume enclosed by a closed triangle mesh (positive when it faces outward).
 
     Sum over faces of ``v0 . (v1 x v2) / 6`` after centring, which keeps the round-off
     independent of where the model sits.
+
+    Parameters
+    ----------
+    V : (n, 3) float
+        Vertex coordinates.
+    F : (m, 3) int
+        Vertex indices of every triangle.
+
+    Returns
+    -------
+    float
+        The volume; 0.0 without faces.  Meaningful for a closed, consistently wound mesh.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> cube = trimesh.creation.box(extents=(1.0, 2.0, 3.0))
+    >>> round(signed_volume(cube.vertices, cube.faces), 9), round(signed_volume(cube.vertices, cube.faces[:, ::-1]), 9)
+    (6.0, -6.0)
     """
     V = np.asarray(V, np.float64)
     if len(F) == 0:

@@ -18,7 +18,7 @@ class _Parts:
         self.parts: list[str] = []
 
     def add(self, mesh_or_vf, part: str) -> None:
-        """A piece given as ``(V, F)`` or as a mesh with ``vertices`` and ``faces``."""
+        """Add a piece given as ``(V, F)`` or as a mesh with ``vertices`` and ``faces``."""
         if isinstance(mesh_or_vf, tuple):
             V, F = mesh_or_vf
         else:
@@ -52,7 +52,7 @@ def _block_and_head(b: _Parts) -> np.ndarray:
 
 
 def _front(b: _Parts) -> None:
-    """The front accessories (front = -x): pulleys, alternator, water pump and the fan."""
+    """Add the front accessories (front = -x): pulleys, alternator, water pump and the fan."""
     import trimesh
 
     b.box((-2.1, -0.9, 0.2), (-1.98, 0.9, 1.9), "timing_cover", c=0.2)
@@ -93,7 +93,7 @@ def _back_and_pipes(b: _Parts, xs: np.ndarray) -> None:
 
 
 def assembly(sections: int = 24, cell: float = 0.2) -> GroundTruth:
-    """An engine-like assembly of about 30 named closed parts of very different sizes.
+    """Build an engine-like assembly of about 30 named closed parts of very different sizes.
 
     Block, head, valve cover and oil pan (large boxes); pistons inside the block (fully
     hidden); spark plugs and bolts half sunk into the valve cover; pulleys, alternator,

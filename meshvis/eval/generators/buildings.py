@@ -20,7 +20,7 @@ def house(
     partition: bool = True,
     seed: int = 0,
 ) -> GroundTruth:
-    """A closed house of stacked room boxes with furniture: hidden interiors and coplanar walls.
+    """Build a closed house of stacked room boxes with furniture: hidden interiors and coplanar walls.
 
     Every room is a closed box facing out of the room, with its own tessellation (cell size
     jittered per room), so neighbouring rooms share wall planes with coplanar, differently
@@ -33,18 +33,21 @@ def house(
     ----------
     rooms : (int, int)
         Rooms along x and y; every room must touch the exterior (it lies on the grid's
-        border or on the ground floor), else :class:`ParameterError`.
+        border or on the ground floor).
     floors : int
         Storeys.
-    room_size : (float, float, float)
+    room_size : (3,) float
         Nominal room width, depth, height; widths and depths vary by +-20 % per column/row.
     cell : float
         Nominal triangle size.
     furniture : int
         Furniture boxes per room (0..4).
-    roof, partition : bool
-        Add the roof prism / the partition sheet.
+    roof : bool
+        Add the roof prism.
+    partition : bool
+        Add the partition sheet (in the last room of the top floor).
     seed : int
+        Jitters the room widths, depths and cell sizes and places the furniture.
 
     Returns
     -------
@@ -58,6 +61,18 @@ def house(
         roof's bottom (its attic side, the back), furniture, the partition (two-sided) and
         the cabinet.  The safe is layer 3.  Faces lying on another solid (furniture
         bottoms, upper-floor triangles partly or wholly under furniture) are ``ambiguous``.
+
+    Raises
+    ------
+    ParameterError
+        No room or no floor, a room that does not touch the exterior (more than two rooms
+        along both x and y with several floors), or ``furniture`` outside 0..4.
+
+    Examples
+    --------
+    >>> t = house(rooms=(1, 1), floors=1, furniture=0)
+    >>> t.soup.part_names, t.n_layers, t.check()
+    (['room_000', 'roof', 'partition'], 2, [])
     """
     nx, ny, floors = int(rooms[0]), int(rooms[1]), int(floors)
     _check_house(rooms, floors, furniture)
@@ -93,7 +108,7 @@ def house(
 
 
 def _check_house(rooms: tuple[int, int], floors: int, furniture: int) -> None:
-    """ParameterError unless every room of the house touches the exterior."""
+    """Raise ParameterError unless every room of the house touches the exterior."""
     nx, ny = int(rooms[0]), int(rooms[1])
     if nx < 1 or ny < 1 or floors < 1:
         raise ParameterError(
@@ -119,9 +134,12 @@ def _furniture(
     tris: np.ndarray,
     side: np.ndarray,
 ) -> tuple[list[_Piece], np.ndarray]:
-    """Furniture of one room: one box per chosen quadrant of its floor (the first room's first
-    box is a cabinet with a safe floating inside); and which of the room's triangles are
-    ambiguous (floor triangles of an upper storey partly under furniture)."""
+    """Furnish one room: one box per chosen quadrant of its floor.
+
+    The first room's first box is a cabinet with a safe floating inside.  Also returns which
+    of the room's triangles are ambiguous (floor triangles of an upper storey partly under
+    furniture).
+    """
     i, j, k = room
     pieces = []
     amb = np.zeros(len(tris), bool)
@@ -156,8 +174,11 @@ def _furniture(
 
 
 def _room(tris: np.ndarray, inner: np.ndarray, amb: np.ndarray, name: str) -> _Piece:
-    """A room box: its sides towards the exterior are outside (layer 1, front outward), the
-    sides shared with a neighbour hidden (layer 2, back outward)."""
+    """Make a room box a piece: its sides toward the exterior outside, the shared ones hidden.
+
+    Sides toward the exterior are layer 1 with the front outward; sides shared with a
+    neighbour are layer 2 with the back outward.
+    """
     V, F = _weld(tris)
     vis = ~inner
     return _Piece(
@@ -172,7 +193,7 @@ def _room(tris: np.ndarray, inner: np.ndarray, amb: np.ndarray, name: str) -> _P
 
 
 def _partition(lo: np.ndarray, hi: np.ndarray, height: float, cell: float) -> _Piece:
-    """A free-standing single sheet across the middle of a room: hidden, two-sided."""
+    """Build a free-standing single sheet across the middle of a room: hidden, two-sided."""
     cy = 0.5 * (lo[1] + hi[1])
     ub = np.linspace(lo[2], lo[2] + 0.6 * height, max(2, int(round(0.6 * height / cell)) + 1))
     vc = np.linspace(
@@ -185,7 +206,7 @@ def _partition(lo: np.ndarray, hi: np.ndarray, height: float, cell: float) -> _P
 
 
 def _roof(xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, cell: float) -> _Piece:
-    """The gable roof: a closed prism on the top ceilings; its bottom (coplanar with them) is hidden."""
+    """Build the gable roof: a closed prism on the top ceilings; its bottom (coplanar with them) is hidden."""
     Z0, Y, X = zs[-1], ys[-1], xs[-1]
     section = np.array([[0.0, Z0], [Y, Z0], [Y / 2, Z0 + 0.45 * Y]])
     rV, rF = _prism_x(xs[0], X, section, cell)
@@ -201,7 +222,7 @@ def _roof(xs: np.ndarray, ys: np.ndarray, zs: np.ndarray, cell: float) -> _Piece
 
 
 def _prism_x(x0: float, x1: float, section: np.ndarray, cell: float) -> tuple[np.ndarray, np.ndarray]:
-    """A closed, outward prism along x over the triangular cross-section ``section`` (3, 2) in (y, z).
+    """Build a closed, outward prism along x over the triangular cross-section ``section`` (3, 2) in (y, z).
 
     The cross-section is a barycentric lattice of order ``k``; its boundary points are reused
     by the side strips so that all corners coincide exactly.

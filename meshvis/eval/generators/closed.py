@@ -22,11 +22,34 @@ def _welded(soup: Soup, tol: float = 0.0) -> np.ndarray:
 
 
 def is_closed(soup: Soup, oriented: bool = True, tol: float = WELD_TOL) -> bool:
-    """Whether the surface is closed once corners closer than ``tol`` x diagonal are merged.
+    """Tell whether the surface is closed once corners closer than ``tol`` x diagonal are merged.
 
     Closed means every edge is used an even number of times; *oriented* closed (the
     default) means every edge is crossed as often in one direction as in the other, i.e.
     the surface bounds a volume with consistent winding.  Non-manifold edges are allowed.
+
+    Parameters
+    ----------
+    soup : Soup
+        The model.
+    oriented : bool
+        Also require consistent winding.
+    tol : float
+        Weld distance as a fraction of the bounding-box diagonal (see
+        :func:`meshvis.geometry.adjacency.weld`).
+
+    Returns
+    -------
+    bool
+        Whether the surface is (oriented) closed; False for a model without faces.
+
+    Examples
+    --------
+    >>> import numpy as np, trimesh
+    >>> from meshvis.io import as_soup
+    >>> cube = as_soup(trimesh.creation.box())
+    >>> is_closed(cube), is_closed(cube.subset(np.arange(1, 12)))
+    (True, False)
     """
     if soup.n_faces == 0:
         return False
@@ -44,9 +67,11 @@ def _components(soup: Soup, tol: float = WELD_TOL) -> np.ndarray:
 
 
 def _outward_bodies(soup: Soup) -> tuple[np.ndarray, np.ndarray]:
-    """Body (edge-connected component) of every face, and whether the face's front faces
-    out of its body: the body's signed volume (sum of ``v0 . (v1 x v2)``) is not negative.
-    Meaningful for closed, consistently wound bodies."""
+    """Find the body (edge-connected component) of every face and whether it faces out of it.
+
+    A face's front faces out of its body when the body's signed volume (sum of
+    ``v0 . (v1 x v2)``) is not negative.  Meaningful for closed, consistently wound bodies.
+    """
     labels = _components(soup)
     t = soup.triangles - soup.bounds.mean(axis=0)
     vol = np.bincount(labels, np.einsum("ij,ij->i", t[:, 0], np.cross(t[:, 1], t[:, 2])))
@@ -178,26 +203,41 @@ def _folded_onto_neighbour(soup: Soup, degrees: float = FOLD_DEGREES, max_fan: i
 
 
 def from_closed_mesh(model: Any, name: str | None = None) -> GroundTruth:
-    """The truth of a closed real model: every body outward and outside, nested ones hidden.
+    """Build the truth of a closed real model: every body outward and outside, nested ones hidden.
 
     The model must be closed with consistent winding (every directed edge matched by its
-    reverse once coincident corners are merged), else :class:`ModelError`.  Bodies are
-    the edge-connected components; each is outward where its signed volume is positive.
-    A face whose outward side has winding number ``d`` (of all bodies, its own included)
-    is hidden with layer ``d + 1`` when ``d > 0``: it lies inside another body, or inside
-    a fold of its own body when the surface crosses itself (``cow.obj`` does).  Faces that
-    cross another face, straddle an intersection curve or touch another body's surface
-    are ambiguous (see :func:`_containment`).  For a clean single body this is simply:
-    all faces layer 1, outside on the outward side.
+    reverse once coincident corners are merged).  Bodies are the edge-connected components;
+    each is outward where its signed volume is positive.  A face whose outward side has
+    winding number ``d`` (of all bodies, its own included) is hidden with layer ``d + 1``
+    when ``d > 0``: it lies inside another body, or inside a fold of its own body when the
+    surface crosses itself (``cow.obj`` does).  Faces that cross another face, straddle an
+    intersection curve, touch another body's surface or are folded onto a neighbour (the
+    same surface stored twice) are ambiguous.  For a clean single body this is simply: all
+    faces layer 1, outside on the outward side.
 
     Parameters
     ----------
-    model : Soup, trimesh, (V, F) or path
+    model : Soup, trimesh.Trimesh, (V, F) or path
+        The model, as :func:`meshvis.as_soup` accepts it; its winding is kept.
     name : str, optional
+        Name of the truth; default the file name without extension, or ``"closed_mesh"``.
 
     Returns
     -------
     GroundTruth
+        The truth, faces in the model's order.
+
+    Raises
+    ------
+    ModelError
+        The model is not closed with consistent winding, or cannot be read.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> t = from_closed_mesh(trimesh.creation.icosphere(1), name="ball")
+    >>> t.name, t.n_faces, t.n_layers, bool(t.outward.all())
+    ('ball', 80, 1, True)
     """
     from meshvis.io import as_soup
 

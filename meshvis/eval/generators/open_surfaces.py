@@ -16,16 +16,37 @@ def cup(
     bottom_rings: int = 8,
     wall_rings: int = 16,
 ) -> GroundTruth:
-    """A cup modelled as a single sheet (open top): every face is two-sided.
+    """Build a cup modelled as a single sheet (open top): every face is two-sided.
 
     A surface of revolution about z: a flat bottom disc of ``bottom_rings`` rings and a
     wall flaring from ``radius`` to ``radius * (1 + flare)`` over ``height``.
+
+    Parameters
+    ----------
+    radius : float
+        Radius of the bottom disc.
+    height : float
+        Height of the wall.
+    flare : float
+        How much wider the rim is than the bottom, as a fraction of ``radius``.
+    sections : int
+        Segments around the axis.
+    bottom_rings : int
+        Rings of the bottom disc.
+    wall_rings : int
+        Rings of the wall.
 
     Returns
     -------
     GroundTruth
         Both sides of every face are outside, layer 1, ``two_sided``; the front faces the
         larger open region (away from the axis and downward), so ``outward`` is True.
+
+    Examples
+    --------
+    >>> t = cup(sections=8, bottom_rings=2, wall_rings=2)
+    >>> t.n_faces, bool(t.two_sided.all()), bool(t.outside.all())
+    (56, True, True)
     """
     r = np.concatenate(
         [
@@ -46,7 +67,7 @@ def cup(
 def terrain(
     n: int = 64, size: float = 1.0, amplitude: float = 0.15, bumps: int = 12, seed: int = 0
 ) -> GroundTruth:
-    """A heightfield sheet: open, with no inherent inside; the user names the sides.
+    """Build a heightfield sheet: open, with no inherent inside; the user names the sides.
 
     Heights are a sum of ``bumps`` random Gaussian hills and pits plus a gentle slope.
 
@@ -54,16 +75,26 @@ def terrain(
     ----------
     n : int
         Grid cells per side (``2 n**2`` faces).
-    size, amplitude : float
-        Extent in x and y; height scale.
+    size : float
+        Extent in x and y (the grid spans ``[0, size]``).
+    amplitude : float
+        Height scale: every bump's height is uniform in ``[-amplitude, amplitude]``.
     bumps : int
+        Number of hills and pits.
     seed : int
+        Positions, widths and heights of the bumps.
 
     Returns
     -------
     GroundTruth
         Hints: one inside point below the terrain's centre, one outside point above it.
         Given them, the top side (the front) is outside and the bottom inside; layer 1.
+
+    Examples
+    --------
+    >>> t = terrain(n=4)
+    >>> t.n_faces, sorted(t.hints), t.hints["outside_points"].shape
+    (32, ['inside_points', 'outside_points'], (1, 3))
     """
     rng = np.random.default_rng(seed)
     x = np.linspace(0.0, size, n + 1)

@@ -41,7 +41,7 @@ def _load_mesh(path: Path) -> Soup:
 
 
 def skin_and_ribcage(folder: str | os.PathLike) -> GroundTruth:
-    """The dm_control dog skin with its rib cage inside: real hidden geometry.
+    """Build the truth of the dm_control dog skin with its rib cage inside: real hidden geometry.
 
     Parameters
     ----------
@@ -63,6 +63,9 @@ def skin_and_ribcage(folder: str | os.PathLike) -> GroundTruth:
     ------
     FileNotFoundError
         When either file is missing.
+    ModelError
+        When a file can be read neither by :func:`meshvis.load` nor by trimesh, or the two
+        together are not closed with consistent winding.
     """
     from meshvis.geometry.adjacency import duplicate_faces
 

@@ -1,5 +1,8 @@
-"""Single-sheet boxes: hairline cracks (:func:`cracked_box`) and a real opening
-(:func:`box_with_opening`)."""
+"""Single-sheet boxes with hairline cracks or with a real opening.
+
+:func:`cracked_box` has slits that must not let the outside in; :func:`box_with_opening`
+is a cave whose inside is reachable.
+"""
 
 from __future__ import annotations
 
@@ -21,7 +24,7 @@ def _box_sheet(
     splits: dict | None = None,
     opening: tuple[str, float] | None = None,
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """A single-sheet box surface facing outward, optionally cracked or opened.
+    """Build a single-sheet box surface facing outward, optionally cracked or opened.
 
     Parameters
     ----------
@@ -87,7 +90,7 @@ def cracked_box(
     inner: bool = True,
     seed: int = 0,
 ) -> GroundTruth:
-    """A single-sheet closed box with hairline cracks, and a small box inside it.
+    """Build a single-sheet closed box with hairline cracks, and a small box inside it.
 
     The six sides are separate sheets pulled back from the box edges, leaving slits of
     about ``crack_width`` along all 12 edges; ``face_cracks`` randomly chosen sides are
@@ -96,23 +99,31 @@ def cracked_box(
 
     Parameters
     ----------
-    size : (float, float, float)
+    size : (3,) float
         Box extents, centred on the origin.
     cell : float
         Triangle size.
     crack_width : float
         Width of the slits as a fraction of the box diagonal.
     face_cracks : int
-        Sides (0..6) with an extra crack across them.
+        Sides with an extra crack across them (clipped to 0..6).
     inner : bool
         Put a closed box (30 % of the size) at the centre.
     seed : int
+        Chooses the cracked sides, the direction of each cut and where it falls (30 % to
+        70 % across the side).
 
     Returns
     -------
     GroundTruth
         Cracks are defects: the interior stays inside.  Box sheet: layer 1, front outside.
         Inner box: hidden, layer 2, outward.
+
+    Examples
+    --------
+    >>> t = cracked_box(cell=0.25)
+    >>> t.soup.part_names, t.n_faces, int(t.hidden.sum())
+    (['box', 'inner_box'], 432, 32)
     """
     rng = np.random.default_rng(seed)
     half = 0.5 * np.asarray(size, np.float64)
@@ -141,14 +152,17 @@ def box_with_opening(
     inner: bool = True,
     seed: int = 0,
 ) -> GroundTruth:
-    """A single-sheet box with a large opening in one side: a cave (appendix H, Fig. 7).
+    """Build a single-sheet box with a large opening in one side: a cave (appendix H, Fig. 7).
 
     Parameters
     ----------
-    size, cell : as :func:`cracked_box`.
+    size : (3,) float
+        Box extents, centred on the origin.
+    cell : float
+        Triangle size.
     opening : float
         The opening is a centred rectangle of ``opening`` times the side's width and height
-        (cells whose centre lies in it are removed).
+        (cells whose centre lies in it are removed); in (0, 1).
     side : {"-x", "+x", "-y", "+y", "-z", "+z"}
         The side with the opening.
     crack_width : float
@@ -166,6 +180,17 @@ def box_with_opening(
         the inner box is visible (layer 1, front outside).  For small openings the truth
         stays "reachable"; where a method puts the line between crack and opening is its
         own parameter.
+
+    Raises
+    ------
+    ParameterError
+        An unknown ``side``, or ``opening`` outside (0, 1).
+
+    Examples
+    --------
+    >>> t = box_with_opening(cell=0.25)
+    >>> t.n_faces, t.n_layers, int(t.two_sided.sum())
+    (432, 1, 400)
     """
     if side not in _SIDES:
         raise ParameterError(f"side must be one of {_SIDES}, got {side!r}")

@@ -14,19 +14,19 @@ from .truth import GroundTruth
 def nested_shells(
     n: int = 3, kind: str = "sphere", subdivisions: int = 3, cell: float = 0.1, seed: int = 0
 ) -> GroundTruth:
-    """Concentric closed shells that do not touch: the textbook layer test.
+    """Build concentric closed shells that do not touch: the textbook layer test.
 
     Parameters
     ----------
     n : int
-        Number of shells; radii (or half sizes) shrink linearly from 1 to 0.35.
+        Number of shells, at least 1; radii (or half sizes) shrink linearly from 1 to 0.35.
     kind : {"sphere", "box", "mixed"}
         Icospheres, axis-aligned boxes of half size ``r * (1, 0.8, 0.6)``, or alternating
         spheres and cubes, each inscribed in the previous one, sizes halving per shell.
     subdivisions : int
         Icosphere subdivision level (20 * 4**subdivisions faces per sphere).
     cell : float
-        Box cell size relative to the outer shell's half size.
+        Box cell size relative to the shell's half size.
     seed : int
         Seeds the random rotation of every sphere (so tessellations do not line up).
 
@@ -36,6 +36,19 @@ def nested_shells(
         Shell ``i`` (1 = outermost) is layer ``i``; only shell 1 has an outside side (its
         front); every face is built facing away from the common centre, so ``outward`` is
         all True (layer semantics; the "cavity" reading would turn shells 2.. inward).
+
+    Raises
+    ------
+    ParameterError
+        ``n`` below 1 or an unknown ``kind``.
+
+    Examples
+    --------
+    >>> t = nested_shells(n=2, subdivisions=1)
+    >>> t.n_faces, t.n_layers, int(t.visible.sum())
+    (160, 2, 80)
+    >>> t.soup.part_names
+    ['shell_1', 'shell_2']
     """
     if n < 1:
         raise ParameterError(f"nested_shells needs n >= 1, got {n}")
@@ -67,7 +80,7 @@ def nested_shells(
 
 
 def overlapping_solids(subdivisions: int = 4, cell: float = 0.1, seed: int = 0) -> GroundTruth:
-    """Two closed solids that interpenetrate: a sphere and a box pushed half into it.
+    """Build two closed solids that interpenetrate: a sphere and a box pushed half into it.
 
     Parameters
     ----------
@@ -85,6 +98,12 @@ def overlapping_solids(subdivisions: int = 4, cell: float = 0.1, seed: int = 0) 
         just off each face: faces inside the other solid are hidden (layer 2), the rest are
         one-sided with the front outside (layer 1).  Faces that straddle the intersection
         curve are ``ambiguous``.
+
+    Examples
+    --------
+    >>> t = overlapping_solids(subdivisions=1, cell=0.5)
+    >>> t.soup.part_names, t.n_layers, t.check()
+    (['sphere', 'box'], 2, [])
     """
     rng = np.random.default_rng(seed)
     sV, sF = _icosphere(subdivisions, 1.0, rotation=_random_rotation(rng))
@@ -101,16 +120,34 @@ def overlapping_solids(subdivisions: int = 4, cell: float = 0.1, seed: int = 0) 
 def sphere_pair(
     subdivisions: int = 4, crack: int = 6, inner_radius: float = 0.5, seed: int = 0
 ) -> GroundTruth:
-    """An outer sphere with a small hole of ``crack`` missing faces, and an inner sphere.
+    """Build an outer sphere with a small hole of ``crack`` missing faces, and an inner sphere.
 
     The hole is the ``crack`` faces nearest to a random vertex (its one-ring for 6 on a
     regular vertex).
+
+    Parameters
+    ----------
+    subdivisions : int
+        Icosphere level of the outer sphere (radius 1); the inner sphere is one level
+        coarser, at least level 1.
+    crack : int
+        Faces removed from the outer sphere.
+    inner_radius : float
+        Radius of the inner sphere.
+    seed : int
+        Chooses the vertex of the hole and rotates both tessellations.
 
     Returns
     -------
     GroundTruth
         The hole is a defect (DESIGN.md §4: small cracks must not let the outside in):
         outer sphere layer 1, front outside; inner sphere hidden, layer 2, outward.
+
+    Examples
+    --------
+    >>> t = sphere_pair(subdivisions=2)
+    >>> t.n_faces, int(t.hidden.sum())
+    (394, 80)
     """
     rng = np.random.default_rng(seed)
     V, F = _icosphere(subdivisions, 1.0, rotation=_random_rotation(rng))

@@ -78,14 +78,38 @@ def soupify(
     Parameters
     ----------
     truth : GroundTruth
-    flip, duplicate : float in [0, 1]
-    unweld, shuffle : bool
+        The model and its truth (not modified).
+    flip : float
+        Fraction of the faces to turn over, in [0, 1].
+    unweld : bool
+        Give every face its own three vertices.
+    shuffle : bool
+        Shuffle the face order and rotate the corners of every face.
+    duplicate : float
+        Fraction of the faces to store twice, in [0, 1].
     holes : int
+        Number of small holes to punch, at least 0.
     seed : int
+        Seeds every random choice (holes, duplicates, flips, order).
 
     Returns
     -------
     GroundTruth
+        The soup and its truth, named ``<name>_soup``; the notes list the steps applied.
+
+    Raises
+    ------
+    ParameterError
+        ``flip`` or ``duplicate`` outside [0, 1], or ``holes`` negative.
+
+    Examples
+    --------
+    >>> from meshvis.eval.generators import nested_shells
+    >>> t = soupify(nested_shells(n=2, subdivisions=1), flip=0.5, seed=0)
+    >>> t.name, t.n_faces, int(t.flipped.sum()), len(t.soup.vertices)
+    ('nested_shells_soup', 160, 80, 480)
+    >>> t.check()
+    []
     """
     for nm, v in (("flip", flip), ("duplicate", duplicate)):
         if not 0.0 <= v <= 1.0:

@@ -54,6 +54,7 @@ class GroundTruth:
     flipped: np.ndarray | None = None
 
     def __post_init__(self) -> None:
+        """Broadcast the truth arrays to their per-face shapes and fill in the defaults."""
         m = self.soup.n_faces
         self.outside = np.array(np.broadcast_to(np.asarray(self.outside, bool), (m, 2)))
         self.layer = np.array(np.broadcast_to(np.asarray(self.layer, np.int64), (m,)))
@@ -81,6 +82,7 @@ class GroundTruth:
     # ------------------------------------------------------------------ views
     @property
     def n_faces(self) -> int:
+        """Number of faces of the model."""
         return self.soup.n_faces
 
     @property
@@ -95,14 +97,20 @@ class GroundTruth:
 
     @property
     def n_layers(self) -> int:
+        """Deepest layer (0 for a model without faces)."""
         return int(self.layer.max()) if self.n_faces else 0
 
     def check(self) -> list[str]:
-        """The list of broken invariants (empty when the truth is self-consistent).
+        """List the broken invariants (empty when the truth is self-consistent).
 
         Invariants: layers start at 1; layer 1 holds exactly the faces with an outside
         side; a visible one-sided face has exactly one outside side, the outward one; a
         visible two-sided face has both sides outside.
+
+        Returns
+        -------
+        list of str
+            One message per broken invariant.
         """
         problems = []
         if self.n_faces and self.layer.min() < 1:
@@ -121,7 +129,19 @@ class GroundTruth:
 
     # ------------------------------------------------------------------ derived truths
     def subset(self, index: np.ndarray) -> GroundTruth:
-        """The truth of the faces ``index`` (mask or integer array; repeats allowed)."""
+        """Take the truth of the faces ``index``.
+
+        Parameters
+        ----------
+        index : (m,) bool or (k,) int
+            A face mask, or face indices (repeats allowed).
+
+        Returns
+        -------
+        GroundTruth
+            The chosen faces with their truth; ``origin_face`` and ``flipped`` follow them, the
+            hints are kept.
+        """
         index = np.asarray(index)
         if index.dtype == bool:
             index = np.flatnonzero(index)
@@ -139,10 +159,20 @@ class GroundTruth:
         )
 
     def flip_faces(self, flip: np.ndarray) -> GroundTruth:
-        """The truth with the faces where ``flip`` is True turned over.
+        """Turn over the faces where ``flip`` is True.
 
         Turning a face over swaps its sides, so the two ``outside`` columns swap and
-        ``outward`` toggles.
+        ``outward`` toggles (and so does ``flipped``).
+
+        Parameters
+        ----------
+        flip : (m,) bool
+            The faces to turn over.
+
+        Returns
+        -------
+        GroundTruth
+            A new truth; this one is not modified.
         """
         flip = np.asarray(flip, bool).reshape(self.n_faces)
         return replace(
@@ -159,13 +189,33 @@ class GroundTruth:
         )
 
     def oriented(self) -> Soup:
-        """The soup with every face turned so that its front faces outward (the ideal output
-        of normal orientation)."""
+        """Turn every face so that its front faces outward (the ideal output of normal orientation).
+
+        Returns
+        -------
+        Soup
+            The model with the faces whose ``outward`` is False turned over.
+        """
         return self.soup.flipped(~self.outward)
 
     @classmethod
     def concatenate(cls, truths: Sequence[GroundTruth], name: str = "", notes: str = "") -> GroundTruth:
-        """One truth from several (parts are kept apart, hints are merged)."""
+        """Join several truths into one (parts are kept apart, hints are merged).
+
+        Parameters
+        ----------
+        truths : sequence of GroundTruth
+            The truths, in order.
+        name : str
+            Name of the result; default the names joined by ``+``.
+        notes : str
+            What the joined model tests.
+
+        Returns
+        -------
+        GroundTruth
+            The faces of all truths in order; ``origin_face`` is offset by the faces before.
+        """
         truths = list(truths)
         offsets = np.cumsum([0] + [t.n_faces for t in truths[:-1]])
         hints: dict[str, list] = {}
@@ -191,7 +241,13 @@ class GroundTruth:
         """Write the truth arrays (not the geometry) to a compressed ``.npz`` file.
 
         The arrays are indexed like the soup's faces; pair the file with the model file
-        written from the same soup (faces in the same order).
+        written from the same soup (faces in the same order).  Identical truths give identical
+        files, and the file appears only once complete.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The ``.npz`` file to write.
         """
         arrays = dict(
             outside=self.outside,
@@ -212,7 +268,27 @@ class GroundTruth:
 
     @classmethod
     def load_arrays(cls, path: str | os.PathLike, soup: Soup) -> GroundTruth:
-        """Pair truth arrays written by :meth:`save_arrays` with a soup loaded from the model file."""
+        """Pair truth arrays written by :meth:`save_arrays` with a soup loaded from the model file.
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The ``.npz`` file.
+        soup : Soup
+            The model, faces in the order the arrays were written in.
+
+        Returns
+        -------
+        GroundTruth
+            The truth of ``soup``.
+
+        Raises
+        ------
+        ModelError
+            The file holds the truth of another number of faces.
+        FileNotFoundError
+            The file does not exist.
+        """
         with np.load(os.fspath(path), allow_pickle=False) as z:
             if len(z["layer"]) != soup.n_faces:
                 raise ModelError(
@@ -234,6 +310,7 @@ class GroundTruth:
             )
 
     def __repr__(self) -> str:
+        """Show the name and the counts of faces, visible faces, layers and parts on one line."""
         return (
             f"<GroundTruth {self.name!r}: {self.n_faces} faces, {int(self.visible.sum())} visible, "
             f"{self.n_layers} layers, {self.soup.n_parts} parts>"
@@ -241,7 +318,7 @@ class GroundTruth:
 
 
 def _write_npz(path: str, arrays: dict[str, np.ndarray]) -> None:
-    """A compressed ``.npz`` that is identical byte for byte for identical arrays.
+    """Write a compressed ``.npz`` that is identical byte for byte for identical arrays.
 
     ``numpy.savez_compressed`` stamps every member with the current time; here every
     member gets a fixed date.  Written to a temporary file, then renamed.
