@@ -1,6 +1,6 @@
 """Baselines: what a user would run instead of meshvis, wrapped behind one signature.
 
-Every function takes a model (anything :func:`meshvis.soup.as_soup` accepts) and keyword
+Every function takes a model (anything :func:`meshvis.as_soup` accepts) and keyword
 knobs, and returns a :class:`BaselineResult` with one value per **input** face and the
 wall time of the call.  Each function answers one task:
 
@@ -85,10 +85,35 @@ class BaselineResult:
 
 
 def welded(model: Any) -> tuple[np.ndarray, np.ndarray]:
-    """Compact welded ``(vertices, faces)`` of a model, faces in input order.
+    """Weld a model into compact ``(vertices, faces)``, faces in input order.
 
     Corners closer than :data:`meshvis.geometry.adjacency.WELD_TOL` × diagonal are merged; each
     welded vertex takes the position of one of its input corners.
+
+    Parameters
+    ----------
+    model : Soup, trimesh.Trimesh, (V, F) or path
+        The model, as :func:`meshvis.as_soup` accepts it.
+
+    Returns
+    -------
+    vertices : (k, 3) float64
+        The welded vertices, each used by some face.
+    faces : (m, 3) int64
+        The input faces, as indices into ``vertices``.
+
+    Raises
+    ------
+    ModelError
+        The model cannot be used (see :func:`meshvis.as_soup`).
+
+    Examples
+    --------
+    >>> import numpy as np, trimesh
+    >>> cube = trimesh.creation.box()
+    >>> V, F = welded((cube.triangles.reshape(-1, 3), np.arange(36).reshape(-1, 3)))  # a soup
+    >>> V.shape, F.shape
+    ((8, 3), (12, 3))
     """
     soup = as_soup(model)
     index, faces = weld(soup.vertices, soup.faces)
@@ -99,8 +124,10 @@ def welded(model: Any) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _turned(before: np.ndarray, after: np.ndarray) -> np.ndarray:
-    """(m,) bool: rows of ``after`` that are not a cyclic rotation of the rows of ``before``
-    (the face was written with the opposite winding)."""
+    """Find the rows of ``after`` that are not a cyclic rotation of the rows of ``before``.
+
+    (m,) bool: such a face was written with the opposite winding.
+    """
     same = np.zeros(len(before), bool)
     for k in range(3):
         same |= (np.roll(before, k, axis=1) == after).all(axis=1)
@@ -116,7 +143,7 @@ def _failed(method: str, task: str, t0: float, exc: BaseException, params: dict)
 def libigl_reorient(
     model: Any, *, rays_total: int | None = None, rays_minimum: int = 10, facet_wise: bool = False
 ) -> BaselineResult:
-    """libigl's ray-cast reorientation (Takayama et al. 2014) on the welded model.
+    """Orient by libigl's ray casting (Takayama et al. 2014) on the welded model.
 
     Faces are grouped into manifold patches that are oriented consistently; each patch is
     then turned so that its front is the less occluded side, judged by ``rays_total``
@@ -124,14 +151,20 @@ def libigl_reorient(
 
     Parameters
     ----------
-    model : the input
-    rays_total : total rays; None = libigl's default, 100 × number of faces
-    rays_minimum : rays per patch at least
-    facet_wise : decide every face on its own (no patches)
+    model : Soup, trimesh.Trimesh, (V, F) or path
+        The input, as :func:`meshvis.as_soup` accepts it.
+    rays_total : int, optional
+        Total rays; None for libigl's default, 100 × the number of faces.
+    rays_minimum : int
+        Rays per patch at least.
+    facet_wise : bool
+        Decide every face on its own (no patches).
 
     Returns
     -------
-    BaselineResult with ``values`` = flipped (m,) bool
+    BaselineResult
+        ``values`` = flipped, (m,) bool; ``ok=False`` with the message when the library
+        (or reading the model) failed.
     """
     params = {"rays_total": rays_total, "rays_minimum": rays_minimum, "facet_wise": facet_wise}
     t0 = time.perf_counter()
@@ -153,12 +186,33 @@ def libigl_reorient(
 
 
 def trimesh_fix_normals(model: Any, *, multibody: bool = True) -> BaselineResult:
-    """trimesh's winding repair: consistent winding per body, then every body turned so
-    that its signed volume is positive (``multibody=True``; else only the whole mesh).
+    """Orient by trimesh's winding repair on the welded model.
+
+    The winding is made consistent per body, then every body is turned so that its signed
+    volume is positive (``multibody=True``; else only the whole mesh is).
+
+    Parameters
+    ----------
+    model : Soup, trimesh.Trimesh, (V, F) or path
+        The input, as :func:`meshvis.as_soup` accepts it.
+    multibody : bool
+        Turn every body on its own rather than the whole mesh.
 
     Returns
     -------
-    BaselineResult with ``values`` = flipped (m,) bool
+    BaselineResult
+        ``values`` = flipped, (m,) bool; ``ok=False`` with the message when the library
+        failed or changed the face count.
+
+    Examples
+    --------
+    >>> import numpy as np, trimesh
+    >>> cube = trimesh.creation.box()
+    >>> faces = cube.faces.copy()
+    >>> faces[0] = faces[0, ::-1]  # one face wound the wrong way
+    >>> r = trimesh_fix_normals((cube.vertices, faces))
+    >>> r.ok, np.flatnonzero(r.values).tolist()
+    (True, [0])
     """
     params = {"multibody": multibody}
     t0 = time.perf_counter()
@@ -197,12 +251,31 @@ def _meshlab(V: np.ndarray, F: np.ndarray):
 
 
 def pymeshlab_reorient(model: Any, *, rays: int = 64, parity_sampling: bool = False) -> BaselineResult:
-    """MeshLab's "re-orient faces by geometry" (``meshing_re_orient_faces_by_geometry``):
-    ray-cast orientation like libigl's, ``rays`` per patch.
+    """Orient by MeshLab's "re-orient faces by geometry" on the welded model.
+
+    ``meshing_re_orient_faces_by_geometry`` casts rays as libigl's reorientation does
+    (Takayama et al. 2014), ``rays`` from the centroid of every face.
+
+    Parameters
+    ----------
+    model : Soup, trimesh.Trimesh, (V, F) or path
+        The input, as :func:`meshvis.as_soup` accepts it.
+    rays : int
+        Rays cast from the centroid of every face.
+    parity_sampling : bool
+        Decide by parity sampling (the parity of the hits along each ray) instead of
+        visibility sampling.
 
     Returns
     -------
-    BaselineResult with ``values`` = flipped (m,) bool
+    BaselineResult
+        ``values`` = flipped, (m,) bool; ``ok=False`` with the message when the library
+        failed or changed the face count.
+
+    Raises
+    ------
+    MissingExtraError
+        pymeshlab (the ``bench`` extra) is not installed.
     """
     params = {"rays": rays, "parity_sampling": parity_sampling}
     require_baselines()  # a missing library is the user's to fix, not a failed run
@@ -223,17 +296,35 @@ def pymeshlab_reorient(model: Any, *, rays: int = 64, parity_sampling: bool = Fa
 
 # ============================================================================ inside removal
 def pymeshlab_ao(model: Any, *, rays: int = 64, both_sides: bool = False) -> BaselineResult:
-    """Ambient occlusion in MeshLab (``compute_scalar_ambient_occlusion``, per-face quality
-    ``fq`` = light reaching the face from ``rays`` directions), then remove the faces with
-    ``fq == 0`` (``compute_selection_by_condition_per_face``).
+    """Remove the faces no light reaches, by ambient occlusion in MeshLab.
+
+    ``compute_scalar_ambient_occlusion`` sets the per-face quality ``fq`` to the light
+    reaching the face from ``rays`` directions; the faces with ``fq == 0`` are removed
+    (``compute_selection_by_condition_per_face``).
 
     MeshLab lights a face on its front side only, so a face whose front points inward is
     never lit.  ``both_sides=True`` runs the occlusion on the model plus a turned-over copy
     and keeps a face lit on either side: the fair variant for soups with random winding.
 
+    Parameters
+    ----------
+    model : Soup, trimesh.Trimesh, (V, F) or path
+        The input, as :func:`meshvis.as_soup` accepts it.
+    rays : int
+        Light directions of the occlusion.
+    both_sides : bool
+        Light both sides of every face (method name ``pymeshlab_ao_2sided``).
+
     Returns
     -------
-    BaselineResult with ``values`` = keep (m,) bool
+    BaselineResult
+        ``values`` = keep, (m,) bool; ``ok=False`` with the message when the library failed
+        or changed the face count.
+
+    Raises
+    ------
+    MissingExtraError
+        pymeshlab (the ``bench`` extra) is not installed.
     """
     params = {"rays": rays, "both_sides": both_sides}
     method = "pymeshlab_ao_2sided" if both_sides else "pymeshlab_ao"
@@ -275,17 +366,27 @@ def _peel_main(in_path: str, out_path: str) -> None:  # pragma: no cover - runs 
 
 
 def libigl_peel(model: Any, *, timeout: float = 300.0) -> BaselineResult:
-    """libigl's outer-hull peeling (CGAL, exact): layer k is the outer hull of what is
-    left once layers 1 … k-1 are gone.
+    """Peel layers by libigl's outer-hull peeling (CGAL, exact).
 
-    The peel assumes a piecewise-constant-winding (closed, possibly self-intersecting)
-    input; on other input CGAL may throw or abort the process.  It therefore runs in a
-    separate Python process with a time limit; the reported time is the welding plus the
-    library call timed inside the worker (not the worker's start-up).
+    Layer k is the outer hull of what is left once layers 1 … k-1 are gone.  The peel
+    assumes a piecewise-constant-winding (closed, possibly self-intersecting) input; on
+    other input CGAL may throw or abort the process.  It therefore runs in a separate
+    Python process with a time limit; the reported time is the welding plus the library
+    call timed inside the worker (not the worker's start-up).
+
+    Parameters
+    ----------
+    model : Soup, trimesh.Trimesh, (V, F) or path
+        The input, as :func:`meshvis.as_soup` accepts it.
+    timeout : float
+        Seconds to wait for the worker process.
 
     Returns
     -------
-    BaselineResult with ``values`` = layer (m,) int64 (1 = outer)
+    BaselineResult
+        ``values`` = layer, (m,) int64 (1 = outer), with the number of layers in
+        ``params["layers"]``; ``ok=False`` with the message when the library failed, the
+        worker died or gave no answer within ``timeout``.
     """
     import subprocess
     import sys
@@ -360,7 +461,20 @@ class Baseline:
     fixed: dict = field(default_factory=dict)
 
     def knob_value(self, x: float, n_faces: int) -> int:
-        """The knob's argument for sweep value ``x`` on a model of ``n_faces`` faces."""
+        """Convert sweep value ``x`` into the knob's argument for a model of ``n_faces`` faces.
+
+        Parameters
+        ----------
+        x : float
+            A value of :attr:`sweep` (a multiple of the face count when :attr:`per_face`).
+        n_faces : int
+            Faces of the model.
+
+        Returns
+        -------
+        int
+            ``round(x * n_faces)`` (at least 1) when :attr:`per_face`, else ``int(x)``.
+        """
         return max(1, int(round(x * n_faces))) if self.per_face else int(x)
 
 
