@@ -65,10 +65,32 @@ def sweep(
 ) -> tuple[list[C.Point], list[str]]:
     """Measure every method at every budget on every case (real ones read from ``models_dir``).
 
+    Parameters
+    ----------
+    cases : iterable of Case
+        The inputs (:mod:`meshvis.eval.bench.cases`).
+    quick : bool
+        Use the short sweeps (:data:`RAYS_QUICK`, :data:`QUICK_SWEEPS`).
+    seed : int
+        Seed of meshvis' classification.
+    peel_timeout : float
+        Time limit in seconds of one CGAL peel.
+    log : callable
+        Receives a progress line per case and per run.
+    models_dir : str or os.PathLike
+        The folder of the real models.
+
     Returns
     -------
-    points : list of :class:`~meshvis.eval.bench.cases.Point`
-    skipped : one line per case that could not be built (missing real model)
+    points : list of Point
+        One scored run per method, budget, case and task.
+    skipped : list of str
+        One line per case that could not be built (missing real model).
+
+    Raises
+    ------
+    ParameterError
+        A real case is asked for and ``models_dir`` is not a folder.
     """
     points: list[C.Point] = []
     skipped: list[str] = []
@@ -114,6 +136,15 @@ def sweep(
 
 # ====================================================================== outputs
 def write_csv(path: str, points: list[C.Point]) -> None:
+    """Write the points to ``path`` as CSV, one row per point (floats to 6 significant digits).
+
+    Parameters
+    ----------
+    path : str
+        The CSV file, written atomically.
+    points : list of Point
+        The points.
+    """
     from meshvis.io import atomic_write
 
     rows = [p.row() for p in points]
@@ -126,7 +157,18 @@ def write_csv(path: str, points: list[C.Point]) -> None:
 
 
 def read_csv(path: str) -> list[C.Point]:
-    """The points of an ``accuracy.csv`` written by :func:`write_csv` (to redraw charts)."""
+    """Read the points of an ``accuracy.csv`` written by :func:`write_csv` (to redraw charts).
+
+    Parameters
+    ----------
+    path : str
+        The CSV file.
+
+    Returns
+    -------
+    list of Point
+        The points, fields converted back to their types (``extra`` empty).
+    """
     kinds = {f.name: f.type for f in C.Point.__dataclass_fields__.values()}
     points = []
     with open(path, newline="") as fh:
@@ -168,7 +210,19 @@ STYLE = {
 
 
 def plot_task(path: str, task: str, points: list[C.Point]) -> None:
-    """One PNG: a panel per case, error (log) against time (log), one curve per method."""
+    """Draw one PNG: a panel per case, error (log) against time (log), one curve per method.
+
+    Exact answers (error 0) are drawn on the floor line :data:`FLOOR`.
+
+    Parameters
+    ----------
+    path : str
+        The PNG file, written atomically.
+    task : {"orient", "remove", "layers"}
+        The task to draw.
+    points : list of Point
+        All points; those of other tasks and failed runs are left out.
+    """
     import matplotlib
 
     matplotlib.use("Agg")
@@ -229,13 +283,24 @@ def plot_task(path: str, task: str, points: list[C.Point]) -> None:
 def dominance(points: list[C.Point], task: str, case: str) -> tuple[list[str], list[str]]:
     """Compare meshvis' sweep with every baseline point of one task on one case.
 
+    Parameters
+    ----------
+    points : list of Point
+        All points.
+    task : str
+        The task.
+    case : str
+        The case's name.
+
     Returns
     -------
-    beaten : baseline points with a lower error than any meshvis point at most as slow
-        (meshvis' curve lies above them), one line each
-    earlier : baseline points faster than meshvis' fastest point where meshvis' fastest
-        point is at least as accurate (the curves do not overlap in time; meshvis is not
-        worse, only later), one line each
+    beaten : list of str
+        Baseline points with a lower error than any meshvis point at most as slow
+        (meshvis' curve lies above them), one line each.
+    earlier : list of str
+        Baseline points faster than meshvis' fastest point where meshvis' fastest point is
+        at least as accurate (the curves do not overlap in time; meshvis is not worse, only
+        later), one line each.
     """
     mv = [p for p in points if p.case == case and p.task == task and p.method == "meshvis" and p.ok]
     beaten, earlier = [], []
@@ -262,7 +327,26 @@ def dominance(points: list[C.Point], task: str, case: str) -> tuple[list[str], l
 
 
 def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: str, seconds: float) -> str:
-    """The report: machine, command, one table per task, and the curve check."""
+    """Write the report: machine, command, one table per task, and the curve check.
+
+    Parameters
+    ----------
+    points : list of Point
+        All points.
+    skipped : list of str
+        One line per skipped case.
+    machine : dict
+        A result of :func:`~meshvis.eval.bench.cases.machine`.
+    command : str
+        The command that produced the numbers.
+    seconds : float
+        Wall time of the sweep.
+
+    Returns
+    -------
+    str
+        The Markdown text of ``accuracy.md``.
+    """
     lines = C.report_head("meshvis bench accuracy", command, seconds, machine, skipped)
     for task in TASKS:
         pts = [p for p in points if p.task == task]
@@ -320,6 +404,13 @@ def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: 
 
 # ====================================================================== command
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the options of ``meshvis bench accuracy`` to its parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The parser of the benchmark.
+    """
     p.add_argument(
         "--out", required=True, metavar="DIR", help="folder for the CSV, charts and table (created)"
     )
@@ -344,7 +435,23 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def prepare_out(out: str, names: tuple[str, ...], force: bool) -> None:
-    """Create ``out``; refuse to overwrite earlier results in it without ``force``."""
+    """Create ``out``; refuse to overwrite earlier results in it without ``force``.
+
+    Parameters
+    ----------
+    out : str
+        The output folder.
+    names : tuple of str
+        The files the benchmark writes there.
+    force : bool
+        Allow replacing them.
+
+    Raises
+    ------
+    OutputError
+        ``out`` cannot be created or written, or holds one of ``names`` while ``force`` is
+        False.
+    """
     from meshvis.io import ensure_folder
 
     ensure_folder(out)
@@ -354,6 +461,30 @@ def prepare_out(out: str, names: tuple[str, ...], force: bool) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    """Run ``meshvis bench accuracy`` and write :data:`OUTPUTS` into ``--out``.
+
+    Progress goes to standard error and the Markdown report to standard output, unless
+    ``--quiet``.  ``--quick`` also caps the CGAL peel at 60 s.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The options of :func:`add_arguments`.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    MissingExtraError
+        pymeshlab (the ``bench`` extra) is not installed.
+    ParameterError
+        An unknown case, or no folder of real models when a real case is asked for.
+    OutputError
+        ``--out`` cannot be written, or holds earlier results and ``--force`` is not given.
+    """
     require_baselines()
     chosen = C.select_cases(args.cases, C.QUICK if args.quick else tuple(C.CASES))
     prepare_out(args.out, OUTPUTS, args.force)

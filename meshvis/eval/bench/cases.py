@@ -108,7 +108,26 @@ HIDDEN_SHELL_CASES = ("sphere_pair", "nested_shells", "cracked_box", "skin_ribca
 
 
 def select_cases(names: str | None, default: tuple[str, ...]) -> list[Case]:
-    """Cases named in a comma-separated list (or ``default``); unknown names are an error."""
+    """Look up the cases named in a comma-separated list.
+
+    Parameters
+    ----------
+    names : str or None
+        Comma-separated case names (blanks around names ignored); None or empty for
+        ``default``.
+    default : tuple of str
+        The names used when ``names`` gives none.
+
+    Returns
+    -------
+    list of Case
+        The cases, in the order named.
+
+    Raises
+    ------
+    ParameterError
+        A name that is not a key of :data:`CASES`.
+    """
     from meshvis.errors import ParameterError
 
     wanted = [n.strip() for n in names.split(",") if n.strip()] if names else list(default)
@@ -119,10 +138,33 @@ def select_cases(names: str | None, default: tuple[str, ...]) -> list[Case]:
 
 
 def built_cases(cases, skipped: list[str], log, models_dir: str | os.PathLike = DEFAULT_MODELS):
-    """Yield ``(case, truth)`` for every case that can be built; the others are logged and
-    appended to ``skipped`` (a missing real model is not an error of the benchmark, a
-    missing folder of real models is: :class:`~meshvis.errors.ParameterError` before the
-    first case, when any case is real)."""
+    """Build the cases one by one, yielding those that can be built.
+
+    A case that cannot be built (a missing real model) is logged and listed in ``skipped``:
+    it is not an error of the benchmark.  A missing folder of real models is, as soon as
+    any case is real, before the first case is built.
+
+    Parameters
+    ----------
+    cases : iterable of Case
+        The cases, in order.
+    skipped : list of str
+        Receives one line per case that was skipped, with the reason.
+    log : callable
+        Receives one line per case (its face count, or why it was skipped).
+    models_dir : str or os.PathLike
+        The folder of the real models.
+
+    Yields
+    ------
+    tuple of (Case, GroundTruth)
+        Every case that was built, with its truth.
+
+    Raises
+    ------
+    ParameterError
+        Some case is real and ``models_dir`` is not a folder.
+    """
     cases = list(cases)
     if any(case.real for case in cases):
         models_folder(models_dir)
@@ -137,8 +179,29 @@ def built_cases(cases, skipped: list[str], log, models_dir: str | os.PathLike = 
 
 
 def load_case(case: Case, models_dir: str | os.PathLike = DEFAULT_MODELS) -> tuple[GroundTruth | None, str]:
-    """Build a case's truth (a real one from ``models_dir``); ``(None, reason)`` when a real
-    model is missing or unusable."""
+    """Build a case's truth (a real one from ``models_dir``).
+
+    Parameters
+    ----------
+    case : Case
+        The case.
+    models_dir : str or os.PathLike
+        The folder of the real models (read for real cases only).
+
+    Returns
+    -------
+    truth : GroundTruth or None
+        The truth; None when a real model is missing or its truth cannot be built.
+    reason : str
+        Why the case was skipped; empty when it was built.
+
+    Raises
+    ------
+    ParameterError
+        The case is real and ``models_dir`` is not a folder.
+    Exception
+        Whatever a generated (not real) case's builder raises.
+    """
     try:
         return (case.build(models_folder(models_dir)) if case.real else case.build()), ""
     except FileNotFoundError as exc:
@@ -173,13 +236,26 @@ class Point:
     extra: dict = field(default_factory=dict)
 
     def row(self) -> dict:
+        """Give the point as a flat dictionary (a CSV row): every field but ``extra``.
+
+        Returns
+        -------
+        dict
+            Field name -> value.
+        """
         d = asdict(self)
         d.pop("extra")
         return d
 
 
 def load1() -> float:
-    """1-minute load average (0.0 where the OS does not report it)."""
+    """Read the 1-minute load average.
+
+    Returns
+    -------
+    float
+        The load average; 0.0 where the OS does not report it.
+    """
     try:
         return float(os.getloadavg()[0])
     except (OSError, AttributeError):
@@ -187,12 +263,33 @@ def load1() -> float:
 
 
 def score(truth: GroundTruth, task: str, values: np.ndarray | None) -> dict:
-    """Errors of a per-face result: ``error`` (the charted number) and the task's extras.
+    """Score a per-face result against the truth: ``error`` (the charted number) and the task's extras.
 
     orient: ``error`` = area-weighted misoriented fraction, ``error_hidden`` = the same on
     faces of layer 2 and deeper (NaN when there are none); remove: ``error`` = area
     decided wrongly, plus ``precision`` and ``recall``; layers: ``error`` = area in the
     wrong layer.
+
+    Parameters
+    ----------
+    truth : GroundTruth
+        The case's truth.
+    task : {"orient", "remove", "layers"}
+        What ``values`` answers.
+    values : (m,) ndarray or None
+        ``flipped`` (bool), ``keep`` (bool) or ``layer`` (int) per face; None for a failed
+        run.
+
+    Returns
+    -------
+    dict
+        The fields of :class:`Point` to set: ``error`` (NaN for a failed run) and the
+        task's extras.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``task``.
     """
     nan = float("nan")
     if values is None:
@@ -214,13 +311,33 @@ def score(truth: GroundTruth, task: str, values: np.ndarray | None) -> dict:
 def meshvis_run(
     truth: GroundTruth, tasks: tuple[str, ...], *, seed: int = 0, share: bool = True, **classify_kw
 ) -> dict[str, tuple[float, np.ndarray, dict]]:
-    """Run meshvis' applications on a case; per task ``(seconds, values, info)``.
+    """Run meshvis' applications on a case and time each.
 
     With ``share`` the classification is computed once and its time is added to every
     task's own time (what a user pays for each command alone, without paying the
     classification three times in the benchmark); without, every task runs end to end
     (``orient(soup)``, ``remove_interior(soup)``, ``layers(soup)``), as the commands do.
     The generator's side hints, if any, are passed on.
+
+    Parameters
+    ----------
+    truth : GroundTruth
+        The case; its soup is the input and its hints are used.
+    tasks : tuple of str
+        Among "orient", "remove" and "layers" (any other name runs the layers).
+    seed : int
+        Seed of the classification.
+    share : bool
+        Classify once for all tasks.
+    **classify_kw
+        Passed to :func:`meshvis.classify` (``rays_per_node``, ``progressive``, ...).
+
+    Returns
+    -------
+    dict
+        Task -> ``(seconds, values, info)``: the time including the classification, the
+        per-face answer (``flipped``, ``keep`` or ``layer``) and ``{"rays", "rounds"}`` of the
+        classification used.
     """
     from meshvis.graphcut.classify import classify
     from meshvis.repair.layers import layers
@@ -256,7 +373,35 @@ def meshvis_run(
 def baseline_point(
     truth: GroundTruth, case: str, name: str, value: float | None, *, timeout: float = 300.0
 ) -> Point:
-    """Run baseline ``name`` with its knob at sweep ``value`` (None: library default) and score it."""
+    """Run baseline ``name`` with its knob at sweep ``value`` and score it.
+
+    Parameters
+    ----------
+    truth : GroundTruth
+        The case; the baseline runs on its soup.
+    case : str
+        The case's name, recorded in the point.
+    name : str
+        A key of :data:`meshvis.eval.baselines.BASELINES`.
+    value : float or None
+        The sweep value of the baseline's knob (see :meth:`Baseline.knob_value`); None for
+        the library's default.
+    timeout : float
+        Time limit in seconds of the CGAL peel's worker (``libigl_peel`` only).
+
+    Returns
+    -------
+    Point
+        The scored run; ``ok=False`` with the library's message (and NaN errors) when it
+        failed.
+
+    Raises
+    ------
+    KeyError
+        ``name`` is not a baseline.
+    MissingExtraError
+        A MeshLab baseline without pymeshlab installed.
+    """
     b: Baseline = BASELINES[name]
     kw = dict(b.fixed)
     if b.knob is not None and value is not None:
@@ -284,8 +429,11 @@ def baseline_point(
 
 
 def warm_up() -> None:
-    """Run every method once on a tiny model so that library start-up (Embree devices,
-    imports) is not charged to the first measured run."""
+    """Run every method once on a tiny model, so that start-up is not charged to a measured run.
+
+    Library start-up (Embree devices, imports) then happens here; the CGAL peel, which runs
+    in its own process anyway, is left out.
+    """
     import trimesh
 
     from meshvis.graphcut.classify import classify
@@ -300,7 +448,14 @@ def warm_up() -> None:
 
 # ====================================================================== machine
 def machine() -> dict:
-    """Where the numbers come from: CPU, cores, OS, Python and library versions, load."""
+    """Describe where the numbers come from: CPU, cores, OS, Python and library versions, load.
+
+    Returns
+    -------
+    dict
+        ``cpu``, ``cores``, ``os``, ``python``, ``meshvis``, ``versions`` (library ->
+        version, or "missing") and ``load_average`` (1, 5 and 15 minutes).
+    """
     cpu = platform.processor() or platform.machine()
     try:
         with open("/proc/cpuinfo") as fh:
@@ -342,7 +497,18 @@ def _dist_version(mod: str) -> str:
 
 
 def machine_lines(m: dict) -> list[str]:
-    """Markdown bullet lines describing :func:`machine`'s result."""
+    """Describe a :func:`machine` result as Markdown bullet lines.
+
+    Parameters
+    ----------
+    m : dict
+        A result of :func:`machine`.
+
+    Returns
+    -------
+    list of str
+        Three bullet lines: CPU and OS, versions, load average at the start.
+    """
     v = ", ".join(f"{k} {x}" for k, x in m["versions"].items())
     return [
         f"- CPU: {m['cpu']}, {m['cores']} logical cores; {m['os']}",
@@ -353,9 +519,18 @@ def machine_lines(m: dict) -> list[str]:
 
 
 def shared_legend(fig, axes, fontsize: int, ncol: int | None = None) -> None:
-    """One legend below the panels of ``fig``: every labelled line of ``axes`` once, in order.
+    """Draw one legend below the panels of ``fig``: every labelled line of ``axes`` once, in order.
 
-    ``ncol`` columns (default: one per entry, at most 4).
+    Parameters
+    ----------
+    fig : matplotlib.figure.Figure
+        The figure.
+    axes : ndarray of matplotlib.axes.Axes
+        Its panels.
+    fontsize : int
+        Font size of the legend.
+    ncol : int, optional
+        Columns of the legend; default one per entry, at most 4.
     """
     handles, names = [], []
     for ax in axes.ravel():
@@ -368,7 +543,26 @@ def shared_legend(fig, axes, fontsize: int, ncol: int | None = None) -> None:
 
 
 def report_head(title: str, command: str, seconds: float, machine: dict, skipped: list[str]) -> list[str]:
-    """The first lines of a benchmark's Markdown report: title, command, machine, skipped cases."""
+    """Write the first lines of a benchmark's Markdown report: title, command, machine, skipped cases.
+
+    Parameters
+    ----------
+    title : str
+        The report's title.
+    command : str
+        The command that produced the numbers.
+    seconds : float
+        Wall time of the whole run.
+    machine : dict
+        A result of :func:`machine` (taken at the start).
+    skipped : list of str
+        One line per skipped case.
+
+    Returns
+    -------
+    list of str
+        The lines, the load average at the end included.
+    """
     lines = [f"# {title}", "", f"Command: `{command}` — {seconds:.0f} s in all.", ""]
     lines += machine_lines(machine) + [
         f"- load average at the end: {', '.join(f'{x:.2f}' for x in os.getloadavg())}",
@@ -380,7 +574,18 @@ def report_head(title: str, command: str, seconds: float, machine: dict, skipped
 
 
 def fmt_err(x: float) -> str:
-    """An error for a table: '–' when the run failed, '0' when exact."""
+    """Format an error for a table: '–' when the run failed, '0' when exact.
+
+    Parameters
+    ----------
+    x : float or None
+        The error; None or NaN for a failed run.
+
+    Returns
+    -------
+    str
+        Four decimals, or scientific notation below 1e-3.
+    """
     if x is None or np.isnan(x):
         return "–"
     if x == 0:
@@ -389,5 +594,16 @@ def fmt_err(x: float) -> str:
 
 
 def fmt_time(x: float) -> str:
-    """Seconds for a table."""
+    """Format seconds for a table.
+
+    Parameters
+    ----------
+    x : float or None
+        The time; None or NaN for a failed run ('–').
+
+    Returns
+    -------
+    str
+        Three decimals below 10 s, one above.
+    """
     return "–" if x is None or np.isnan(x) else (f"{x:.3f}" if x < 10 else f"{x:.1f}")

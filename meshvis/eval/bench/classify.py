@@ -18,7 +18,23 @@ from meshvis.io import load
 
 
 def default_models(models_dir: str | os.PathLike = DEFAULT_MODELS) -> list[tuple[str, Any]]:
-    """The monastery and the skin + rib cage, read from ``models_dir`` (checked to exist)."""
+    """List the default models: the monastery and the skin + rib cage, read from ``models_dir``.
+
+    Parameters
+    ----------
+    models_dir : str or os.PathLike
+        The folder of the real models (checked to exist; the files are read when built).
+
+    Returns
+    -------
+    list of (str, callable)
+        Name and a function of no argument that reads the model, per model.
+
+    Raises
+    ------
+    ParameterError
+        ``models_dir`` is not a folder.
+    """
     folder = models_folder(models_dir)
     return [
         (
@@ -35,7 +51,35 @@ def run(
     seed: int = 0,
     models_dir: str | os.PathLike = DEFAULT_MODELS,
 ) -> list[dict]:
-    """Classify each model once and return one result dict per model (default models from ``models_dir``)."""
+    """Classify each model once and collect the counts and per-stage times.
+
+    Parameters
+    ----------
+    models : list of str, optional
+        Model files; default :func:`default_models` of ``models_dir``.
+    rays_per_node : int
+        Ray budget per node of the classification.
+    seed : int
+        Seed of the classification.
+    models_dir : str or os.PathLike
+        The folder of the real models, for the default models.
+
+    Returns
+    -------
+    list of dict
+        Per model: name, faces, total seconds, seconds per stage (or "skipped"), rounds,
+        rays, nodes, edges, flagged faces, Embree's share of the sampling, outside area
+        fraction, load average and the classification's summary text.
+
+    Raises
+    ------
+    ParameterError
+        Without ``models``, when ``models_dir`` is not a folder.
+    ModelError
+        A model cannot be read.
+    FileNotFoundError
+        A file of the skin + rib cage is missing.
+    """
     todo = default_models(models_dir) if not models else [(m, lambda m=m: load(m)) for m in models]
     out = []
     for name, make in todo:
@@ -67,6 +111,18 @@ def run(
 
 
 def format(results: list[dict]) -> str:
+    """Format the results of :func:`run`: per model a title line, the summary and Embree's share.
+
+    Parameters
+    ----------
+    results : list of dict
+        A result of :func:`run`.
+
+    Returns
+    -------
+    str
+        The text to print.
+    """
     lines = []
     for r in results:
         lines.append(

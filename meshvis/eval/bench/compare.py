@@ -42,7 +42,7 @@ SPEED_TARGET = 3.0
 
 
 def _best_of(repeat: int, run):
-    """The run with the smallest time among ``repeat`` runs (errors of that run)."""
+    """Keep the run with the smallest time among ``repeat`` runs (with that run's errors)."""
     best = None
     for _ in range(max(1, repeat)):
         p = run()
@@ -54,7 +54,36 @@ def _best_of(repeat: int, run):
 def compare_case(
     truth, case: str, *, seed: int = 0, repeat: int = 1, peel_timeout: float = 300.0, log=print
 ) -> list[C.Point]:
-    """All methods at default settings on one case; one :class:`Point` per (method, task)."""
+    """Run every method at its default settings on one case, end to end.
+
+    meshvis runs each task as its command does (a classification per task); each baseline
+    runs once per repeat with the library's default knob.
+
+    Parameters
+    ----------
+    truth : GroundTruth
+        The case's truth; the methods run on its soup.
+    case : str
+        The case's name, recorded in the points.
+    seed : int
+        Seed of meshvis' classification.
+    repeat : int
+        Runs per method; the fastest successful one is kept.
+    peel_timeout : float
+        Time limit in seconds of the CGAL peel.
+    log : callable
+        Receives one line per method and task.
+
+    Returns
+    -------
+    list of Point
+        One scored point per (method, task).
+
+    Raises
+    ------
+    MissingExtraError
+        pymeshlab (the ``bench`` extra) is not installed.
+    """
     points: list[C.Point] = []
     for task in TASKS:
 
@@ -86,7 +115,25 @@ def compare_case(
 
 
 def checks(points: list[C.Point], case: str) -> list[str]:
-    """The comparison targets on one case, each as 'yes'/'NO' with its numbers."""
+    """Check the comparison targets on one case, each as 'yes'/'NO' with its numbers.
+
+    The targets: meshvis at least as accurate as the best baseline on every task, at
+    least :data:`HIDDEN_TARGET` of the hidden shells' area oriented correctly (cases with
+    hidden faces), and orientation at least :data:`SPEED_TARGET` times faster than libigl's
+    default.
+
+    Parameters
+    ----------
+    points : list of Point
+        The points of :func:`compare_case`.
+    case : str
+        The case's name.
+
+    Returns
+    -------
+    list of str
+        One line per target that can be checked on the case.
+    """
     out = []
     get = lambda task, method: next(
         (
@@ -127,6 +174,26 @@ def checks(points: list[C.Point], case: str) -> list[str]:
 
 
 def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: str, seconds: float) -> str:
+    """Write the report: machine, command, a table of every point and the targets per case.
+
+    Parameters
+    ----------
+    points : list of Point
+        The points of :func:`compare_case` for every case.
+    skipped : list of str
+        One line per skipped case.
+    machine : dict
+        A result of :func:`~meshvis.eval.bench.cases.machine`.
+    command : str
+        The command that produced the numbers.
+    seconds : float
+        Wall time of the run.
+
+    Returns
+    -------
+    str
+        The Markdown text of ``compare.md``.
+    """
     lines = C.report_head("meshvis bench compare", command, seconds, machine, skipped)
     lines += [
         "| case | faces | task | method | error | hidden-shell error | precision | recall | time (s) "
@@ -153,6 +220,15 @@ def markdown(points: list[C.Point], skipped: list[str], machine: dict, command: 
 
 
 def write_csv(path: str, points: list[C.Point]) -> None:
+    """Write the points to ``path`` as CSV (see :func:`meshvis.eval.bench.accuracy.write_csv`).
+
+    Parameters
+    ----------
+    path : str
+        The CSV file, written atomically.
+    points : list of Point
+        The points.
+    """
     from meshvis.eval.bench.accuracy import write_csv as _w
 
     _w(path, points)
@@ -160,6 +236,13 @@ def write_csv(path: str, points: list[C.Point]) -> None:
 
 # ====================================================================== command
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the options of ``meshvis bench compare`` to its parser.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The parser of the benchmark.
+    """
     p.add_argument("--quick", action="store_true", help=f"only {', '.join(QUICK)}")
     p.add_argument(
         "--cases",
@@ -176,6 +259,31 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    """Run ``meshvis bench compare`` and print the report (also into ``--out`` when given).
+
+    Progress goes to standard error and the Markdown report to standard output, unless
+    ``--quiet``; with ``--out`` the report and the points are written as ``compare.md`` and
+    ``compare.csv``.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The options of :func:`add_arguments`.
+
+    Returns
+    -------
+    int
+        Exit status 0 (a missed target is reported, not an error).
+
+    Raises
+    ------
+    MissingExtraError
+        pymeshlab (the ``bench`` extra) is not installed.
+    ParameterError
+        An unknown case, or no folder of real models when a real case is asked for.
+    OutputError
+        ``--out`` cannot be written, or holds earlier results and ``--force`` is not given.
+    """
     require_baselines()
     chosen = C.select_cases(args.cases, QUICK if args.quick else FULL)
     if args.out:

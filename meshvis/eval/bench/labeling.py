@@ -65,8 +65,18 @@ _SOURCE_ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.dirname(o
 
 
 def default_model() -> tuple[Any, str]:
-    """The project's engine-like assembly: ``models/assembly.obj`` of the current folder (the
-    repository root) or of the source tree, else the generator that made it."""
+    """Find the project's engine-like assembly: ``models/assembly.obj``, else its generator.
+
+    The file is looked for in the current folder (the repository root) and in the source
+    tree; without it the model is made by :func:`meshvis.eval.generators.assembly`.
+
+    Returns
+    -------
+    model : Soup
+        The assembly.
+    name : str
+        The file's path, or ``"meshvis.eval.generators.assembly()"``.
+    """
     for path in (
         os.path.join("models", "assembly.obj"),
         os.path.join(_SOURCE_ROOT, "models", "assembly.obj"),
@@ -88,7 +98,7 @@ def _median_timings(runs: Sequence[dict[str, float]]) -> dict[str, float]:
 
 
 def _load(model: Any) -> tuple[Any, str]:
-    """The model to measure and its name (default: :func:`default_model`)."""
+    """Load the model to measure and name it (default: :func:`default_model`)."""
     if model is None:
         return default_model()
     soup = load_models(model)
@@ -226,7 +236,7 @@ def _orbit(
 def _header(
     name: str, soup: Any, *, d_e: float | None, spacing: Spacing, size: int, repeat: int, setup_s: float
 ) -> dict[str, Any]:
-    """The result's description of the run, with empty sections to fill."""
+    """Describe the run in the result, with empty sections to fill."""
     return {
         "model": name,
         "d_e": d_e,
@@ -290,26 +300,48 @@ def run(
     rotate: float | None = None,
     progress: Callable[[str], None] | None = None,
 ) -> dict[str, Any]:
-    """Run the labeling benchmark.
+    """Run the labeling benchmark (the four parts of the module docstring).
 
     Parameters
     ----------
-    model : anything :func:`meshvis.labeling.layout` takes; default :func:`default_model`
-    size : image width = height of the layout comparison (pixels)
-    layouts : layouts to compare
-    sizes : image sizes of the quality-against-size curve
-    size_layout : layout of the size curve
-    orbit_frames : frames of the orbit (0 skips the orbit)
-    orbit_layout : layout of the orbit
-    repeat : runs per timing (the median is reported); the first, untimed run warms caches
-    adjusttext : also run the adjustText baseline (slow: seconds per layout)
-    adjusttext_iterations : its fixed iteration count
-    up, azimuth, elevation : the camera (fitted to the model)
-    views : azimuths of the many-views comparison (0 skips it), at each of ``view_elevations``
-    d_e : endpoint distance threshold of the fuzzy method (fraction of ``d_S``; default:
-        the paper's, see :func:`meshvis.labeling.pipeline.solve`)
-    rotate : ``Spacing.rotate`` of both methods (pixels; default the Spacing default)
-    progress : called with a line of text after each step
+    model : Soup, trimesh object, (V, F), path or a sequence of these, optional
+        The model, as :func:`meshvis.labeling.inputs.load_models` takes it; default
+        :func:`default_model`.
+    size : int
+        Image width and height of the layout comparison, in pixels.
+    layouts : sequence of str
+        The layouts to compare (keys of :data:`meshvis.labeling.candidates.LAYOUTS`).
+    sizes : sequence of int
+        Image sizes of the quality-against-size curve.
+    size_layout : str
+        Layout of the size curve.
+    orbit_frames : int
+        Frames of the orbit (0 or 1 skips the orbit).
+    orbit_layout : str
+        Layout of the orbit.
+    repeat : int
+        Runs per timing (the median is reported); a first, untimed run warms caches.
+    adjusttext : bool
+        Also run the adjustText baseline (slow: seconds per layout).
+    adjusttext_iterations : int
+        Its fixed iteration count.
+    up : (3,) float
+        The model's up direction, for the cameras.
+    azimuth : float
+        Azimuth of the benchmark view in degrees (the camera is fitted to the model).
+    elevation : float
+        Elevation of the benchmark view and of the orbit, in degrees.
+    views : int
+        Azimuths of the many-views comparison at each of ``view_elevations`` (0 skips it).
+    view_elevations : sequence of float
+        Elevations of the many-views comparison, in degrees.
+    d_e : float, optional
+        Endpoint distance threshold of the fuzzy method (fraction of ``d_S``; default the
+        paper's, see :func:`meshvis.labeling.pipeline.solve`).
+    rotate : float, optional
+        ``Spacing.rotate`` of both methods (pixels; default the Spacing default).
+    progress : callable, optional
+        Called with a line of text after each step.
 
     Returns
     -------
@@ -319,6 +351,13 @@ def run(
         ``metrics``), ``sizes`` (per size: times and metrics of both methods, ``error``),
         ``orbit`` (sequence metrics of the three variants), ``views`` (per layout:
         :func:`compare_views`).
+
+    Raises
+    ------
+    MissingExtraError
+        ``adjusttext`` is True and adjustText is not installed.
+    ModelError
+        The model cannot be used.
     """
     say = progress or (lambda s: None)
     if adjusttext:  # fail before the first layout, not in the middle of the run
@@ -360,18 +399,33 @@ def compare_views(
     d_e: float | None = None,
     spacing: Spacing | None = None,
 ) -> dict[str, Any]:
-    """Quality of the fuzzy and the two-step method over many views of one model.
+    """Measure the quality of the fuzzy and the two-step method over many views of one model.
 
-    Returns, per method: ``labels`` and ``unplaced`` (summed), ``clean`` (views with no
-    overlap, crossing, box over the model or bad anchor), ``leader_mean`` and
-    ``salience_mean`` (means over the views of each view's mean), ``box_ms`` and
-    ``layout_ms`` (medians over the views), ``layout_ms_max`` (the slowest view) and
-    ``labels_max`` (the most labels in one view);
-    and ``views``, ``fuzzy_shorter`` (views whose mean leader is shorter with fuzzy) and
-    ``common_leader`` (per method: summed leader length / d_S over the labels both
-    methods place in a view, summed over the views) and ``common_first_segment`` (the
-    same for the leaders' first segments: anchor to endpoint in the silhouette layout).
-    ``d_e``, ``spacing``: as in :func:`solve`.
+    Parameters
+    ----------
+    buffers : sequence of IdBuffer
+        The ID buffers of the views (:func:`meshvis.labeling.idbuffer.id_buffer`).
+    texts : sequence of str
+        The label text of every part.
+    layout : str
+        The layout.
+    d_e : float, optional
+        As in :func:`meshvis.labeling.pipeline.solve`.
+    spacing : Spacing, optional
+        As in :func:`meshvis.labeling.pipeline.solve`.
+
+    Returns
+    -------
+    dict
+        Per method: ``labels`` and ``unplaced`` (summed), ``clean`` (views with no
+        overlap, crossing, box over the model or bad anchor), ``leader_mean`` and
+        ``salience_mean`` (means over the views of each view's mean), ``box_ms`` and
+        ``layout_ms`` (medians over the views), ``layout_ms_max`` (the slowest view) and
+        ``labels_max`` (the most labels in one view); and ``views``, ``fuzzy_shorter`` (views
+        whose mean leader is shorter with fuzzy), ``common_leader`` (per method: summed
+        leader length / d_S over the labels both methods place in a view, summed over the
+        views) and ``common_first_segment`` (the same for the leaders' first segments:
+        anchor to endpoint in the silhouette layout).
     """
     per: dict[str, list] = {"fuzzy": [], "two-step": []}
     common = {"fuzzy": 0.0, "two-step": 0.0}
@@ -429,7 +483,7 @@ def _format_times(result: dict[str, Any]) -> list[str]:
 
 
 def _format_quality(result: dict[str, Any]) -> list[str]:
-    """The quality metrics of every layout and method."""
+    """Tabulate the quality metrics of every layout and method."""
     lines = [
         "",
         "quality",
@@ -513,7 +567,19 @@ def _format_views(result: dict[str, Any]) -> list[str]:
 
 
 def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' common name
-    """Plain-text tables of a :func:`run` result."""
+    """Format a :func:`run` result as plain-text tables.
+
+    Parameters
+    ----------
+    result : dict
+        A result of :func:`run`.
+
+    Returns
+    -------
+    str
+        The header, per-stage times, quality, and the size, orbit and views tables of the
+        parts that ran.
+    """
     lines = [
         f"labeling benchmark: {result['model']} ({result['parts']} parts, {result['visible_parts']} visible), "
         f"{result['size']} x {result['size']}, median of {result['repeat']} runs, d_e "
@@ -532,7 +598,13 @@ def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' co
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Options of ``meshvis bench labeling``."""
+    """Add the options of ``meshvis bench labeling`` to its parser.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The parser of the benchmark.
+    """
     parser.add_argument("model", nargs="*", help="model file(s) (default: models/assembly.obj)")
     parser.add_argument(
         "--size", type=int, default=512, help="image size of the layout comparison (default 512)"
@@ -571,7 +643,25 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    """Entry point of ``meshvis bench labeling``."""
+    """Run ``meshvis bench labeling``: print progress lines, then the tables.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The options of :func:`add_arguments`.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    MissingExtraError
+        adjustText is not installed and ``--no-adjusttext`` is not given.
+    ModelError
+        A model cannot be read.
+    """
     from meshvis.rays.camera import AXES
 
     model = None
@@ -595,7 +685,22 @@ def main(args: argparse.Namespace) -> int:
 
 
 def report(result: dict[str, Any], text: str, json_path: str | None) -> int:
-    """Print a benchmark's tables after its progress lines and write its JSON; exit status 0."""
+    """Print a benchmark's tables after its progress lines and write its JSON.
+
+    Parameters
+    ----------
+    result : dict
+        The numbers, written to ``json_path``.
+    text : str
+        The tables to print.
+    json_path : str or None
+        The JSON file; None writes none.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+    """
     print()
     print(text)
     if json_path:

@@ -46,7 +46,20 @@ REAL = (
 def default_models(
     models_dir: str | os.PathLike = DEFAULT_MODELS,
 ) -> list[tuple[str, Any, tuple[float, float, float]]]:
-    """The generated engine assembly and the real multi-part models of ``models_dir`` that are there.
+    """List the sweep's models: the generated engine assembly and the real multi-part models present.
+
+    The real models of :data:`REAL` are taken from ``models_dir`` when all their files
+    are there.
+
+    Parameters
+    ----------
+    models_dir : str or os.PathLike
+        The folder of the real models.
+
+    Returns
+    -------
+    list of (str, model, (3,) float)
+        Name, model (a soup, a path or a list of paths) and up direction, per model.
 
     Raises
     ------
@@ -77,15 +90,29 @@ def run(
 ) -> dict[str, Any]:
     """Lay out every case once and summarise.
 
+    A case is a (model, view, image size, layout, method); the views are ``azimuths``
+    evenly spaced azimuths at each elevation, the camera fitted to the model.
+
     Parameters
     ----------
-    models : (name, model, up) triples; default :func:`default_models`
-    azimuths : views per elevation, evenly spaced around the up axis
-    elevations : camera elevations (degrees)
-    sizes : image widths = heights (pixels)
-    layouts, methods : what to run
-    progress : called with a line of text after each model
-    models_dir : folder of the real models of the default ``models``
+    models : sequence of (str, model, (3,) float), optional
+        (name, model, up) triples, the model as
+        :func:`meshvis.labeling.inputs.load_models` takes it; default
+        :func:`default_models` of ``models_dir``.
+    azimuths : int
+        Views per elevation, evenly spaced around the up axis.
+    elevations : sequence of float
+        Camera elevations (degrees).
+    sizes : sequence of int
+        Image widths = heights (pixels).
+    layouts : sequence of str
+        The layouts to run.
+    methods : sequence of str
+        The layout methods to run.
+    progress : callable, optional
+        Called with a line of text after each model.
+    models_dir : str or os.PathLike
+        Folder of the real models of the default ``models``.
 
     Returns
     -------
@@ -93,6 +120,13 @@ def run(
         ``cases`` (per case key ``model|azimuth|elevation|size|layout|method``: ``labels``,
         ``unplaced``, ``clean``, ``leader_mean``, ``leader_max``, ``leader_sum`` (/ ``d_S``),
         ``layout_ms``) and ``summary`` (see :func:`summarise`).
+
+    Raises
+    ------
+    ParameterError
+        Without ``models``, when ``models_dir`` is not a folder.
+    ModelError
+        A model cannot be read.
     """
     say = progress or (lambda s: None)
     warm_up()  # one-time imports are not a layout's time
@@ -124,9 +158,21 @@ def run(
 
 
 def summarise(cases: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
-    """Per (layout, method, size): ``layouts``, ``clean``, ``labels``, ``unplaced``,
-    ``leader_mean`` (mean of the layouts' means), ``leader_max_p90`` and ``leader_max``
-    (90th percentile and largest of the layouts' longest leaders), ``layout_ms`` (mean)."""
+    """Summarise the cases per (layout, method, size).
+
+    Parameters
+    ----------
+    cases : dict
+        The ``cases`` of a :func:`run` result.
+
+    Returns
+    -------
+    list of dict
+        One row per (layout, method, size), in layout order: ``layouts``, ``clean``,
+        ``labels``, ``unplaced``, ``leader_mean`` (mean of the layouts' means),
+        ``leader_max_p90`` and ``leader_max`` (90th percentile and largest of the layouts'
+        longest leaders), ``layout_ms`` (mean).
+    """
     groups: dict[tuple[str, str, int], list[dict[str, Any]]] = {}
     for key, c in cases.items():
         _, _, _, n, layout, method = key.split("|")
@@ -156,7 +202,18 @@ def summarise(cases: dict[str, dict[str, Any]]) -> list[dict[str, Any]]:
 
 
 def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' common name
-    """Plain-text table of a :func:`run` result."""
+    """Format a :func:`run` result as a plain-text table, one row per summary row.
+
+    Parameters
+    ----------
+    result : dict
+        A result of :func:`run`.
+
+    Returns
+    -------
+    str
+        The table.
+    """
     rows = result["summary"]
     lines = [
         f"labeling sweep: {len(result['cases'])} layouts; leader lengths / d_S; max = each layout's longest "
@@ -174,7 +231,13 @@ def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' co
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Options of ``meshvis bench labeling-sweep``."""
+    """Add the options of ``meshvis bench labeling-sweep`` to its parser.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The parser of the benchmark.
+    """
     parser.add_argument("--azimuths", type=int, default=8, help="views per elevation (default 8)")
     parser.add_argument(
         "--elevations",
@@ -192,7 +255,23 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    """Entry point of ``meshvis bench labeling-sweep``."""
+    """Run ``meshvis bench labeling-sweep``: print progress lines, then the table.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The options of :func:`add_arguments`.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+
+    Raises
+    ------
+    ParameterError
+        ``--models`` is not a folder.
+    """
     result = run(
         azimuths=args.azimuths,
         elevations=args.elevations,

@@ -98,19 +98,24 @@ def run(
     rays_per_node: int = 32,
     progress: Callable[[CaseResult], None] | None = None,
 ) -> dict:
-    """Run every stability case.
+    """Run every stability case (the five groups of the module docstring).
 
     Parameters
     ----------
-    quick : fewer scales and crack widths, smaller models, fewer measuring rays
-    seed : seed of every classification (stressed and untouched models use the same)
-    rays_per_node : ray budget of every classification
-    progress : called with each :class:`CaseResult` as soon as it is known
+    quick : bool
+        Fewer scales and crack widths, smaller models, fewer measuring rays.
+    seed : int
+        Seed of every classification (stressed and untouched models use the same).
+    rays_per_node : int
+        Ray budget of every classification.
+    progress : callable, optional
+        Called with each :class:`CaseResult` as soon as it is known.
 
     Returns
     -------
-    dict with ``cases`` (list of :class:`CaseResult` as dicts), ``passed``, ``failed``,
-    ``quick``, ``seed``, ``rays_per_node``, ``seconds``, ``machine``.
+    dict
+        ``cases`` (list of :class:`CaseResult` as dicts), ``passed``, ``failed``,
+        ``quick``, ``seed``, ``rays_per_node``, ``seconds``, ``machine``.
     """
     t0 = time.perf_counter()
     results: list[CaseResult] = []
@@ -154,7 +159,18 @@ def run(
 
 
 def format_case(r: CaseResult | dict) -> str:
-    """One line (plus a table for the crack sweep and the tiny-cube parts) for a case."""
+    """Format one case: a PASS/FAIL line, plus a table for the crack sweep and the tiny-cube parts.
+
+    Parameters
+    ----------
+    r : CaseResult or dict
+        The case, or its dictionary from a :func:`run` result.
+
+    Returns
+    -------
+    str
+        The line, with the table's lines below it when the case has one.
+    """
     d = asdict(r) if isinstance(r, CaseResult) else r
     line = f"{'PASS' if d['passed'] else 'FAIL'}  [{d['group']}] {d['name']}: {d['figure']}  ({d['seconds']:.2f} s)"
     rows = d.get("table") or []
@@ -197,7 +213,18 @@ def format_case(r: CaseResult | dict) -> str:
 
 
 def format(result: dict) -> str:
-    """The printed report: one line per case, then the count."""
+    """Format the printed report: one line per case, then the count.
+
+    Parameters
+    ----------
+    result : dict
+        A result of :func:`run`.
+
+    Returns
+    -------
+    str
+        The report.
+    """
     lines = [format_case(c) for c in result["cases"]]
     total = result["passed"] + result["failed"]
     lines.append(
@@ -209,7 +236,13 @@ def format(result: dict) -> str:
 
 # ============================================================================ command line
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    """Arguments of ``meshvis bench stability``."""
+    """Add the options of ``meshvis bench stability`` to its parser.
+
+    Parameters
+    ----------
+    parser : argparse.ArgumentParser
+        The parser of the benchmark.
+    """
     parser.add_argument(
         "--quick", action="store_true", help="reduced set (fewer scales and widths, smaller models)"
     )
@@ -219,7 +252,18 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
-    """Run the cases, print one line each as they finish and the count; 1 if any case failed."""
+    """Run ``meshvis bench stability``: print one line per case as it finishes, then the count.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The options of :func:`add_arguments` (missing ones take their defaults).
+
+    Returns
+    -------
+    int
+        Exit status: 1 when any case failed, else 0.
+    """
     from meshvis.io.jsonfile import write_json
 
     result = run(

@@ -1,5 +1,8 @@
-"""The cases of the stability benchmark (:mod:`meshvis.eval.bench.stability`): each classifies
-a stressed model, compares it with the untouched one and says PASS or FAIL with its figure."""
+"""The cases of the stability benchmark (:mod:`meshvis.eval.bench.stability`).
+
+Each case classifies a stressed model, compares it with the untouched one and says PASS
+or FAIL with its figure.
+"""
 
 from __future__ import annotations
 
@@ -82,17 +85,22 @@ class CaseResult:
 
 # ============================================================================ measures
 def area_agreement(reference: np.ndarray, other: np.ndarray, areas: np.ndarray) -> float:
-    """Share of the area whose per-face side labels agree.
+    """Measure the share of the area whose per-face side labels agree.
 
     Parameters
     ----------
-    reference, other : (m, 2) bool, side-outside labels (``Classification.side_outside``)
-    areas : (m,) float64, face areas (of the reference model)
+    reference : (m, 2) bool
+        Side-outside labels of the reference (``Classification.side_outside``).
+    other : (m, 2) bool
+        Side-outside labels to compare.
+    areas : (m,) float64
+        Face areas (of the reference model).
 
     Returns
     -------
-    float in [0, 1]: ``Σ_f A_f [ref_f == other_f] / Σ_f A_f`` where a face agrees when both
-    of its sides do; 1.0 for a model of zero area.
+    float
+        In [0, 1]: ``Σ_f A_f [ref_f == other_f] / Σ_f A_f`` where a face agrees when both of
+        its sides do; 1.0 for a model of zero area.
     """
     same = np.all(np.asarray(reference, bool) == np.asarray(other, bool), axis=1)
     total = float(np.sum(areas))
@@ -116,11 +124,22 @@ def _walk_floats(obj: Any, path: str, out: list[str]) -> None:
 
 
 def nonfinite(c: Classification) -> list[str]:
-    """Names of the floats of a classification that are NaN or infinite (empty when all are finite).
+    """Name the floats of a classification that are NaN or infinite.
 
     Checked: every float and float array in ``c.report(per_face=True)``, the node areas,
     the per-face outside fractions, every array of the graph weights (Eq. 5–9, before and
     after the cosine filter) and the cut value.
+
+    Parameters
+    ----------
+    c : Classification
+        The classification.
+
+    Returns
+    -------
+    list of str
+        The path of every non-finite value (with the count for arrays); empty when all are
+        finite.
     """
     bad: list[str] = []
     _walk_floats(c.report(per_face=True), "report", bad)
@@ -130,7 +149,18 @@ def nonfinite(c: Classification) -> list[str]:
 
 
 def aspect_ratios(soup: Soup) -> np.ndarray:
-    """Per face: longest edge over smallest altitude, ``L_max² / (2 A)`` (inf for zero area)."""
+    """Compute every face's longest edge over its smallest altitude, ``L_max² / (2 A)``.
+
+    Parameters
+    ----------
+    soup : Soup
+        The model.
+
+    Returns
+    -------
+    (m,) float64
+        The aspect ratios; inf for zero-area faces.
+    """
     t = soup.triangles
     e = np.linalg.norm(t[:, [1, 2, 0]] - t, axis=2)
     lmax = e.max(axis=1)
@@ -152,7 +182,27 @@ def _finite_note(bad: list[str]) -> str:
 def similarity_cases(
     models: dict[str, Soup], scales: Iterable[float], rays_per_node: int, seed: int
 ) -> list[CaseResult]:
-    """Group 1: classification under uniform scale, far translation, rotation, and a rerun."""
+    """Run group 1: classification under uniform scale, far translation, rotation, and a rerun.
+
+    Per model, the rerun must agree exactly with the reference classification and every
+    transformed copy on :data:`AGREEMENT` of the area.
+
+    Parameters
+    ----------
+    models : dict of str to Soup
+        The models, by name.
+    scales : iterable of float
+        The uniform scale factors.
+    rays_per_node : int
+        Ray budget of every classification.
+    seed : int
+        Seed of every classification and of the rotation.
+
+    Returns
+    -------
+    list of CaseResult
+        One timed case per model and variant.
+    """
     out = []
     for name, soup in models.items():
         ref = classify(soup, rays_per_node=rays_per_node, seed=seed)
@@ -227,8 +277,10 @@ def _appended_case(
     rays_per_node: int,
     seed: int,
 ) -> CaseResult:
-    """Faces appended to the model (``make``): the original faces must keep their labels;
-    ``extra`` adds figures of the classification."""
+    """Append faces to the model (``make``) and check that the original faces keep their labels.
+
+    ``extra`` adds figures of the classification.
+    """
     m = soup.n_faces
     s = make()
     c = classify(s, rays_per_node=rays_per_node, seed=seed)
@@ -262,7 +314,22 @@ def _perturbed_case(name: str, soup: Soup, ref: Classification, rays_per_node: i
 
 
 def degenerate_cases(models: dict[str, Soup], rays_per_node: int, seed: int) -> list[CaseResult]:
-    """Group 2: slivers, zero-area faces, duplicates, near-coplanar copies, perturbed corners."""
+    """Run group 2: slivers, zero-area faces, duplicates, near-coplanar copies, perturbed corners.
+
+    Parameters
+    ----------
+    models : dict of str to Soup
+        The models, by name.
+    rays_per_node : int
+        Ray budget of every classification.
+    seed : int
+        Seed of every classification and of the stresses.
+
+    Returns
+    -------
+    list of CaseResult
+        Five timed cases per model.
+    """
     out = []
     budget = dict(rays_per_node=rays_per_node, seed=seed)
     for name, soup in models.items():
@@ -309,7 +376,7 @@ def _side_nodes(c: Classification, faces: np.ndarray, side: int) -> np.ndarray:
 def escape_share(
     c: Classification, faces: np.ndarray, side: int, n_rays: int, seed: int = 0, per_node: bool = False
 ) -> float | tuple[float, np.ndarray, np.ndarray]:
-    """Measured share of the cosine rays from one side of ``faces`` that escape the model.
+    """Measure the share of the cosine rays from one side of ``faces`` that escape the model.
 
     Casts about ``n_rays`` rays with the classifier's own sampling
     (:func:`meshvis.graphcut.sampling.sample_round`: area-uniform origins pushed off by the ray
@@ -318,9 +385,29 @@ def escape_share(
     the ``opening`` threshold of :func:`meshvis.graphcut.weights.inside_prior` is compared with,
     node by node.
 
+    Parameters
+    ----------
+    c : Classification
+        The classification whose nodes and ray caster are used.
+    faces : (k,) int
+        The faces.
+    side : {0, 1}
+        The side of the faces (0 = front).
+    n_rays : int
+        About this many rays in all (at least one per node of positive area).
+    seed : int
+        Seed of the rays.
+    per_node : bool
+        Also return the share of every node.
+
     Returns
     -------
-    share, or ``(share, nodes, node_shares)`` when ``per_node``
+    share : float
+        The escape share; 0.0 when no ray was counted.
+    nodes : (n,) int64
+        Only with ``per_node``: the nodes of that side of ``faces``.
+    node_shares : (n,) float64
+        Only with ``per_node``: the escape share of each of them.
     """
     from meshvis.graphcut.sampling import VisibilityCounts, sample_round
 
@@ -348,17 +435,34 @@ def crack_sweep(
 ) -> list[dict]:
     """Classify :func:`meshvis.eval.generators.cracked_box` for every crack width.
 
+    Parameters
+    ----------
+    widths : iterable of float
+        Crack widths, fractions of the box diagonal.
+    cell : float
+        Triangle size of the box.
+    rays_per_node : int
+        Ray budget of the classifications.
+    seed : int
+        Seed of the models, the classifications and the measuring rays.
+    share_rays : int
+        Extra rays that measure the escape share of the box's inner sides.
+    opening : float
+        The ``opening`` threshold of the classification.
+
     Returns
     -------
-    list of dict, one per width, with: ``width``; ``inner_outside`` (share of the inner
-    box's area with an outside side: the leak); ``box_inner_side_outside`` (share of the
-    box sheet whose inner side is outside); ``share_classifier`` (area-weighted escape
-    share of the box's inner sides as the classifier saw it) and ``share_measured``
-    (from ``share_rays`` extra rays), with its smallest and largest value over the walls
-    (``share_measured_min``/``_max``, nodes of at least 1 % of the area); the inner sides' total outside link ``w_out``,
-    inside prior ``w_in`` and both after the cosine filter; ``paper_inner_outside``
-    (the leak with ``opening=None``, the paper's unfaded prior); ``flagged`` faces and
-    ``nonfinite`` names.
+    list of dict
+        One per width, with: ``width``; ``inner_outside`` (share of the inner box's area
+        with an outside side: the leak); ``box_inner_side_outside`` (share of the box sheet
+        whose inner side is outside); ``share_classifier`` (area-weighted escape share of
+        the box's inner sides as the classifier saw it) and ``share_measured`` (from
+        ``share_rays`` extra rays), with its smallest and largest value over the walls
+        (``share_measured_min``/``_max``, nodes of at least 1 % of the area); the inner
+        sides' total outside link ``w_out``, inside prior ``w_in`` and both after the cosine
+        filter (``cap_out``, ``cap_in``); ``paper_inner_outside`` (the leak with
+        ``opening=None``, the paper's unfaded prior); ``flagged`` faces, ``rays`` and
+        ``nonfinite`` names.
     """
     rows = []
     for w in widths:
@@ -402,7 +506,7 @@ def crack_sweep(
 def slit_transmission(
     widths: Iterable[float], positions: Iterable[float] = (0.9, 0.3), n_rays: int = 20_000, seed: int = 0
 ) -> list[dict]:
-    """Share of straight rays that pass through a slit of width ``w`` × diagonal, as Embree sees it.
+    """Measure the share of straight rays that pass through a slit of width ``w`` × diagonal, as Embree sees it.
 
     The model: two coplanar rectangles in z = 0 spanning x ∈ [−1, 1], y ∈ [−0.2, 0.2]
     (diagonal D ≈ 2.04), cut by a slit of width ``w D`` centred at ``x = position``.  Rays
@@ -411,10 +515,22 @@ def slit_transmission(
     0 for a slit the float32 scene has closed.  Two positions are tried because the
     float32 spacing of the normalised coordinate differs between them (``spacing``).
 
+    Parameters
+    ----------
+    widths : iterable of float
+        Slit widths, fractions of D.
+    positions : iterable of float
+        x of the slit's centre.
+    n_rays : int
+        Rays per width and position.
+    seed : int
+        Seed of the ray origins.
+
     Returns
     -------
-    list of dict: ``width``, ``position``, ``spacing`` (float32 spacing at the slit, in
-    units of D), ``transmitted``
+    list of dict
+        ``width``, ``position``, ``spacing`` (float32 spacing at the slit, in units of D),
+        ``transmitted``.
     """
     from meshvis.rays.caster import RayCaster
 
@@ -462,7 +578,7 @@ def slit_transmission(
 def offset_probe(
     widths: Iterable[float], offsets: Iterable[float], n_rays: int, cell: float = 0.1, seed: int = 0
 ) -> list[dict]:
-    """Escape share of the cracked box's inner sides for narrow cracks, with two ray offsets.
+    """Measure the escape share of the cracked box's inner sides for narrow cracks, per ray offset.
 
     For every ray ``offset`` (fraction of the diagonal) and crack ``width``, the share is
     measured with :func:`escape_share` from about ``n_rays`` rays.  ``share / width`` is
@@ -470,9 +586,23 @@ def offset_probe(
     narrower, because rays from the two walls that form a slit start further inside than
     the slit is wide and can no longer leave through it.
 
+    Parameters
+    ----------
+    widths : iterable of float
+        Crack widths, fractions of the box diagonal.
+    offsets : iterable of float
+        Ray offsets, fractions of the diagonal.
+    n_rays : int
+        Measuring rays per width and offset.
+    cell : float
+        Triangle size of the box.
+    seed : int
+        Seed of the models and the classifications (the measuring rays use ``seed + 1``).
+
     Returns
     -------
-    list of dict: ``width``, ``offset``, ``share``, ``share_per_width``, ``escaped`` (rays)
+    list of dict
+        ``width``, ``offset``, ``share``, ``share_per_width``, ``escaped`` (rays).
     """
     rows = []
     for off in offsets:
@@ -503,12 +633,36 @@ def crack_case(
     offset_widths: Iterable[float] = (),
     offset_rays: int = 0,
 ) -> CaseResult:
-    """Group 3: from which crack width the interior leaks; passes when leaking is monotone in the width.
+    """Run group 3: from which crack width the interior leaks; passes when leaking is monotone in the width.
 
     The figures behind the explanation come with it: the escape shares, the terminal
     weights of the box's inner sides before and after the cosine filter, the leak under
     the paper's unfaded prior, the float32 slit probe (:func:`slit_transmission`) and the
     ray-offset probe (:func:`offset_probe`, default offset and ten times smaller).
+
+    Parameters
+    ----------
+    widths : iterable of float
+        Crack widths of the sweep (:func:`crack_sweep`).
+    cell : float
+        Triangle size of the box.
+    rays_per_node : int
+        Ray budget of the classifications.
+    seed : int
+        Seed of everything random.
+    share_rays : int
+        Measuring rays of the escape share.
+    slit_widths : iterable of float
+        Widths of the float32 slit probe (empty: no probe).
+    offset_widths : iterable of float
+        Crack widths of the ray-offset probe (empty: no probe).
+    offset_rays : int
+        Measuring rays of the ray-offset probe (0: no probe).
+
+    Returns
+    -------
+    CaseResult
+        The case, with the sweep as its table and the probes in its values.
     """
     widths = sorted(widths, reverse=True)
     rows = crack_sweep(widths, cell, rays_per_node, seed, share_rays)
@@ -567,12 +721,18 @@ def compare_solvers(c: Classification) -> dict:
     number of directed capacities crossing either cut (every node crosses with exactly
     one terminal link): :func:`meshvis.graphcut.mincut.rounding_bound` with that *k*.
 
+    Parameters
+    ----------
+    c : Classification
+        The classification whose graph is cut.
+
     Returns
     -------
-    dict with both values, their difference, the bound, the weight span (orders of
-    magnitude of the positive edge weights and of all positive capacities), the
-    capacities rounded to zero (count, share of their sum in the exact cut value), the
-    nodes and faces labelled differently and the area agreement.
+    dict
+        Both values, their difference, the bound, the weight span (orders of magnitude of
+        the positive edge weights and of all positive capacities), the capacities rounded
+        to zero (count, share of their sum in the exact cut value), the nodes and faces
+        labelled differently and the area agreement.
     """
     w = c.graph.weights
     pm: Cut = c.graph.cut("pymaxflow")
@@ -608,7 +768,30 @@ def compare_solvers(c: Classification) -> dict:
 def weight_cases(
     models: dict[str, Soup], rays_per_node: int, seed: int, require_span: set[str]
 ) -> list[CaseResult]:
-    """Group 4: both max-flow solvers on the same graph (weights spanning 12+ orders for the tiny-cube model)."""
+    """Run group 4: both max-flow solvers on the same graph.
+
+    A case passes when the cut values agree within the rounding bound, the labels on
+    :data:`AGREEMENT` of the area, no value is non-finite and, for the models of
+    ``require_span``, the edge weights span at least :data:`WEIGHT_ORDERS` orders of
+    magnitude.
+
+    Parameters
+    ----------
+    models : dict of str to Soup
+        The models, by name.
+    rays_per_node : int
+        Ray budget of every classification.
+    seed : int
+        Seed of every classification.
+    require_span : set of str
+        Names of the models whose weights must span :data:`WEIGHT_ORDERS` orders (their
+        parts' outcome is tabulated).
+
+    Returns
+    -------
+    list of CaseResult
+        One timed case per model.
+    """
     out = []
     for name, soup in models.items():
 
@@ -670,10 +853,25 @@ _BAD_OBJ = {
 
 
 def tiny_cases(rays_per_node: int, seed: int, folder: str | None = None) -> list[CaseResult]:
-    """Group 5: one triangle, two triangles, one quad; empty file, no faces, one zero-area triangle.
+    """Run group 5: one triangle, two triangles, one quad; empty file, no faces, one zero-area triangle.
 
     The models are written as OBJ files and read back through :func:`meshvis.classify`'s
-    path argument, so reading is part of the test.
+    path argument, so reading is part of the test.  The first three must have both sides
+    of every face outside; the last three must raise a one-line ModelError naming the file.
+
+    Parameters
+    ----------
+    rays_per_node : int
+        Ray budget of every classification.
+    seed : int
+        Seed of every classification.
+    folder : str, optional
+        Where the temporary folder of the files is made (default the system's).
+
+    Returns
+    -------
+    list of CaseResult
+        Six timed cases.
     """
     out = []
     with tempfile.TemporaryDirectory(dir=folder) as tmp:

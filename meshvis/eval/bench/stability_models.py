@@ -1,5 +1,8 @@
-"""Stressed models of the stability benchmark: similarity transforms, slivers, zero-area,
-duplicate and near-coplanar faces, perturbed corners, tiny pieces beside huge ones."""
+"""Stressed models of the stability benchmark: transformed, degenerate and tiny geometry.
+
+Similarity transforms, slivers, zero-area, duplicate and near-coplanar faces, perturbed
+corners, and tiny pieces beside huge ones.
+"""
 
 from __future__ import annotations
 
@@ -14,7 +17,7 @@ TINY_SIZES = (1e-6, 1e-5, 1e-4, 1e-3, 1e-2)
 
 
 def _with(soup: Soup, vertices: np.ndarray, faces: np.ndarray, parent: np.ndarray) -> Soup:
-    """A soup of new geometry whose faces inherit the attributes of their ``parent`` faces."""
+    """Make a soup of new geometry whose faces inherit the attributes of their ``parent`` faces."""
     return Soup(
         vertices,
         faces,
@@ -28,13 +31,29 @@ def _with(soup: Soup, vertices: np.ndarray, faces: np.ndarray, parent: np.ndarra
 
 
 def similarity(soup: Soup, kind: str, amount: float = 1.0, seed: int = 0) -> Soup:
-    """The soup under a similarity transform.
+    """Apply a similarity transform to the soup.
 
     Parameters
     ----------
-    kind : "scale" (uniform, about the origin, factor ``amount``), "translate" (by
-        ``amount`` × diagonal along (1, 2, 3)/|(1, 2, 3)|) or "rotate" (a random rotation
-        drawn from ``seed``)
+    soup : Soup
+        The model.
+    kind : {"scale", "translate", "rotate"}
+        Uniform scale about the origin by the factor ``amount``; translation by ``amount`` ×
+        diagonal along (1, 2, 3)/|(1, 2, 3)|; or a random rotation drawn from ``seed``.
+    amount : float
+        The scale factor, or the translation in diagonals (unused by "rotate").
+    seed : int
+        Seed of the rotation.
+
+    Returns
+    -------
+    Soup
+        The transformed soup, faces and attributes unchanged.
+
+    Raises
+    ------
+    ValueError
+        An unknown ``kind``.
     """
     m = np.eye(4)
     if kind == "scale":
@@ -63,9 +82,25 @@ def split_into_slivers(
     piece is a sliver of aspect ratio about ``1/t``.  Both pieces keep the winding.  The
     split point also leaves a T-junction on the neighbour across edge ab.
 
+    Parameters
+    ----------
+    soup : Soup
+        The model.
+    fraction : float
+        Probability of every face to be split (at least one face is).
+    t_min : float
+        Smallest split position along ab, a fraction of the edge.
+    t_max : float
+        Largest split position along ab.
+    seed : int
+        Seeds the choice of faces and the positions.
+
     Returns
     -------
-    soup, parent : the new soup and, per new face, the index of the face it came from
+    soup : Soup
+        The new soup: the unsplit faces first, then the slivers, then their partners.
+    parent : (k,) int64
+        Per new face, the index of the face it came from.
     """
     rng = np.random.default_rng(seed)
     m = soup.n_faces
@@ -88,6 +123,20 @@ def add_zero_area(soup: Soup, fraction: float = 0.1, seed: int = 0) -> Soup:
     """Append zero-area faces: half collapsed to a corner (a, a, a), half collinear (a, mid(ab), b).
 
     The original faces keep their indices ``0 .. m-1``.
+
+    Parameters
+    ----------
+    soup : Soup
+        The model.
+    fraction : float
+        Zero-area faces to add, a fraction of the face count (at least 2).
+    seed : int
+        Seeds which faces the new ones are made from.
+
+    Returns
+    -------
+    Soup
+        The soup with the zero-area faces appended (attributes from their source faces).
     """
     rng = np.random.default_rng(seed)
     k = max(2, int(fraction * soup.n_faces))
@@ -105,7 +154,22 @@ def add_zero_area(soup: Soup, fraction: float = 0.1, seed: int = 0) -> Soup:
 
 
 def add_duplicates(soup: Soup, fraction: float = 0.1, seed: int = 0) -> Soup:
-    """Append exact duplicates of a ``fraction`` of the faces, and reversed duplicates of as many others."""
+    """Append exact duplicates of a ``fraction`` of the faces, and reversed duplicates of as many others.
+
+    Parameters
+    ----------
+    soup : Soup
+        The model.
+    fraction : float
+        Faces to duplicate each way, a fraction of the face count (at least 1).
+    seed : int
+        Seeds which faces are duplicated.
+
+    Returns
+    -------
+    Soup
+        The soup with the copies appended (the original faces keep their indices).
+    """
     rng = np.random.default_rng(seed)
     k = max(1, int(fraction * soup.n_faces))
     src = rng.permutation(soup.n_faces)[: 2 * k]
@@ -115,7 +179,24 @@ def add_duplicates(soup: Soup, fraction: float = 0.1, seed: int = 0) -> Soup:
 
 
 def add_near_coplanar(soup: Soup, offset: float = 1e-7, fraction: float = 0.1, seed: int = 0) -> Soup:
-    """Append copies of a ``fraction`` of the faces moved ``offset`` × diagonal along their normal."""
+    """Append copies of a ``fraction`` of the faces moved ``offset`` × diagonal along their normal.
+
+    Parameters
+    ----------
+    soup : Soup
+        The model.
+    offset : float
+        Distance of the copies from their originals, a fraction of the diagonal.
+    fraction : float
+        Faces to copy, a fraction of the face count (at least 1).
+    seed : int
+        Seeds which faces are copied.
+
+    Returns
+    -------
+    Soup
+        The soup with the moved copies appended (the original faces keep their indices).
+    """
     rng = np.random.default_rng(seed)
     k = max(1, int(fraction * soup.n_faces))
     src = rng.choice(soup.n_faces, k, replace=False)
@@ -134,6 +215,20 @@ def perturb_corners(soup: Soup, amount: float = 1e-9, seed: int = 0) -> Soup:
 
     Neighbouring faces then no longer share corners exactly: hairline cracks and overlaps
     of about ``amount`` appear along every edge (the faces keep their order).
+
+    Parameters
+    ----------
+    soup : Soup
+        The model.
+    amount : float
+        Largest move per axis, a fraction of the diagonal.
+    seed : int
+        Seeds the moves.
+
+    Returns
+    -------
+    Soup
+        The perturbed soup, three vertices per face.
     """
     rng = np.random.default_rng(seed)
     v = soup.triangles.reshape(-1, 3)
@@ -142,7 +237,7 @@ def perturb_corners(soup: Soup, amount: float = 1e-9, seed: int = 0) -> Soup:
 
 
 def _cube(center: np.ndarray, size: float) -> tuple[np.ndarray, np.ndarray]:
-    """A closed axis-aligned cube of edge ``size`` (12 outward triangles)."""
+    """Build a closed axis-aligned cube of edge ``size`` (12 outward triangles)."""
     import trimesh
 
     b = trimesh.creation.box(extents=(size, size, size))
@@ -161,7 +256,7 @@ def _triangle(center: np.ndarray, size: float, normal: np.ndarray) -> tuple[np.n
 
 
 def tiny_beside_huge(sizes: Iterable[float] = TINY_SIZES, subdivisions: int = 2, hole: bool = True) -> Soup:
-    """Large nested spheres with tiny lone triangles and tiny closed cubes beside them.
+    """Build large nested spheres with tiny lone triangles and tiny closed cubes beside them.
 
     The outer sphere (radius 1, one face removed when ``hole``: a small crack, so that the
     min cut is not trivially zero) encloses a sphere of radius 0.5.  For every ``size`` (a
@@ -170,9 +265,19 @@ def tiny_beside_huge(sizes: Iterable[float] = TINY_SIZES, subdivisions: int = 2,
     (radius 0.75).  Node areas then range from about 12 (the outer sphere) down to
     ``(√3/4)(1e-6 D)²`` ≈ 5e-12, and the edge weights (Eq. 5) over 12 orders of magnitude.
 
+    Parameters
+    ----------
+    sizes : iterable of float
+        Edge lengths of the tiny pieces, fractions of ``D``.
+    subdivisions : int
+        Icosphere level of both spheres.
+    hole : bool
+        Remove one face of the outer sphere.
+
     Returns
     -------
-    Soup with one part per piece: ``outer``, ``inner``, ``{out,in}_{tri,cube}_<size>``
+    Soup
+        One part per piece: ``outer``, ``inner``, ``{out,in}_{tri,cube}_<size>``.
     """
     import trimesh
 
