@@ -211,9 +211,9 @@ def run(args: argparse.Namespace) -> int:
     """Run ``meshvis batch``: one repair operation over many files, locally or on Dask.
 
     Every file's output and report go into ``--out`` (created when missing), together with
-    ``summary.csv`` and ``summary.json``.  A status line per file is printed on standard
-    error (with a progress bar on a terminal) and, unless ``--quiet``, a summary table and
-    the errors in full on standard output.
+    ``summary.csv`` and ``summary.json``.  Unless ``--quiet``, a status line per file is
+    printed on standard error (with a progress bar on a terminal), then a summary table
+    and the errors in full on standard output.
 
     Parameters
     ----------

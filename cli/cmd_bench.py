@@ -15,7 +15,7 @@ def add_parser(sub) -> None:
     ``rays`` and ``classify`` are set up here; every other benchmark is a module of
     :mod:`meshvis.eval.bench` with ``add_arguments(parser)`` and ``main(args)``, whose help is
     the first line of its module docstring (a module that is not there is left out).
-    ``meshvis bench`` without a benchmark prints the help and returns 2.
+    A benchmark name is required: ``meshvis bench`` alone is a usage error (status 2).
 
     Parameters
     ----------

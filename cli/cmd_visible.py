@@ -46,7 +46,8 @@ def add_parser(sub) -> None:
 def run(args: argparse.Namespace) -> int:
     """Run ``meshvis visible``: search which faces can be seen from the region ``--from``.
 
-    Prints one line (faces and share of the area seen, rays, why the search stopped, time).
+    Prints one line unless ``--quiet`` (faces and share of the area seen, rays, why the
+    search stopped, time).
     No model is written; ``--report`` writes the JSON report with per-face results and
     ``--preview`` a picture with the unseen faces in red.
 
