@@ -556,8 +556,8 @@ def write_obj(
     groups: np.ndarray | None = None,
     group_names: list[str] | None = None,
     face_values=None,
-) -> None:
-    """Write ``soup`` as OBJ, plus an MTL file and textures when it has materials.
+) -> bool:
+    """Write ``soup`` as OBJ, plus an MTL file and textures when it has materials; True when edited.
 
     A soup read from an OBJ file whose faces are input faces (some removed, turned over or
     repeated) on the vertices as read is written by editing the input's lines
@@ -595,6 +595,7 @@ def write_obj(
     except BaseException:
         remove_created(created)
         raise
+    return edits is not None
 
 
 def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:

@@ -36,7 +36,7 @@ def save(
     face_groups: np.ndarray | None = None,
     group_names: list[str] | None = None,
     face_values: Mapping[str, np.ndarray] | None = None,
-) -> None:
+) -> bool:
     """Write a soup to an OBJ, PLY, STL, OFF, GLB or glTF file, atomically.
 
     Parameters
@@ -72,6 +72,13 @@ def save(
       relative to each node's centre.
     * STL (binary, float32): geometry only.  OFF: geometry and vertex colours.
 
+    :func:`rebuild_note` says in one line what a rebuilt output leaves out.
+
+    Returns
+    -------
+    bool
+        True when the input file was edited, False when the soup was written from scratch.
+
     Raises
     ------
     OutputError
@@ -105,4 +112,61 @@ def save(
     if n_mat > len(soup.materials):  # ids without a Material: give them one so writers can name them
         extra = [Material(f"material{i}") for i in range(len(soup.materials), n_mat)]
         soup = replace(soup, materials=list(soup.materials) + extra)
-    WRITERS[WRITE_FORMATS[ext]](soup, path, groups, group_names, values)
+    return bool(WRITERS[WRITE_FORMATS[ext]](soup, path, groups, group_names, values))
+
+
+def edits_with_groups(path: str) -> bool:
+    """Whether the writer for ``path`` edits its input when given face groups (PLY, STL, OFF).
+
+    OBJ and glTF writers rebuild a grouped soup (one group or node per group); PLY adds the
+    groups as a face property to the edited input; STL and OFF have no groups to write.
+    """
+    return WRITE_FORMATS.get(os.path.splitext(path)[1].lower()) in ("ply", "stl", "off")
+
+
+#: source format -> what a rebuilt output does not carry over from it
+LOST_WHEN_REBUILT = {
+    "glb": "node tree, instancing, animations, skins, vertex normals, extensions and all textures but the base colour",
+    "gltf": "node tree, instancing, animations, skins, vertex normals, extensions and all textures but the base colour",
+    "obj": "vn normals, smoothing groups, comments and polygons (written as triangles)",
+    "ply": "other elements and properties and their types, comments",
+    "stl": "header",
+    "off": "comments and polygons (written as triangles)",
+}
+
+
+def rebuild_note(soup: Soup, path: str, why: str | None = None) -> str | None:
+    """One line saying that ``path`` was written from scratch and what of the input it lacks.
+
+    Parameters
+    ----------
+    soup : Soup
+        The soup that :func:`save` wrote to ``path`` (and returned False for).
+    path : str
+        The output.
+    why : str, optional
+        The reason, when it is not the change of format (e.g. one node per layer).
+
+    Returns
+    -------
+    str or None
+        None when the soup was not read from a file (nothing to lose).
+
+    Examples
+    --------
+    >>> import meshvis, numpy as np
+    >>> soup = meshvis.as_soup((np.eye(3), np.array([[0, 1, 2]])))
+    >>> rebuild_note(soup, "out.ply") is None
+    True
+    """
+    rec = soup.source
+    if rec is None or rec.format not in LOST_WHEN_REBUILT:
+        return None
+    out = WRITE_FORMATS.get(os.path.splitext(path)[1].lower(), "?")
+    if why is None:
+        same = out == rec.format or {out, rec.format} == {"glb", "gltf"}
+        why = "the result is not an edit of the input's faces" if same else "formats differ"
+    return (
+        f"{path}: written anew, not edited from the {rec.format.upper()} input ({why}): "
+        f"its {LOST_WHEN_REBUILT[rec.format]} are not carried over"
+    )

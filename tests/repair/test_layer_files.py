@@ -1,0 +1,95 @@
+"""``layers`` outputs keep the input: per-layer files are edits of it (OBJ, glTF), PLY gets a property."""
+
+import os
+
+import numpy as np
+import pytest
+
+import meshvis
+from meshvis.io.gltf_edit import read_container
+from meshvis.io.ply import read_elements
+from meshvis.repair.operation import layer_paths, run_operation
+
+REAL = "/work/shared/models/real"
+
+
+def _model(name):
+    path = os.path.join(REAL, name)
+    if not os.path.exists(path):
+        pytest.skip(f"{path} not available")
+    return path
+
+
+def _sorted_triangles(soup):
+    t = np.round(soup.triangles, 5).reshape(len(soup.faces), 9)
+    return t[np.lexsort(t.T[::-1])]
+
+
+def _run(src, out):
+    soup = meshvis.load(src)
+    notes = []
+    report = run_operation("layers", soup, {"output": out, "seed": 0}, say=notes.append)
+    return soup, report, notes
+
+
+def _layers(report):
+    return np.asarray(report["per_face"]["layer"])
+
+
+def test_truck_layer_files_keep_animation_nodes_materials_and_texture(tmp_path):
+    src = _model("CesiumMilkTruck.glb")
+    out = str(tmp_path / "t.glb")
+    soup, report, notes = _run(src, out)
+    layer = _layers(report)
+    assert report["layer_files"] == layer_paths(out, int(layer.max()))
+    assert any(n.startswith(f"{out}: written anew") and "animations" in n for n in notes)  # the grouped file
+    a, abuf, _ = read_container(src, "in")
+    for k, path in enumerate(report["layer_files"], start=1):
+        b, bbuf, _ = read_container(path, "out")
+        for key in ("animations", "materials", "textures", "images", "samplers", "scenes", "skins", "asset"):
+            assert b.get(key) == a.get(key), (path, key)
+        assert [{x: v for x, v in n.items() if x != "mesh"} for n in b["nodes"]] == [
+            {x: v for x, v in n.items() if x != "mesh"} for n in a["nodes"]
+        ]
+        view = a["images"][0]["bufferView"]
+        va, vb = a["bufferViews"][view], b["bufferViews"][view]
+        assert va == vb
+        start, end = va.get("byteOffset", 0), va.get("byteOffset", 0) + va["byteLength"]
+        assert bytes(bbuf[0][start:end]) == bytes(abuf[0][start:end])  # texture bytes
+        back = meshvis.load(path)
+        assert np.array_equal(_sorted_triangles(back), _sorted_triangles(soup.subset(layer == k)))
+    assert not any(n.startswith(f"{report['layer_files'][0]}:") for n in notes)  # edited: no note
+
+
+@pytest.mark.parametrize("name", ["suzanne.obj", "spot.obj"])
+def test_obj_layer_files_keep_normals_uvs_and_groups(name, tmp_path):
+    src = _model(name)
+    out = str(tmp_path / name)
+    soup, report, _ = _run(src, out)
+    layer = _layers(report)
+
+    def non_face(path):
+        lines = open(path, encoding="latin-1").read().splitlines()
+        return [ln for ln in lines if not ln.startswith(("f ", "mtllib"))]
+
+    stem = os.path.splitext(name)[0]
+    for k, path in enumerate(report["layer_files"], start=1):
+        # v, vt, vn, s, g, usemtl, comments; the faces before any o/g keep the input's part name
+        assert [ln for ln in non_face(path) if ln != f"o {stem}"] == non_face(src)
+        back = meshvis.load(path)
+        assert np.array_equal(_sorted_triangles(back), _sorted_triangles(soup.subset(layer == k)))
+        if soup.uv is not None:
+            uv = soup.subset(layer == k).uv.reshape(-1, 6)
+            assert np.array_equal(np.sort(back.uv.reshape(-1, 6), axis=0), np.sort(uv, axis=0))
+
+
+def test_ply_layers_output_is_the_input_with_a_layer_property(tmp_path):
+    src = _model("pyvista__ant.ply")
+    out = str(tmp_path / "ant.ply")
+    soup, report, notes = _run(src, out)
+    assert "layer_files" not in report and not [n for n in notes if "written anew" in n]  # edited
+    a, ca = read_elements(src, "in")
+    b, cb = read_elements(out, "out")
+    assert list(b) == list(a) and all(np.array_equal(a["vertex"][k], b["vertex"][k]) for k in a["vertex"])
+    assert np.array_equal(a["face"]["vertex_indices"][1], b["face"]["vertex_indices"][1])
+    assert np.array_equal(b["face"]["layer"][soup.source_face], _layers(report))
