@@ -36,7 +36,7 @@ def save(
     face_groups: np.ndarray | None = None,
     group_names: list[str] | None = None,
     face_values: Mapping[str, np.ndarray] | None = None,
-) -> bool:
+) -> None:
     """Write a soup to an OBJ, PLY, STL, OFF, GLB or glTF file, atomically.
 
     Parameters
@@ -72,12 +72,8 @@ def save(
       relative to each node's centre.
     * STL (binary, float32): geometry only.  OFF: geometry and vertex colours.
 
-    :func:`rebuild_note` says in one line what a rebuilt output leaves out.
-
-    Returns
-    -------
-    bool
-        True when the input file was edited, False when the soup was written from scratch.
+    :func:`write` does the same and tells which of the two it did; :func:`rebuild_note`
+    says in one line what a rebuilt output leaves out.
 
     Raises
     ------
@@ -85,6 +81,43 @@ def save(
         Unknown extension, missing or unwritable folder.
     ParameterError
         ``face_groups`` / ``face_values`` of the wrong length.
+    """
+    write(soup, path, face_groups=face_groups, group_names=group_names, face_values=face_values)
+
+
+def write(
+    soup: Soup,
+    path: str | os.PathLike,
+    *,
+    face_groups: np.ndarray | None = None,
+    group_names: list[str] | None = None,
+    face_values: Mapping[str, np.ndarray] | None = None,
+) -> bool:
+    """:func:`save`, telling whether it edited the input or wrote the soup from scratch.
+
+    Parameters
+    ----------
+    soup, path, face_groups, group_names, face_values
+        As for :func:`save`.
+
+    Returns
+    -------
+    bool
+        True when the file the soup was read from was edited, False when the soup was
+        written from scratch.
+
+    Raises
+    ------
+    OutputError, ParameterError
+        As :func:`save`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> soup = as_soup((np.eye(3), np.array([[0, 1, 2]])))
+    >>> import tempfile, os
+    >>> write(soup, os.path.join(tempfile.mkdtemp(), "t.ply"))  # no file behind it: written anew
+    False
     """
     path = _validate.path("path", path)
     soup = as_soup(soup)
@@ -141,7 +174,7 @@ def rebuild_note(soup: Soup, path: str, why: str | None = None) -> str | None:
     Parameters
     ----------
     soup : Soup
-        The soup that :func:`save` wrote to ``path`` (and returned False for).
+        The soup that :func:`write` wrote to ``path`` (and returned False for).
     path : str
         The output.
     why : str, optional

@@ -179,10 +179,10 @@ def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
 
 
 def _save(soup, path: str, tell: Callable[[str], None], why: str | None = None, **groups) -> bool:
-    """:func:`meshvis.save`, with a one-line note when the output is rebuilt rather than edited."""
-    from meshvis.io import rebuild_note, save
+    """:func:`meshvis.io.writing.write`, with a one-line note when the output is rebuilt, not edited."""
+    from meshvis.io.writing import rebuild_note, write
 
-    edited = save(soup, path, **groups)
+    edited = write(soup, path, **groups)
     note = None if edited else rebuild_note(soup, path, why)
     if note:
         tell(note)

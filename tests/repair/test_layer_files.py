@@ -59,6 +59,28 @@ def test_truck_layer_files_keep_animation_nodes_materials_and_texture(tmp_path):
         back = meshvis.load(path)
         assert np.array_equal(_sorted_triangles(back), _sorted_triangles(soup.subset(layer == k)))
     assert not any(n.startswith(f"{report['layer_files'][0]}:") for n in notes)  # edited: no note
+    for path in report["layer_files"]:
+        assert _validate(path)["errors"] == 0
+
+
+def _validate(path):
+    import json
+    import shutil
+    import subprocess
+
+    here = os.path.join(os.path.dirname(__file__), "..", "io")
+    node = shutil.which("node")
+    root = os.environ.get("NODE_PATH") or os.path.join(here, "..", "..", ".tools", "gltf", "node_modules")
+    if not node or not os.path.isdir(os.path.join(root, "gltf-validator")):
+        pytest.skip("gltf-validator (npm) not installed; .ci/run installs it")
+    run = subprocess.run(
+        [node, os.path.join(here, "validate_gltf.js"), path],
+        capture_output=True,
+        text=True,
+        env={**os.environ, "NODE_PATH": root},
+        timeout=120,
+    )
+    return json.loads(run.stdout)
 
 
 @pytest.mark.parametrize("name", ["suzanne.obj", "spot.obj"])
