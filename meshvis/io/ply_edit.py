@@ -11,6 +11,7 @@ their corners.  A binary file stays binary in the same byte order, ASCII stays A
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -143,6 +144,14 @@ def _turned_normals(src, columns: dict, corner_turned: np.ndarray):
     turned_use = np.bincount(idx[ok & corner_turned], minlength=n) > 0
     kept_use = np.bincount(idx[ok & ~corner_turned], minlength=n) > 0
     split = np.flatnonzero(turned_use & kept_use)
+    index_type = np.asarray(columns[src.index_name][1]).dtype
+    if len(split) and n + len(split) - 1 > np.iinfo(index_type).max:
+        warnings.warn(
+            f"{len(split)} vertices shared by turned and unturned faces keep their normals: their "
+            f"copies would not fit the file's {index_type} vertex indices",
+            stacklevel=4,
+        )
+        split = split[:0]
     copy_of = np.full(n, -1, np.int64)
     copy_of[split] = n + np.arange(len(split))
     move = ok & corner_turned & (copy_of[np.where(ok, idx, 0)] >= 0)
