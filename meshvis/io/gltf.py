@@ -393,14 +393,15 @@ def write_gltf(
 
     A soup read from a glTF file whose faces are input faces (some removed, turned over,
     reordered or repeated) on the vertices as read is written by editing the input
-    document (:mod:`meshvis.io.gltf_edit`); any other soup, or one with ``groups``, is
-    written from scratch.
+    document (:mod:`meshvis.io.gltf_edit`; with ``groups``, each node keeps the faces of
+    the first group and gets a child node per other group); any other soup is written
+    from scratch, with one node per part or per group.
     """
-    edits = face_edits(soup, ("glb", "gltf")) if groups is None else None
+    edits = face_edits(soup, ("glb", "gltf"))
     if (
         edits is not None
         and can_edit(edits.record.data, path)
-        and write_edited(edits, soup.faces, path, binary)
+        and write_edited(edits, soup.faces, path, binary, groups, group_names)
     ):
         return True
 

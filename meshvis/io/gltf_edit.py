@@ -18,6 +18,9 @@ Rules:
 * a primitive left without faces is dropped from its mesh; a node whose mesh is left
   without primitives loses its mesh (and skin / morph weights), the mesh stays unused;
 * a primitive drawn as a strip or a fan that changed is rewritten as a triangle list;
+* a turned face's shading normals turn with it (:func:`turn_normals`);
+* with face groups (e.g. layers), every node keeps the faces of the first group and gets
+  a child node per other group it has faces in (:func:`_group_children`);
 * a changed Draco-compressed primitive cannot be edited: the soup is then written anew.
 
 The library pygltflib was measured as the document layer and not used: loading and saving
@@ -162,7 +165,14 @@ def can_edit(src: GltfSource, path: str) -> bool:
     return os.path.abspath(src.folder) == out_folder
 
 
-def write_edited(edits: FaceEdits, faces: np.ndarray, path: str, binary: bool) -> bool:
+def write_edited(
+    edits: FaceEdits,
+    faces: np.ndarray,
+    path: str,
+    binary: bool,
+    groups: np.ndarray | None = None,
+    group_names: list[str] | None = None,
+) -> bool:
     """Write the input document with the faces of the soup (see the module docstring).
 
     Parameters
@@ -175,6 +185,12 @@ def write_edited(edits: FaceEdits, faces: np.ndarray, path: str, binary: bool) -
         Output file.
     binary : bool
         GLB (True) or a self-contained .gltf with data URIs (False).
+    groups : (m,) int64, optional
+        A group per face (e.g. a layer).  Every node keeps the faces of the first group
+        present; the faces of every other group go to a new child node of each node,
+        named ``<node>.<group name>`` (see :func:`_group_children`).
+    group_names : list of str, optional
+        Name of every group number.
 
     Returns
     -------
@@ -182,15 +198,56 @@ def write_edited(edits: FaceEdits, faces: np.ndarray, path: str, binary: bool) -
         False (nothing written) when a changed primitive is Draco-compressed.
     """
     src: GltfSource = edits.record.data
-    variants = _piece_indices(src, edits, faces)
-    if _compressed(src.doc, variants):
+    if groups is None or len(groups) == 0:
+        parts = [(0, _piece_indices(src, edits, faces))]
+    else:
+        parts = []
+        for g in np.unique(groups).tolist():
+            sel = groups == g
+            sub = FaceEdits(edits.record, edits.origin[sel], edits.flipped[sel])
+            parts.append((g, _piece_indices(src, sub, faces[sel])))
+    if any(_compressed(src.doc, v) for _, v in parts):
         return False
     doc = copy.deepcopy(src.doc)
     buffers = [bytearray(b) if b is not None else None for b in src.buffers]
     state = _EditState(doc, buffers, src.glb_bin, src.folder)
-    _apply_variants(state, src, variants)
+    instances = list(dict.fromkeys(int(n) for n in src.pieces[:, 0]))
+    users = list(instances)
+    changes = dict(parts[0][1])
+    for g, variant in parts[1:]:
+        name = (group_names or [])[g] if g < len(group_names or []) else f"group{g}"
+        children = _group_children(doc, instances, variant, name)
+        changes.update(children)
+        users += list(children)
+    _apply_variants(state, users, changes)
     _write_document(state, path, binary)
     return True
+
+
+def _group_children(doc: dict, users: list[int], variant: dict, name: str) -> dict:
+    """One child node per node with faces in a group; returns child -> its primitive changes.
+
+    The child has no transform of its own (it moves with its parent, animations
+    included), the parent's mesh, skin and morph weights, and the name
+    ``<parent>.<name>``; :func:`_apply_variants` then gives it the group's faces.
+    """
+    nodes = doc["nodes"]
+    out = {}
+    for node in users:
+        change = variant.get(node, {})
+        n_prims = len(doc["meshes"][nodes[node]["mesh"]]["primitives"])
+        if change and sum(1 for v, _ in change.values() if len(v) == 0) == n_prims:
+            continue  # no face of this node in the group
+        parent = nodes[node]
+        stem = (
+            parent.get("name") or doc["meshes"][parent["mesh"]].get("name") or f"node{node}"
+        )  # as the reader
+        child = {"name": f"{stem}.{name}", "mesh": parent["mesh"]}
+        child.update({k: parent[k] for k in ("skin", "weights") if k in parent})
+        nodes.append(child)
+        parent.setdefault("children", []).append(len(nodes) - 1)
+        out[len(nodes) - 1] = change
+    return out
 
 
 def _compressed(doc: dict, changes: dict) -> bool:
@@ -385,12 +442,13 @@ class _EditState:
         return len(views) - 1
 
 
-def _apply_variants(state: _EditState, src: GltfSource, changes: dict) -> None:
-    """Edit the meshes for the changed pieces, splitting a shared mesh only when needed."""
+def _apply_variants(state: _EditState, users: list[int], changes: dict) -> None:
+    """Edit the meshes of the nodes ``users`` for their changes, splitting a shared mesh only when needed."""
     doc = state.doc
     nodes = doc.get("nodes", [])
+    original = copy.deepcopy(doc.get("meshes", []))
     instances: dict[int, list[int]] = {}
-    for node in dict.fromkeys(int(n) for n in src.pieces[:, 0]):
+    for node in users:
         instances.setdefault(int(nodes[node]["mesh"]), []).append(node)
     for mesh_index, users in instances.items():
         keyed: dict = {}
@@ -407,12 +465,12 @@ def _apply_variants(state: _EditState, src: GltfSource, changes: dict) -> None:
                 continue
             group = keyed[key]
             target = mesh_index
-            n_prims = len(src.doc["meshes"][mesh_index]["primitives"])
+            n_prims = len(original[mesh_index]["primitives"])
             if sum(1 for v, _ in changes[group[0]].values() if len(v) == 0) == n_prims:
                 _drop_mesh(doc, group)  # nothing left to draw: no copy needed
                 continue
             if key != base:  # instances that need other faces than the mesh keeps: a copy
-                doc["meshes"].append(copy.deepcopy(src.doc["meshes"][mesh_index]))
+                doc["meshes"].append(copy.deepcopy(original[mesh_index]))
                 target = len(doc["meshes"]) - 1
                 for prim in doc["meshes"][target]["primitives"]:
                     if "indices" in prim:

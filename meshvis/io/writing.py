@@ -46,7 +46,9 @@ def save(
         The extension picks the format.
     face_groups : (m,) int, optional
         A group number per face (e.g. a layer); written as OBJ ``g`` groups inside the
-        parts, as one glTF node per group, and as a ``group`` face property in PLY.
+        parts, as glTF nodes (an edited document: each node keeps the faces of the first
+        group and gets a child node ``<node>.<group name>`` per other group; a rebuilt
+        one: one node per group), and as a ``group`` face property in PLY.
     group_names : list of str, optional
         Name of each group number; default ``group<k>``.
     face_values : dict name -> (m,) array, optional
@@ -56,11 +58,12 @@ def save(
     ----------------------
     A soup read from a file of the output's format whose faces are input faces (some
     removed, turned over, reordered or repeated; ``Soup.origin`` tells which) on the
-    vertices as read, saved without ``face_groups`` / ``face_values``, is written by
-    editing the input file: everything but the face data is kept as it was (glTF nodes,
-    instancing, accessors, materials, texture bytes, animations, extensions; OBJ ``vn``,
-    smoothing groups, comments, polygons; every PLY element and property with its type;
-    the STL header).  Any other soup is written from scratch:
+    vertices as read (OBJ: saved without ``face_groups``), is written by editing the
+    input file: everything but the face data is kept as it was (glTF nodes, instancing,
+    accessors, materials, texture bytes, animations, extensions; OBJ ``vn``, smoothing
+    groups, comments, polygons; every PLY element and property with its type; the STL
+    header); turned faces get turned shading normals (docs/files.md).  Any other soup
+    is written from scratch:
 
     * OBJ: parts (``o``), groups (``g``), materials (an MTL file next to the OBJ, textures
       copied next to it), UVs, vertex colours (RGB).
@@ -148,13 +151,15 @@ def write(
     return bool(WRITERS[WRITE_FORMATS[ext]](soup, path, groups, group_names, values))
 
 
-def edits_with_groups(path: str) -> bool:
-    """Whether the writer for ``path`` edits its input when given face groups (PLY, STL, OFF).
+def rebuilds_groups(path: str) -> bool:
+    """Whether the writer for ``path`` writes a soup with face groups from scratch (OBJ).
 
-    OBJ and glTF writers rebuild a grouped soup (one group or node per group); PLY adds the
-    groups as a face property to the edited input; STL and OFF have no groups to write.
+    An OBJ file's groups are its ``g`` statements, so a grouped soup is written anew with
+    one group per face group.  The other writers edit the input: glTF gives every node a
+    child node per further group, PLY adds the groups as a face property, STL and OFF have
+    no groups to write.
     """
-    return WRITE_FORMATS.get(os.path.splitext(path)[1].lower()) in ("ply", "stl", "off")
+    return WRITE_FORMATS.get(os.path.splitext(path)[1].lower()) == "obj"
 
 
 #: source format -> what a rebuilt output does not carry over from it

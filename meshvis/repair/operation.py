@@ -200,12 +200,13 @@ def layer_paths(path: str, n: int) -> list[str]:
 def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     """``layers``: the model with one face group per layer, and a preview coloured by layer.
 
-    When the output's format is the input's and groups would rebuild it (OBJ, glTF), every
-    layer is also written as the input edited to that layer's faces (:func:`layer_paths`),
-    so each keeps everything the input had.
+    An edited glTF output gives each node a child node per deeper layer; a PLY output gets
+    a ``layer`` face property.  An OBJ output of an OBJ input is rebuilt with one group per
+    layer, so every layer is also written as the input edited to that layer's faces
+    (:func:`layer_paths`), each keeping everything the input had.
     """
     from meshvis.io import check_output
-    from meshvis.io.writing import edits_with_groups
+    from meshvis.io.writing import rebuilds_groups
     from meshvis.rays.render import render_layers, save_png
     from meshvis.repair.layers import layers
 
@@ -216,7 +217,7 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     edited = _save(soup, o["output"], tell, "one node or group per layer", **groups)
     report = r.report()
     wrote = [o["output"]]
-    if not edited and not edits_with_groups(o["output"]) and _same_format(soup, o["output"]):
+    if not edited and rebuilds_groups(o["output"]) and _same_format(soup, o["output"]):
         for k, path in enumerate(layer_paths(o["output"], n), start=1):
             check_output(path, [soup.path] if soup.path else [], bool(o.get("force", True)))
             _save(soup.subset(r.layer == k), path, tell)

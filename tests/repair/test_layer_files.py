@@ -1,4 +1,4 @@
-"""``layers`` outputs keep the input: per-layer files are edits of it (OBJ, glTF), PLY gets a property."""
+"""``layers`` outputs keep the input: glTF gets child nodes, PLY a property, OBJ per-layer edits."""
 
 import os
 
@@ -36,31 +36,39 @@ def _layers(report):
     return np.asarray(report["per_face"]["layer"])
 
 
-def test_truck_layer_files_keep_animation_nodes_materials_and_texture(tmp_path):
-    src = _model("CesiumMilkTruck.glb")
-    out = str(tmp_path / "t.glb")
+@pytest.mark.parametrize("name", ["CesiumMilkTruck.glb", "pins.glb"])
+def test_gltf_layers_output_is_the_input_with_a_child_node_per_deeper_layer(name, tmp_path):
+    src = _model(name)
+    out = str(tmp_path / name)
     soup, report, notes = _run(src, out)
     layer = _layers(report)
-    assert report["layer_files"] == layer_paths(out, int(layer.max()))
-    assert any(n.startswith(f"{out}: written anew") and "animations" in n for n in notes)  # the grouped file
+    assert layer.max() >= 2 and "layer_files" not in report
+    assert not [n for n in notes if "written anew" in n]  # edited in place
     a, abuf, _ = read_container(src, "in")
-    for k, path in enumerate(report["layer_files"], start=1):
-        b, bbuf, _ = read_container(path, "out")
-        for key in ("animations", "materials", "textures", "images", "samplers", "scenes", "skins", "asset"):
-            assert b.get(key) == a.get(key), (path, key)
-        assert [{x: v for x, v in n.items() if x != "mesh"} for n in b["nodes"]] == [
-            {x: v for x, v in n.items() if x != "mesh"} for n in a["nodes"]
-        ]
-        view = a["images"][0]["bufferView"]
-        va, vb = a["bufferViews"][view], b["bufferViews"][view]
-        assert va == vb
+    b, bbuf, _ = read_container(out, "out")
+    for key in ("animations", "materials", "textures", "images", "samplers", "scenes", "skins", "asset"):
+        assert b.get(key) == a.get(key), key
+    n0 = len(a["nodes"])
+    for na, nb in zip(a["nodes"], b["nodes"]):  # the input's nodes, in place, with new children
+        assert {k: v for k, v in na.items() if k not in ("mesh", "children")} == {
+            k: v for k, v in nb.items() if k not in ("mesh", "children")
+        }
+        assert nb.get("children", [])[: len(na.get("children", []))] == na.get("children", [])
+        assert all(c >= n0 for c in nb.get("children", [])[len(na.get("children", [])) :])
+    assert all(set(n) <= {"name", "mesh", "skin", "weights"} for n in b["nodes"][n0:])  # no own transform
+    for im in a.get("images", []):  # texture bytes
+        va = a["bufferViews"][im["bufferView"]]
+        assert b["bufferViews"][im["bufferView"]] == va
         start, end = va.get("byteOffset", 0), va.get("byteOffset", 0) + va["byteLength"]
-        assert bytes(bbuf[0][start:end]) == bytes(abuf[0][start:end])  # texture bytes
-        back = meshvis.load(path)
-        assert np.array_equal(_sorted_triangles(back), _sorted_triangles(soup.subset(layer == k)))
-    assert not any(n.startswith(f"{report['layer_files'][0]}:") for n in notes)  # edited: no note
-    for path in report["layer_files"]:
-        assert _validate(path)["errors"] == 0
+        assert bytes(bbuf[0][start:end]) == bytes(abuf[0][start:end])
+    back = meshvis.load(out)
+    part_layer = [int(p.rsplit(".layer", 1)[1]) if ".layer" in p else 1 for p in back.part_names]
+    got = np.array(part_layer)[back.part_id]
+    for k in range(1, int(layer.max()) + 1):
+        assert np.array_equal(
+            _sorted_triangles(back.subset(got == k)), _sorted_triangles(soup.subset(layer == k))
+        )
+    assert _validate(out)["errors"] == 0
 
 
 def _validate(path):
@@ -89,6 +97,7 @@ def test_obj_layer_files_keep_normals_uvs_and_groups(name, tmp_path):
     out = str(tmp_path / name)
     soup, report, _ = _run(src, out)
     layer = _layers(report)
+    assert report["layer_files"] == layer_paths(out, int(layer.max()))
 
     def non_face(path):
         lines = open(path, encoding="latin-1").read().splitlines()
