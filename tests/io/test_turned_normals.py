@@ -369,3 +369,58 @@ def test_gltf_orient_of_broken_windings_with_right_normals_restores_them(tmp_pat
         n_disagree += int((turned & ~agreed).sum())
     assert n_disagree < 0.01 * soup.n_faces
     assert _validate(out)["errors"] == 0
+
+
+def test_obj_relative_normal_indices_resolve_and_stay_valid(tmp_path):
+    # two triangles sharing an edge, normals given by relative (negative) indices
+    src = tmp_path / "rel.obj"
+    src.write_text(
+        "v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nvn 0 0 1\nvn 0 0 1\nvn 0 0 1\n"
+        "f 1//-3 2//-2 3//-1\nvn 0 0 1\nf 2//-1 4//-1 3//-1\n"
+    )
+    soup = meshvis.load(str(src))
+    os.mkdir(tmp_path / "out")
+    out = str(tmp_path / "out" / "rel.obj")
+    meshvis.save(soup.flipped(np.array([True, False])), out)
+    lines = open(out).read().splitlines()
+    # a later face counts back: the copies go to the end, so its -1 still means the 4th normal
+    assert lines[:9] == src.read_text().splitlines()[:7] + ["f 1//5 3//6 2//7", "vn 0 0 1"]
+    assert lines[9:] == ["f 2//-1 4//-1 3//-1", "vn -0 -0 -1", "vn -0 -0 -1", "vn -0 -0 -1"]
+
+
+def test_ply_copies_that_would_overflow_the_index_type_are_not_made(tmp_path):
+    g = np.stack(np.meshgrid(np.arange(16.0), np.arange(16.0)), -1).reshape(-1, 2)
+    v = np.column_stack([g, np.zeros(256)]).astype("<f4")  # 256 vertices: uchar indices are full
+    q = (np.arange(15)[:, None] * 16 + np.arange(15)).reshape(-1)
+    f = np.concatenate([np.stack([q, q + 1, q + 17], 1), np.stack([q, q + 17, q + 16], 1)])
+    head = (
+        "ply\nformat binary_little_endian 1.0\nelement vertex 256\nproperty float x\nproperty float y\n"
+        "property float z\nproperty float nx\nproperty float ny\nproperty float nz\n"
+        f"element face {len(f)}\nproperty list uchar uchar vertex_indices\nend_header\n"
+    )
+    vd = np.zeros(256, [("p", "<f4", 3), ("n", "<f4", 3)])
+    vd["p"], vd["n"] = v, [0, 0, 1]
+    fd = np.zeros(len(f), [("k", "u1"), ("i", "u1", 3)])
+    fd["k"], fd["i"] = 3, f
+    src = tmp_path / "grid.ply"
+    src.write_bytes(head.encode() + vd.tobytes() + fd.tobytes())
+    soup = meshvis.load(str(src))
+    flip = np.arange(soup.n_faces) < len(q)  # the first triangle of every quad
+    out = str(tmp_path / "o.ply")
+    with pytest.warns(UserWarning, match="keep their normals"):
+        meshvis.save(soup.flipped(flip), out)
+    pos, n, faces, _ = _ply_corners_no_red(out)
+    assert len(pos) == 256 and faces.max() <= 255
+    only_turned = ~np.isin(np.arange(256), f[~flip])
+    assert 0 < only_turned.sum() < 256
+    assert np.array_equal(n[only_turned, 2], -np.ones(only_turned.sum())) and (n[~only_turned, 2] == 1).all()
+
+
+def _ply_corners_no_red(path):
+    from meshvis.io.ply import read_elements
+
+    e, _ = read_elements(path, "x")
+    v = e["vertex"]
+    pos = np.column_stack([v[k] for k in "xyz"])
+    nrm = np.column_stack([v[k] for k in ("nx", "ny", "nz")])
+    return pos, nrm, e["face"]["vertex_indices"][1].reshape(-1, 3).astype(np.int64), None
