@@ -26,7 +26,7 @@ from meshvis.io._common import (
 from meshvis.io.convert import as_soup
 from meshvis.io.reading import READ_FORMATS, load, sniff
 from meshvis.io.scene import soup_from_scene
-from meshvis.io.writing import WRITE_FORMATS, save
+from meshvis.io.writing import WRITE_FORMATS, rebuild_note, save
 
 __all__ = [
     "READ_FORMATS",
@@ -37,6 +37,7 @@ __all__ = [
     "ensure_folder",
     "load",
     "one_line",
+    "rebuild_note",
     "save",
     "sniff",
     "soup_from_scene",

@@ -388,21 +388,22 @@ class _Buffer:
 
 def write_gltf(
     soup: Soup, path: str, groups=None, group_names=None, face_values=None, *, binary: bool = True
-) -> None:
+) -> bool:
     """Write ``soup`` as GLB (``binary=True``) or as one self-contained .gltf (see the module docstring).
 
     A soup read from a glTF file whose faces are input faces (some removed, turned over,
     reordered or repeated) on the vertices as read is written by editing the input
-    document (:mod:`meshvis.io.gltf_edit`); any other soup, or one with ``groups``, is
-    written from scratch.
+    document (:mod:`meshvis.io.gltf_edit`; with ``groups``, each node keeps the faces of
+    the first group and gets a child node per other group); any other soup is written
+    from scratch, with one node per part or per group.
     """
-    edits = face_edits(soup, ("glb", "gltf")) if groups is None else None
+    edits = face_edits(soup, ("glb", "gltf"))
     if (
         edits is not None
         and can_edit(edits.record.data, path)
-        and write_edited(edits, soup.faces, path, binary)
+        and write_edited(edits, soup.faces, path, binary, groups, group_names)
     ):
-        return
+        return True
 
     buf = _Buffer()
     if groups is not None:
@@ -445,6 +446,7 @@ def write_gltf(
         doc["images"] = images
         doc["samplers"] = [{}]
     _serialise(doc, buf.data(), path, binary)
+    return False
 
 
 def _materials(soup: Soup, buf: _Buffer) -> tuple[list, list, list]:
@@ -541,12 +543,12 @@ def _serialise(doc: dict, blob: bytes, path: str, binary: bool) -> None:
             json.dump(doc, fh, separators=(",", ":"))
 
 
-def _write_glb(soup, path, groups, group_names, face_values):
-    write_gltf(soup, path, groups, group_names, binary=True)
+def _write_glb(soup, path, groups, group_names, face_values) -> bool:
+    return write_gltf(soup, path, groups, group_names, binary=True)
 
 
-def _write_gltf_json(soup, path, groups, group_names, face_values):
-    write_gltf(soup, path, groups, group_names, binary=False)
+def _write_gltf_json(soup, path, groups, group_names, face_values) -> bool:
+    return write_gltf(soup, path, groups, group_names, binary=False)
 
 
 #: format name -> reader / writer, collected by :mod:`meshvis.io.reading` and :mod:`meshvis.io.writing`

@@ -18,6 +18,9 @@ Rules:
 * a primitive left without faces is dropped from its mesh; a node whose mesh is left
   without primitives loses its mesh (and skin / morph weights), the mesh stays unused;
 * a primitive drawn as a strip or a fan that changed is rewritten as a triangle list;
+* a turned face's shading normals turn with it (:func:`turn_normals`);
+* with face groups (e.g. layers), every node keeps the faces of the first group and gets
+  a child node per other group it has faces in (:func:`_group_children`);
 * a changed Draco-compressed primitive cannot be edited: the soup is then written anew.
 
 The library pygltflib was measured as the document layer and not used: loading and saving
@@ -33,6 +36,7 @@ import json
 import os
 import struct
 from dataclasses import dataclass
+from urllib.parse import unquote
 
 import numpy as np
 
@@ -48,7 +52,18 @@ _BASE64_PREFIX = "data:application/octet-stream;base64,"
 #: glTF index component types and their numpy types, smallest first
 _INDEX_TYPES = {5121: np.uint8, 5123: np.uint16, 5125: np.uint32}
 _ELEMENT_ARRAY_BUFFER = 34963
+_ARRAY_BUFFER = 34962
 _TRIANGLES = 4
+#: accessor component types and element widths
+_COMPONENT_TYPES = {
+    5120: np.int8,
+    5121: np.uint8,
+    5122: np.int16,
+    5123: np.uint16,
+    5125: np.uint32,
+    5126: np.float32,
+}
+_COMPONENTS = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
 
 
 @dataclass(eq=False)
@@ -150,7 +165,14 @@ def can_edit(src: GltfSource, path: str) -> bool:
     return os.path.abspath(src.folder) == out_folder
 
 
-def write_edited(edits: FaceEdits, faces: np.ndarray, path: str, binary: bool) -> bool:
+def write_edited(
+    edits: FaceEdits,
+    faces: np.ndarray,
+    path: str,
+    binary: bool,
+    groups: np.ndarray | None = None,
+    group_names: list[str] | None = None,
+) -> bool:
     """Write the input document with the faces of the soup (see the module docstring).
 
     Parameters
@@ -163,6 +185,12 @@ def write_edited(edits: FaceEdits, faces: np.ndarray, path: str, binary: bool) -
         Output file.
     binary : bool
         GLB (True) or a self-contained .gltf with data URIs (False).
+    groups : (m,) int64, optional
+        A group per face (e.g. a layer).  Every node keeps the faces of the first group
+        present; the faces of every other group go to a new child node of each node,
+        named ``<node>.<group name>`` (see :func:`_group_children`).
+    group_names : list of str, optional
+        Name of every group number.
 
     Returns
     -------
@@ -170,15 +198,56 @@ def write_edited(edits: FaceEdits, faces: np.ndarray, path: str, binary: bool) -
         False (nothing written) when a changed primitive is Draco-compressed.
     """
     src: GltfSource = edits.record.data
-    variants = _piece_indices(src, edits, faces)
-    if _compressed(src.doc, variants):
+    if groups is None or len(groups) == 0:
+        parts = [(0, _piece_indices(src, edits, faces))]
+    else:
+        parts = []
+        for g in np.unique(groups).tolist():
+            sel = groups == g
+            sub = FaceEdits(edits.record, edits.origin[sel], edits.flipped[sel])
+            parts.append((g, _piece_indices(src, sub, faces[sel])))
+    if any(_compressed(src.doc, v) for _, v in parts):
         return False
     doc = copy.deepcopy(src.doc)
     buffers = [bytearray(b) if b is not None else None for b in src.buffers]
-    state = _EditState(doc, buffers, src.glb_bin)
-    _apply_variants(state, src, variants)
+    state = _EditState(doc, buffers, src.glb_bin, src.folder)
+    instances = list(dict.fromkeys(int(n) for n in src.pieces[:, 0]))
+    users = list(instances)
+    changes = dict(parts[0][1])
+    for g, variant in parts[1:]:
+        name = (group_names or [])[g] if g < len(group_names or []) else f"group{g}"
+        children = _group_children(doc, instances, variant, name)
+        changes.update(children)
+        users += list(children)
+    _apply_variants(state, users, changes)
     _write_document(state, path, binary)
     return True
+
+
+def _group_children(doc: dict, users: list[int], variant: dict, name: str) -> dict:
+    """One child node per node with faces in a group; returns child -> its primitive changes.
+
+    The child has no transform of its own (it moves with its parent, animations
+    included), the parent's mesh, skin and morph weights, and the name
+    ``<parent>.<name>``; :func:`_apply_variants` then gives it the group's faces.
+    """
+    nodes = doc["nodes"]
+    out = {}
+    for node in users:
+        change = variant.get(node, {})
+        n_prims = len(doc["meshes"][nodes[node]["mesh"]]["primitives"])
+        if change and sum(1 for v, _ in change.values() if len(v) == 0) == n_prims:
+            continue  # no face of this node in the group
+        parent = nodes[node]
+        stem = (
+            parent.get("name") or doc["meshes"][parent["mesh"]].get("name") or f"node{node}"
+        )  # as the reader
+        child = {"name": f"{stem}.{name}", "mesh": parent["mesh"]}
+        child.update({k: parent[k] for k in ("skin", "weights") if k in parent})
+        nodes.append(child)
+        parent.setdefault("children", []).append(len(nodes) - 1)
+        out[len(nodes) - 1] = change
+    return out
 
 
 def _compressed(doc: dict, changes: dict) -> bool:
@@ -193,7 +262,7 @@ def _compressed(doc: dict, changes: dict) -> bool:
 
 
 def _piece_indices(src: GltfSource, edits: FaceEdits, faces: np.ndarray) -> dict:
-    """Map node -> {primitive -> (t, 3) local indices} for every piece whose faces changed."""
+    """Map node -> {primitive -> ((t, 3) local indices, (t,) turned over)} for every changed piece."""
     pieces = src.pieces
     first_face = pieces[:, 5]
     n_faces = np.diff(np.append(first_face, len(edits.record.faces)))
@@ -209,19 +278,70 @@ def _piece_indices(src: GltfSource, edits: FaceEdits, faces: np.ndarray) -> dict
         if mirrored:  # the reader turned these faces over; undo it for the file
             local, orig = local[:, [0, 2, 1]], orig[:, [0, 2, 1]]
         if not np.array_equal(local, orig):
-            out.setdefault(node, {})[prim] = local
+            out.setdefault(node, {})[prim] = (local, edits.flipped[sel])
     return out
 
 
 class _EditState:
     """The document being edited, its buffers and the accessors that may be overwritten."""
 
-    def __init__(self, doc: dict, buffers: list, glb_bin: int) -> None:
+    def __init__(self, doc: dict, buffers: list, glb_bin: int, folder: str = ".") -> None:
         self.doc = doc
         self.buffers = buffers
         self.glb_bin = glb_bin
+        self.folder = folder
         self.original = [bytes(b) if b is not None else None for b in buffers]
         self.uses = self._accessor_uses()
+
+    def _buffer(self, index: int) -> bytes:
+        """The input data of a buffer (an external one read from the input's folder once)."""
+        if self.original[index] is None:
+            uri = self.doc["buffers"][index]["uri"]
+            with open(os.path.join(self.folder, unquote(uri)), "rb") as fh:
+                self.original[index] = fh.read()
+        return self.original[index]
+
+    def read_accessor(self, index: int) -> np.ndarray:
+        """(count, components) values of an accessor in its own component type, sparse applied."""
+        acc = self.doc["accessors"][index]
+        dt = np.dtype(_COMPONENT_TYPES[acc["componentType"]]).newbyteorder("<")
+        width = _COMPONENTS[acc["type"]]
+        out = np.zeros((acc["count"], width), dt)
+        if "bufferView" in acc:
+            bv = self.doc["bufferViews"][acc["bufferView"]]
+            stride = bv.get("byteStride", width * dt.itemsize)
+            start = bv.get("byteOffset", 0) + acc.get("byteOffset", 0)
+            data = self._buffer(bv["buffer"])
+            out[:] = np.ndarray(out.shape, dt, data, start, (stride, dt.itemsize))
+        sparse = acc.get("sparse")
+        if sparse:
+            n = sparse["count"]
+            at = self._view_array(sparse["indices"], _COMPONENT_TYPES[sparse["indices"]["componentType"]], n)
+            out[at.astype(np.int64)] = self._view_array(sparse["values"], dt, n * width).reshape(n, width)
+        return out
+
+    def _view_array(self, ref: dict, dtype, n: int) -> np.ndarray:
+        bv = self.doc["bufferViews"][ref["bufferView"]]
+        dt = np.dtype(dtype).newbyteorder("<")
+        start = bv.get("byteOffset", 0) + ref.get("byteOffset", 0)
+        return np.frombuffer(self._buffer(bv["buffer"]), dt, n, start)
+
+    def add_accessor(self, like: dict, values: np.ndarray) -> int:
+        """A new vertex attribute accessor holding ``values`` with the type of accessor ``like``."""
+        dt = values.dtype.newbyteorder("<")
+        size = values.shape[1] * dt.itemsize
+        stride = size + (-size) % 4  # vertex attribute elements are 4-byte aligned
+        rows = np.zeros((len(values), stride), np.uint8)
+        rows[:, :size] = np.ascontiguousarray(values.astype(dt)).view(np.uint8).reshape(len(values), size)
+        view = self._append_view(rows.tobytes(), _ARRAY_BUFFER, stride if stride != size else None)
+        acc = {k: like[k] for k in ("componentType", "normalized", "type") if k in like}
+        acc.update(bufferView=view, count=int(len(values)))
+        for key, fn in (("min", np.min), ("max", np.max)):
+            if key in like and len(values):
+                acc[key] = fn(values, axis=0).tolist()
+        accs = self.doc["accessors"]
+        accs.append(acc)
+        return len(accs) - 1
 
     def _accessor_uses(self) -> dict[int, int]:
         """How many primitives (of all meshes) use each accessor as indices."""
@@ -298,7 +418,7 @@ class _EditState:
             acc["max"] = [top]
         return True
 
-    def _append_view(self, data: bytes) -> int:
+    def _append_view(self, data: bytes, kind: int = _ELEMENT_ARRAY_BUFFER, stride: int | None = None) -> int:
         """A new buffer view holding ``data``, at the end of the binary buffer."""
         target = (
             self.glb_bin if self.glb_bin >= 0 else (0 if self.buffers and self.buffers[0] is not None else -1)
@@ -315,24 +435,26 @@ class _EditState:
         offset = len(blob)
         blob.extend(data)
         views = self.doc.setdefault("bufferViews", [])
-        views.append(
-            {"buffer": target, "byteOffset": offset, "byteLength": len(data), "target": _ELEMENT_ARRAY_BUFFER}
-        )
+        view = {"buffer": target, "byteOffset": offset, "byteLength": len(data)}
+        if stride:
+            view["byteStride"] = stride
+        views.append({**view, "target": kind})
         return len(views) - 1
 
 
-def _apply_variants(state: _EditState, src: GltfSource, changes: dict) -> None:
-    """Edit the meshes for the changed pieces, splitting a shared mesh only when needed."""
+def _apply_variants(state: _EditState, users: list[int], changes: dict) -> None:
+    """Edit the meshes of the nodes ``users`` for their changes, splitting a shared mesh only when needed."""
     doc = state.doc
     nodes = doc.get("nodes", [])
+    original = copy.deepcopy(doc.get("meshes", []))
     instances: dict[int, list[int]] = {}
-    for node in dict.fromkeys(int(n) for n in src.pieces[:, 0]):
+    for node in users:
         instances.setdefault(int(nodes[node]["mesh"]), []).append(node)
     for mesh_index, users in instances.items():
         keyed: dict = {}
         for node in users:
             change = changes.get(node, {})
-            key = tuple(sorted((k, v.shape[0], v.tobytes()) for k, v in change.items()))
+            key = tuple(sorted((k, v.shape[0], v.tobytes(), t.tobytes()) for k, (v, t) in change.items()))
             keyed.setdefault(key, []).append(node)
         if list(keyed) == [()]:
             continue
@@ -343,12 +465,12 @@ def _apply_variants(state: _EditState, src: GltfSource, changes: dict) -> None:
                 continue
             group = keyed[key]
             target = mesh_index
-            n_prims = len(src.doc["meshes"][mesh_index]["primitives"])
-            if sum(1 for v in changes[group[0]].values() if len(v) == 0) == n_prims:
+            n_prims = len(original[mesh_index]["primitives"])
+            if sum(1 for v, _ in changes[group[0]].values() if len(v) == 0) == n_prims:
                 _drop_mesh(doc, group)  # nothing left to draw: no copy needed
                 continue
             if key != base:  # instances that need other faces than the mesh keeps: a copy
-                doc["meshes"].append(copy.deepcopy(src.doc["meshes"][mesh_index]))
+                doc["meshes"].append(copy.deepcopy(original[mesh_index]))
                 target = len(doc["meshes"]) - 1
                 for prim in doc["meshes"][target]["primitives"]:
                     if "indices" in prim:
@@ -356,6 +478,100 @@ def _apply_variants(state: _EditState, src: GltfSource, changes: dict) -> None:
                 for node in group:
                     nodes[node]["mesh"] = target
             _edit_mesh(state, target, changes[group[0]])
+
+
+def turn_normals(state: _EditState, prim: dict, local: np.ndarray, turned: np.ndarray) -> np.ndarray:
+    """Turn the shading normals of a primitive's turned-over faces; return its new indices.
+
+    The normals of a turned face are turned unless they already lie on its new front
+    (:func:`already_front`).  A vertex used only by turned faces gets its ``NORMAL`` negated (and its ``TANGENT``
+    handedness ``w``, so that the bitangent keeps following the texture); a vertex used by
+    turned and unturned faces is copied with every attribute (and morph target) and the
+    turned faces point at the copy.  The primitive gets new
+    accessors for the attributes that change; the input's accessors stay as they were.
+    Without ``NORMAL`` and ``TANGENT`` (viewers then shade by the winding) nothing changes.
+
+    Parameters
+    ----------
+    state : _EditState
+    prim : dict
+        The primitive, edited in place (its ``attributes`` and ``targets``).
+    local : (t, 3) int64
+        The primitive's new triangles (indices into its vertices).
+    turned : (t,) bool
+        Which of them are turned over.
+
+    Returns
+    -------
+    (t, 3) int64
+        ``local`` with the turned faces' corners on the copies.
+    """
+    attrs = prim.get("attributes", {})
+    if not ({"NORMAL", "TANGENT"} & set(attrs)) or "POSITION" not in attrs:
+        return local
+    n = int(state.doc["accessors"][attrs["POSITION"]]["count"])
+    if "NORMAL" in attrs:
+        turned = turned & ~already_front(
+            state.read_accessor(attrs["POSITION"]).astype(np.float64),
+            state.read_accessor(attrs["NORMAL"]).astype(np.float64),
+            local,
+        )
+    if not turned.any():
+        return local
+    flat = local.reshape(-1)
+    corner_turned = np.repeat(turned, 3)
+    turned_use = np.bincount(flat[corner_turned], minlength=n)[:n] > 0
+    kept_use = np.bincount(flat[~corner_turned], minlength=n)[:n] > 0
+    split = np.flatnonzero(turned_use & kept_use)
+    rows = np.concatenate([np.arange(n), split])
+    negate = np.concatenate([turned_use & ~kept_use, np.ones(len(split), bool)])
+    for table, is_target in [(attrs, False)] + [(t, True) for t in prim.get("targets", [])]:
+        for name, index in list(table.items()):
+            if len(split) == 0 and name not in ("NORMAL", "TANGENT"):
+                continue
+            values = state.read_accessor(index)[rows]
+            if name == "NORMAL":
+                values[negate] = _negate(values[negate])
+            elif name == "TANGENT" and not is_target:  # a target's TANGENT is an xyz delta
+                values[negate, 3:] = _negate(values[negate, 3:])
+            table[name] = state.add_accessor(state.doc["accessors"][index], values)
+    copy_of = np.full(n, -1, np.int64)
+    copy_of[split] = n + np.arange(len(split))
+    moved = np.where(corner_turned & (copy_of[flat] >= 0), copy_of[flat], flat)
+    return moved.reshape(-1, 3)
+
+
+def already_front(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """Per face, whether its corners' shading normals already lie on the side its winding makes the front.
+
+    The mean over the corners of (normal . geometric normal) is positive.  A turned face
+    whose normals followed its old winding (the usual case) has them turned with it; one
+    whose normals disagreed with its old winding keeps them, as they point to the side
+    the repair made the front.  A degenerate face counts as not on the front.
+
+    Parameters
+    ----------
+    positions : (n, 3) float64
+    normals : (n, 3) float64
+        Shading normal of every vertex (``faces`` index both).
+    faces : (t, 3) int64
+        The faces as written (turned faces in their new winding).
+
+    Returns
+    -------
+    (t,) bool
+    """
+    p = positions[faces]
+    g = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+    return np.einsum("tcj,tj->t", normals[faces], g) > 0
+
+
+def _negate(values: np.ndarray) -> np.ndarray:
+    """``-values`` in their own type (normalized integers clipped: -(-128) is 127 in a byte)."""
+    if values.dtype.kind == "f":
+        return -values
+    info = np.iinfo(values.dtype)
+    return np.clip(-values.astype(np.int64), info.min, info.max).astype(values.dtype)
 
 
 def _drop_mesh(doc: dict, users: list[int]) -> None:
@@ -369,9 +585,11 @@ def _edit_mesh(state: _EditState, mesh_index: int, change: dict) -> None:
     """Give the primitives of one mesh their new faces; drop the ones left empty."""
     mesh = state.doc["meshes"][mesh_index]
     prims = mesh["primitives"]
-    empty = [k for k, local in change.items() if len(local) == 0]
-    for k, local in change.items():
+    empty = [k for k, (local, _) in change.items() if len(local) == 0]
+    for k, (local, turned) in change.items():
         if len(local):
+            if turned.any():
+                local = turn_normals(state, prims[k], local, turned)
             state.set_indices(prims[k], local)
     for k in sorted(empty, reverse=True):
         acc = prims[k].get("indices")

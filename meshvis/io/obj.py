@@ -556,8 +556,8 @@ def write_obj(
     groups: np.ndarray | None = None,
     group_names: list[str] | None = None,
     face_values=None,
-) -> None:
-    """Write ``soup`` as OBJ, plus an MTL file and textures when it has materials.
+) -> bool:
+    """Write ``soup`` as OBJ, plus an MTL file and textures when it has materials; True when edited.
 
     A soup read from an OBJ file whose faces are input faces (some removed, turned over or
     repeated) on the vertices as read is written by editing the input's lines
@@ -595,6 +595,7 @@ def write_obj(
     except BaseException:
         remove_created(created)
         raise
+    return edits is not None
 
 
 def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:
@@ -604,11 +605,17 @@ def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:
     src_face = src.record
     whole, turned = edits.polygons(src_face, len(src.record_line))
     rec_tris = np.bincount(src_face, minlength=len(src.record_line))
+    normals = _TurnedNormals(src.lines) if turned.any() or edits.flipped.any() else None
+    if normals is not None:  # geometric normal of every input triangle and record, as read
+        p = edits.record.vertices[edits.record.faces]
+        tri_n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
+        rec_n = np.column_stack([np.bincount(src_face, tri_n[:, j], len(src.record_line)) for j in range(3)])
     for r in np.flatnonzero(turned).tolist():
         no = src.record_line[r]
         body, hash_, comment = lines[no].partition("#")
-        tokens = body.split()
-        lines[no] = " ".join(["f", tokens[1], *tokens[:0:-1][:-1]]) + (f" {hash_}{comment}" if hash_ else "")
+        tokens = body.split()[1:]
+        tokens = normals.turn([tokens[0], *tokens[:0:-1]], no, -rec_n[r])
+        lines[no] = " ".join(["f", *tokens]) + (f" {hash_}{comment}" if hash_ else "")
     split = np.flatnonzero(~whole & (rec_tris > 0))
     if len(split):
         order = np.argsort(src_face[edits.origin], kind="stable")
@@ -620,9 +627,14 @@ def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:
             out = []
             for k in order[a:b].tolist():
                 c = src.corners[edits.origin[k]]
-                c = c[[0, 2, 1]] if edits.flipped[k] else c
-                out.append(f"f {tokens[c[0]]} {tokens[c[1]]} {tokens[c[2]]}")
+                if edits.flipped[k]:
+                    t = normals.turn([tokens[i] for i in c[[0, 2, 1]]], no, -tri_n[edits.origin[k]])
+                else:
+                    t = [tokens[i] for i in c]
+                out.append(f"f {t[0]} {t[1]} {t[2]}")
             lines[no] = "\n".join(out) if out else None
+    if normals is not None:
+        normals.insert(lines, src.record_line)
     if mtl_name:
         lines = [f"mtllib {mtl_name}" if ln is not None and ln.startswith("mtllib") else ln for ln in lines]
     if src.default_part is not None and src.default_part != stem:
@@ -630,6 +642,81 @@ def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:
         first = int(src.record_line[0])
         lines[first : first + 1] = [f"o {src.default_part}", lines[first]]
     return "\n".join(ln for ln in lines if ln is not None) + "\n"
+
+
+def _is_vn(line: str) -> bool:
+    s = line.lstrip()
+    return s.startswith("vn") and s[2:3] in (" ", "\t")
+
+
+def _negated(line: str) -> str:
+    """A ``vn`` line with every number negated as text (exact: only the sign changes)."""
+    nums = line.partition("#")[0].split()[1:]
+    return "vn " + " ".join(x[1:] if x[0] == "-" else "-" + x.lstrip("+") for x in nums)
+
+
+class _TurnedNormals:
+    """The ``vn`` lines a turned-over face points at: one negated copy of every normal it used.
+
+    A turned face's corners are pointed at copies so that its shading normals turn with it,
+    unless they already lie on its new front (their mean dot product with its geometric
+    normal is positive: they disagreed with the old winding and point to the side the
+    repair made the front).  Faces that were not turned keep their corners and the
+    input's ``vn`` lines stay as they were.
+    """
+
+    def __init__(self, lines: list[str]) -> None:
+        self.lines = lines
+        self.vn_at = np.array([no for no, ln in enumerate(lines) if _is_vn(ln)], np.int64)
+        rows = [(lines[no].partition("#")[0].split()[1:4] + ["0", "0", "0"])[:3] for no in self.vn_at]
+        try:
+            self.values = np.array(rows, np.float64).reshape(-1, 3)
+        except ValueError:  # unreadable normals: turned with their faces, never read
+            self.values = np.zeros((len(rows), 3))
+        self.copies: dict[int, int] = {}  # input normal (0-based) -> its negated copy
+
+    def _normal(self, token: str, line_no: int) -> int:
+        """Input normal (0-based) of a corner ``v/vt/vn``, -1 without a valid one."""
+        parts = token.split("/")
+        if len(parts) < 3 or not parts[2]:
+            return -1
+        k = int(parts[2])
+        k = int(np.searchsorted(self.vn_at, line_no)) + k if k < 0 else k - 1  # relative: count back
+        return k if 0 <= k < len(self.vn_at) else -1  # a dangling reference stays as it was
+
+    def turn(self, tokens: list[str], line_no: int, normal: np.ndarray) -> list[str]:
+        """The corners of a turned face (new order), pointed at negated copies of their normals.
+
+        ``normal`` is the face's geometric normal in its new winding.
+        """
+        ks = [self._normal(t, line_no) for t in tokens]
+        have = [k for k in ks if k >= 0]
+        if not have or float(np.mean(self.values[have] @ normal)) > 0:
+            return tokens
+        out = []
+        for t, k in zip(tokens, ks):
+            if k >= 0:
+                parts = t.split("/")
+                parts[2] = str(self.copies.setdefault(k, len(self.vn_at) + len(self.copies)) + 1)
+                t = "/".join(parts)
+            out.append(t)
+        return out
+
+    def insert(self, lines: list[str], record_line: np.ndarray) -> None:
+        """Add the copies after the last ``vn`` line (at the end when a later face counts back)."""
+        if not self.copies:
+            return
+        new = "\n".join(_negated(self.lines[self.vn_at[k]]) for k in self.copies)
+        last = int(self.vn_at[-1])
+        later = record_line[record_line > last].tolist()
+        relative = any(_RELATIVE_VN.search(self.lines[no].partition("#")[0]) for no in later)
+        at = len(lines) - 1 if relative else last
+        while lines[at] is None:
+            at -= 1
+        lines[at] = lines[at] + "\n" + new
+
+
+_RELATIVE_VN = re.compile(r"/[^\s/]*/-")
 
 
 def _rebuilt_text(soup: Soup, groups, group_names, mtl_name: str | None, mat_names: list[str]) -> str:

@@ -215,7 +215,7 @@ def _polygon_records(counts: np.ndarray, label: str) -> np.ndarray:
     return keep
 
 
-def write_off(soup: Soup, path: str, groups=None, group_names=None, face_values=None) -> None:
+def write_off(soup: Soup, path: str, groups=None, group_names=None, face_values=None) -> bool:
     """Write ``soup`` as OFF, or COFF with RGBA vertex colours (welded per vertex and colour).
 
     A soup read from an OFF file whose faces are input faces (some removed, turned over or
@@ -227,7 +227,7 @@ def write_off(soup: Soup, path: str, groups=None, group_names=None, face_values=
     if edits is not None:
         with atomic_write(path, "w") as fh:
             fh.write(_edited_lines(edits))
-        return
+        return True
 
     corner_src, faces = weld_corners(soup, use_uv=False)
     flat = soup.faces.reshape(-1)
@@ -244,6 +244,7 @@ def write_off(soup: Soup, path: str, groups=None, group_names=None, face_values=
             fh.write(f"OFF\n{len(pos)} {soup.n_faces} 0\n")
             fh.write(("%s %s %s\n" * len(pos)) % tuple(fmt_floats(pos)))
         fh.write(("3 %d %d %d\n" * soup.n_faces) % tuple(faces.ravel().tolist()))
+    return False
 
 
 def _edited_lines(edits: FaceEdits) -> str:

@@ -537,7 +537,7 @@ def _ply_type(values: np.ndarray) -> tuple[str, str]:
     return "double", "<f8"
 
 
-def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=None) -> None:
+def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=None) -> bool:
     """Write ``soup`` as binary little-endian PLY (see :func:`meshvis.io.save`).
 
     Vertices are welded per (vertex, UV, colour); positions are written as doubles so the
@@ -555,7 +555,7 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
     if edits is not None:
         added, comments = _added_properties(edits, groups, group_names, face_values)
         write_edited(edits, path, added, comments)
-        return
+        return True
     corner_src, faces = weld_corners(soup)
     vdata, header_v = _vertex_rows(soup, corner_src)
     fdata, header_f, comments = _face_rows(soup, faces, groups, group_names, face_values)
@@ -575,6 +575,7 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
         fh.write((header + "\n").encode("utf-8"))
         fh.write(vdata.tobytes())
         fh.write(fdata.tobytes())
+    return False
 
 
 def _added_properties(edits, groups, group_names, face_values) -> tuple[list[NewProperty], list[str]]:

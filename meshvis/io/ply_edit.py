@@ -11,6 +11,7 @@ their corners.  A binary file stays binary in the same byte order, ASCII stays A
 
 from __future__ import annotations
 
+import warnings
 from dataclasses import dataclass
 
 import numpy as np
@@ -61,30 +62,34 @@ def write_edited(
     src = edits.record.data
     layout = src.layout
     added = list(added or [])
-    columns = _face_rows(edits, src, added)
+    columns, corner_turned = _face_rows(edits, src, added)
     n_rows = len(columns[src.index_name][0])
     name, _, props = layout.elements[src.face_element]
     props = list(props) + added
-    head = _header(layout.header, name, n_rows, added, comments or [])
+    rows = {src.face_element: (columns, props, n_rows)}
+    vertex = _turned_normals(src, columns, corner_turned)
+    if vertex is not None:
+        rows[vertex[0]] = vertex[1:]
+    counts = {layout.elements[i][0]: r[2] for i, r in rows.items()}
+    head = _header(layout.header, name, counts, added, comments or [])
     if layout.fmt == "ascii":
         body = [
-            _encode_ascii(columns, props, n_rows)
-            if i == src.face_element
-            else _encode_ascii(src.elements[e], p, n)
+            _encode_ascii(*rows[i]) if i in rows else _encode_ascii(src.elements[e], p, n)
             for i, (e, n, p) in enumerate(layout.elements)
         ]
         data = head + "".join(body).encode("latin-1")
     else:
         endian = "<" if layout.fmt == "binary_little_endian" else ">"
         parts = list(layout.raw)
-        parts[src.face_element] = _encode_binary(columns, props, n_rows, endian)
+        for i, r in rows.items():
+            parts[i] = _encode_binary(*r, endian)
         data = head + b"".join(parts)
     with atomic_write(path, "wb") as fh:
         fh.write(data)
 
 
-def _header(lines: list[str], face: str, n_rows: int, added: list, comments: list[str]) -> bytes:
-    """The input's header with the new face count, added properties and comments."""
+def _header(lines: list[str], face: str, counts: dict, added: list, comments: list[str]) -> bytes:
+    """The input's header with the new element counts, added face properties and comments."""
     out: list[str] = []
     in_face = False
     for line in lines:
@@ -95,8 +100,8 @@ def _header(lines: list[str], face: str, n_rows: int, added: list, comments: lis
             if tok[0] == "element" and comments and not any(t.split()[:1] == ["element"] for t in out):
                 out += [f"comment {c}" for c in comments]
             in_face = _is_element_line(line, face)
-            if in_face:
-                line = f"element {face} {n_rows}"
+            if len(tok) == 3 and tok[0] == "element" and tok[1] in counts:
+                line = f"element {tok[1]} {counts[tok[1]]}"
         out.append(line)
     return ("\n".join(out) + "\n").encode("latin-1")
 
@@ -106,8 +111,105 @@ def _is_element_line(line: str, name: str) -> bool:
     return len(tok) == 3 and tok[0] == "element" and tok[1] == name
 
 
-def _face_rows(edits: FaceEdits, src, added: list) -> dict:
-    """The face element's columns for the soup's faces (``added`` properties included)."""
+#: vertex properties of a shading normal
+_NORMAL = ("nx", "ny", "nz")
+
+
+def _turned_normals(src, columns: dict, corner_turned: np.ndarray):
+    """The vertex rows with the normals of turned faces turned, or None when none changes.
+
+    A vertex used only by turned faces gets its normal negated in place; a vertex used by
+    turned and unturned faces is copied (every property) with the normal negated, and the
+    turned faces' corners point at the copy.  A turned row whose normals already lie on
+    its new front keeps them (:func:`_rows_front`).  ``columns`` is
+    updated in place (the index lists).  Returns (element position, columns, properties,
+    row count).
+    """
+    names = [e[0] for e in src.layout.elements]
+    if "vertex" not in names or not corner_turned.any():
+        return None
+    at = names.index("vertex")
+    _, n, props = src.layout.elements[at]
+    vert = src.elements["vertex"]
+    if not all(k in vert and not isinstance(vert[k], tuple) for k in _NORMAL):
+        return None
+    counts, idx = columns[src.index_name]
+    idx = np.asarray(idx).astype(np.int64)
+    ok = (idx >= 0) & (idx < n)
+    normals = np.column_stack([np.asarray(vert[k], np.float64) for k in _NORMAL])
+    front = _rows_front(src, np.where(ok, idx, 0), np.asarray(counts, np.int64), normals)
+    corner_turned = corner_turned & ~front
+    if not corner_turned.any():
+        return None
+    turned_use = np.bincount(idx[ok & corner_turned], minlength=n) > 0
+    kept_use = np.bincount(idx[ok & ~corner_turned], minlength=n) > 0
+    split = np.flatnonzero(turned_use & kept_use)
+    index_type = np.asarray(columns[src.index_name][1]).dtype
+    if len(split) and n + len(split) - 1 > np.iinfo(index_type).max:
+        warnings.warn(
+            f"{len(split)} vertices shared by turned and unturned faces keep their normals: their "
+            f"copies would not fit the file's {index_type} vertex indices",
+            stacklevel=4,
+        )
+        split = split[:0]
+    copy_of = np.full(n, -1, np.int64)
+    copy_of[split] = n + np.arange(len(split))
+    move = ok & corner_turned & (copy_of[np.where(ok, idx, 0)] >= 0)
+    new_idx = np.where(move, copy_of[np.where(ok, idx, 0)], idx)
+    columns[src.index_name] = (counts, new_idx.astype(columns[src.index_name][1].dtype))
+    rows = np.concatenate([np.arange(n), split])
+    negate = np.concatenate([turned_use & ~kept_use, np.ones(len(split), bool)])
+    out = {}
+    for p in props:
+        col = vert[p.name]
+        if isinstance(col, tuple):  # a list per vertex: copied with its row
+            c, v = col
+            c = np.asarray(c, np.int64)
+            start = np.concatenate([[0], np.cumsum(c)[:-1]]).astype(np.int64)
+            k = c[rows]
+            pick = np.repeat(start[rows], k) + np.arange(int(k.sum())) - np.repeat(np.cumsum(k) - k, k)
+            out[p.name] = (k, v[pick])
+            continue
+        col = np.asarray(col)[rows]
+        if p.name in _NORMAL:
+            col = col.copy()
+            col[negate] = _negate(col[negate])
+        out[p.name] = col
+    return at, out, props, len(rows)
+
+
+def _rows_front(src, idx: np.ndarray, counts: np.ndarray, normals: np.ndarray) -> np.ndarray:
+    """Per index-list entry, whether its row's normals already lie on the row's front (see below).
+
+    The mean over the row's corners of (normal . polygon normal), the polygon normal by
+    Newell's sum over the row as written, is positive: a turned row whose normals
+    disagreed with its old winding keeps them, they point to the side the repair made the
+    front (as in :func:`meshvis.io.gltf_edit.already_front`).
+    """
+    vert = src.elements["vertex"]
+    pos = np.column_stack([np.asarray(vert[k], np.float64) for k in "xyz"])
+    row = np.repeat(np.arange(len(counts)), counts)
+    start = np.repeat(np.cumsum(counts) - counts, counts)
+    nxt = start + (np.arange(len(idx)) - start + 1) % np.maximum(np.repeat(counts, counts), 1)
+    cross = np.cross(pos[idx], pos[idx[nxt]])
+    g = np.column_stack([np.bincount(row, cross[:, j], len(counts)) for j in range(3)])
+    dots = np.einsum("ij,ij->i", normals[idx], g[row])
+    return (np.bincount(row, dots, len(counts)) > 0)[row]
+
+
+def _negate(values: np.ndarray) -> np.ndarray:
+    """``-values`` in their own type (integers clipped: -(-128) is 127 in a signed byte)."""
+    if values.dtype.kind == "f":
+        return -values
+    info = np.iinfo(values.dtype)
+    return np.clip(-values.astype(np.int64), info.min, info.max).astype(values.dtype)
+
+
+def _face_rows(edits: FaceEdits, src, added: list) -> tuple[dict, np.ndarray]:
+    """The face element's columns for the soup's faces (``added`` properties included).
+
+    Also returns, per entry of the index list, whether its face is turned over.
+    """
     counts, values = src.columns[src.index_name]
     n_rows = len(counts)
     start = np.concatenate([[0], np.cumsum(counts)[:-1]]).astype(np.int64)
@@ -137,6 +239,7 @@ def _face_rows(edits: FaceEdits, src, added: list) -> dict:
     tri = src.corners[edits.origin[occ]]
     tri = np.where(edits.flipped[occ][:, None], tri[:, [0, 2, 1]], tri)
     # all rows in input order
+    turned_corner = np.concatenate([np.repeat(turned[rows], k), np.repeat(edits.flipped[occ], 3)])
     out_src = np.concatenate([rows, tri_rows])
     out_k = np.concatenate([k, np.full(len(occ), 3, np.int64)])
     pieces = np.concatenate(
@@ -153,6 +256,7 @@ def _face_rows(edits: FaceEdits, src, added: list) -> dict:
     rank[order] = np.arange(len(order))
     corner_order = np.argsort(rank[pieces], kind="stable")
     out_src, out_k, flat = out_src[order], out_k[order], flat[corner_order]
+    turned_corner = turned_corner[corner_order]
     columns = {}
     n_corners = len(values)
     for name, col in src.columns.items():
@@ -173,7 +277,7 @@ def _face_rows(edits: FaceEdits, src, added: list) -> dict:
             columns[name] = (kk, v[idx])
     for name, v in added_values.items():
         columns[name] = v[order]
-    return columns
+    return columns, turned_corner
 
 
 def _encode_binary(columns: dict, props: list, n: int, endian: str) -> bytes:

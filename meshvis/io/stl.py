@@ -137,12 +137,12 @@ class StlSource:
     records: np.ndarray | None
 
 
-def write_stl(soup: Soup, path: str, groups=None, group_names=None, face_values=None) -> None:
-    """Write ``soup`` as STL, atomically (see the module docstring for which kind)."""
+def write_stl(soup: Soup, path: str, groups=None, group_names=None, face_values=None) -> bool:
+    """Write ``soup`` as STL, atomically (see the module docstring for which kind); True when edited."""
     edits = face_edits(soup, ("stl",))
     if edits is not None and edits.record.data.header is None:
         _write_ascii(soup, path)
-        return
+        return True
     tri = soup.triangles
     if edits is not None:
         src: StlSource = edits.record.data
@@ -159,6 +159,7 @@ def write_stl(soup: Soup, path: str, groups=None, group_names=None, face_values=
         fh.write(header)
         fh.write(struct.pack("<I", soup.n_faces))
         fh.write(rec.tobytes())
+    return edits is not None
 
 
 def _write_ascii(soup: Soup, path: str) -> None:

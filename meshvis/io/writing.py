@@ -46,7 +46,9 @@ def save(
         The extension picks the format.
     face_groups : (m,) int, optional
         A group number per face (e.g. a layer); written as OBJ ``g`` groups inside the
-        parts, as one glTF node per group, and as a ``group`` face property in PLY.
+        parts, as glTF nodes (an edited document: each node keeps the faces of the first
+        group and gets a child node ``<node>.<group name>`` per other group; a rebuilt
+        one: one node per group), and as a ``group`` face property in PLY.
     group_names : list of str, optional
         Name of each group number; default ``group<k>``.
     face_values : dict name -> (m,) array, optional
@@ -56,11 +58,12 @@ def save(
     ----------------------
     A soup read from a file of the output's format whose faces are input faces (some
     removed, turned over, reordered or repeated; ``Soup.origin`` tells which) on the
-    vertices as read, saved without ``face_groups`` / ``face_values``, is written by
-    editing the input file: everything but the face data is kept as it was (glTF nodes,
-    instancing, accessors, materials, texture bytes, animations, extensions; OBJ ``vn``,
-    smoothing groups, comments, polygons; every PLY element and property with its type;
-    the STL header).  Any other soup is written from scratch:
+    vertices as read (OBJ: saved without ``face_groups``), is written by editing the
+    input file: everything but the face data is kept as it was (glTF nodes, instancing,
+    accessors, materials, texture bytes, animations, extensions; OBJ ``vn``, smoothing
+    groups, comments, polygons; every PLY element and property with its type; the STL
+    header); turned faces get turned shading normals (docs/files.md).  Any other soup
+    is written from scratch:
 
     * OBJ: parts (``o``), groups (``g``), materials (an MTL file next to the OBJ, textures
       copied next to it), UVs, vertex colours (RGB).
@@ -72,12 +75,52 @@ def save(
       relative to each node's centre.
     * STL (binary, float32): geometry only.  OFF: geometry and vertex colours.
 
+    :func:`write` does the same and tells which of the two it did; :func:`rebuild_note`
+    says in one line what a rebuilt output leaves out.
+
     Raises
     ------
     OutputError
         Unknown extension, missing or unwritable folder.
     ParameterError
         ``face_groups`` / ``face_values`` of the wrong length.
+    """
+    write(soup, path, face_groups=face_groups, group_names=group_names, face_values=face_values)
+
+
+def write(
+    soup: Soup,
+    path: str | os.PathLike,
+    *,
+    face_groups: np.ndarray | None = None,
+    group_names: list[str] | None = None,
+    face_values: Mapping[str, np.ndarray] | None = None,
+) -> bool:
+    """:func:`save`, telling whether it edited the input or wrote the soup from scratch.
+
+    Parameters
+    ----------
+    soup, path, face_groups, group_names, face_values
+        As for :func:`save`.
+
+    Returns
+    -------
+    bool
+        True when the file the soup was read from was edited, False when the soup was
+        written from scratch.
+
+    Raises
+    ------
+    OutputError, ParameterError
+        As :func:`save`.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> soup = as_soup((np.eye(3), np.array([[0, 1, 2]])))
+    >>> import tempfile, os
+    >>> write(soup, os.path.join(tempfile.mkdtemp(), "t.ply"))  # no file behind it: written anew
+    False
     """
     path = _validate.path("path", path)
     soup = as_soup(soup)
@@ -105,4 +148,63 @@ def save(
     if n_mat > len(soup.materials):  # ids without a Material: give them one so writers can name them
         extra = [Material(f"material{i}") for i in range(len(soup.materials), n_mat)]
         soup = replace(soup, materials=list(soup.materials) + extra)
-    WRITERS[WRITE_FORMATS[ext]](soup, path, groups, group_names, values)
+    return bool(WRITERS[WRITE_FORMATS[ext]](soup, path, groups, group_names, values))
+
+
+def rebuilds_groups(path: str) -> bool:
+    """Whether the writer for ``path`` writes a soup with face groups from scratch (OBJ).
+
+    An OBJ file's groups are its ``g`` statements, so a grouped soup is written anew with
+    one group per face group.  The other writers edit the input: glTF gives every node a
+    child node per further group, PLY adds the groups as a face property, STL and OFF have
+    no groups to write.
+    """
+    return WRITE_FORMATS.get(os.path.splitext(path)[1].lower()) == "obj"
+
+
+#: source format -> what a rebuilt output does not carry over from it
+LOST_WHEN_REBUILT = {
+    "glb": "node tree, instancing, animations, skins, vertex normals, extensions and all textures but the base colour",
+    "gltf": "node tree, instancing, animations, skins, vertex normals, extensions and all textures but the base colour",
+    "obj": "vn normals, smoothing groups, comments and polygons (written as triangles)",
+    "ply": "other elements and properties and their types, comments",
+    "stl": "header",
+    "off": "comments and polygons (written as triangles)",
+}
+
+
+def rebuild_note(soup: Soup, path: str, why: str | None = None) -> str | None:
+    """One line saying that ``path`` was written from scratch and what of the input it lacks.
+
+    Parameters
+    ----------
+    soup : Soup
+        The soup that :func:`write` wrote to ``path`` (and returned False for).
+    path : str
+        The output.
+    why : str, optional
+        The reason, when it is not the change of format (e.g. one node per layer).
+
+    Returns
+    -------
+    str or None
+        None when the soup was not read from a file (nothing to lose).
+
+    Examples
+    --------
+    >>> import meshvis, numpy as np
+    >>> soup = meshvis.as_soup((np.eye(3), np.array([[0, 1, 2]])))
+    >>> rebuild_note(soup, "out.ply") is None
+    True
+    """
+    rec = soup.source
+    if rec is None or rec.format not in LOST_WHEN_REBUILT:
+        return None
+    out = WRITE_FORMATS.get(os.path.splitext(path)[1].lower(), "?")
+    if why is None:
+        same = out == rec.format or {out, rec.format} == {"glb", "gltf"}
+        why = "the result is not an edit of the input's faces" if same else "formats differ"
+    return (
+        f"{path}: written anew, not edited from the {rec.format.upper()} input ({why}): "
+        f"its {LOST_WHEN_REBUILT[rec.format]} are not carried over"
+    )

@@ -131,7 +131,6 @@ def _classify_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict
 
 def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     """``orient``: the oriented model and its preview."""
-    from meshvis.io import save
     from meshvis.rays.render import render, save_png
     from meshvis.repair.orient import orient, orient_from
 
@@ -146,7 +145,7 @@ def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
             semantics=o["semantics"],
             conflicts=o["conflicts"],
         )
-    save(r.soup, o["output"])
+    _save(r.soup, o["output"], tell)
     report = r.report()
     tell(
         f"flipped {report['flipped']} of {report['input_faces']} faces; "
@@ -159,15 +158,14 @@ def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
 
 def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     """``remove-interior``: the kept faces, optionally the removed ones, and a preview."""
-    from meshvis.io import save
     from meshvis.rays.render import render, save_png
     from meshvis.repair.remove import remove_interior
 
     r = remove_interior(soup, classification=c, **removal_kwargs(o, soup))
-    save(r.kept, o["output"])
+    _save(r.kept, o["output"], tell)
     wrote_removed = bool(o["removed"]) and r.removed.n_faces > 0
     if wrote_removed:
-        save(r.removed, o["removed"])
+        _save(r.removed, o["removed"], tell)
     report = r.report()
     tell(
         f"kept {report['kept_faces']}, removed {report['removed_faces']} of {report['input_faces']} faces; "
@@ -180,20 +178,66 @@ def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     return report
 
 
+def _save(soup, path: str, tell: Callable[[str], None], why: str | None = None, **groups) -> bool:
+    """:func:`meshvis.io.writing.write`, with a one-line note when the output is rebuilt, not edited."""
+    from meshvis.io.writing import rebuild_note, write
+
+    edited = write(soup, path, **groups)
+    note = None if edited else rebuild_note(soup, path, why)
+    if note:
+        tell(note)
+    return edited
+
+
+def layer_paths(path: str, n: int) -> list[str]:
+    """The per-layer files of a ``layers`` output: ``name.layer1.ext`` ... ``name.layer<n>.ext``."""
+    import os
+
+    stem, ext = os.path.splitext(path)
+    return [f"{stem}.layer{k}{ext}" for k in range(1, n + 1)]
+
+
 def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
-    """``layers``: the model with one face group per layer, and a preview coloured by layer."""
-    from meshvis.io import save
+    """``layers``: the model with one face group per layer, and a preview coloured by layer.
+
+    An edited glTF output gives each node a child node per deeper layer; a PLY output gets
+    a ``layer`` face property.  An OBJ output of an OBJ input is rebuilt with one group per
+    layer, so every layer is also written as the input edited to that layer's faces
+    (:func:`layer_paths`), each keeping everything the input had.
+    """
+    from meshvis.io import check_output
+    from meshvis.io.writing import rebuilds_groups
     from meshvis.rays.render import render_layers, save_png
     from meshvis.repair.layers import layers
 
     r = layers(soup, classification=c, max_layers=o["max_layers"])
-    names = [f"layer{k}" for k in range(1, int(r.layer.max()) + 1)]
-    save(soup, o["output"], face_groups=r.layer - 1, group_names=names, face_values={"layer": r.layer})
+    n = int(r.layer.max())
+    names = [f"layer{k}" for k in range(1, n + 1)]
+    groups = dict(face_groups=r.layer - 1, group_names=names, face_values={"layer": r.layer})
+    edited = _save(soup, o["output"], tell, "one node or group per layer", **groups)
     report = r.report()
-    tell(f"{r.n_layers} layers, faces per layer {report['faces_per_layer']}; wrote {o['output']}")
+    wrote = [o["output"]]
+    if not edited and rebuilds_groups(o["output"]) and _same_format(soup, o["output"]):
+        for k, path in enumerate(layer_paths(o["output"], n), start=1):
+            check_output(path, [soup.path] if soup.path else [], bool(o.get("force", True)))
+            _save(soup.subset(r.layer == k), path, tell)
+            wrote.append(path)
+        report["layer_files"] = wrote[1:]
+    tell(f"{r.n_layers} layers, faces per layer {report['faces_per_layer']}; wrote {', '.join(wrote)}")
     if o["preview"]:
         save_png(render_layers(soup, r.layer, up=up), o["preview"])
     return report
+
+
+def _same_format(soup, path: str) -> bool:
+    """Whether ``soup`` was read from a file that ``path`` can be an edit of."""
+    import os
+
+    from meshvis.io import WRITE_FORMATS
+
+    out = WRITE_FORMATS.get(os.path.splitext(path)[1].lower())
+    rec = soup.source
+    return rec is not None and (out == rec.format or {out, rec.format} == {"glb", "gltf"})
 
 
 #: operation -> the step that applies it to a classified model and writes its outputs
