@@ -109,3 +109,15 @@ def test_cli_flags_of_remove_interior_and_visible(scenes, tmp_path, capsys):
         == 0
     )
     assert main(["visible", str(src), "--from", "nowhere", "-q"]) == 2
+
+
+def test_both_searches_only_around_the_faces_the_cut_calls_hidden(scenes):
+    soup, bottom, truth = scenes.sealed_pocket()
+    r = remove_interior(soup, visibility="both", seed=0)
+    by_cut = r.reason_code == REASONS.index("kept: an outside side by the cut")
+    assert (~by_cut).any() and (r.visibility.seed_rays[by_cut] == 0).all()
+    assert r.visibility.skipped["not asked about (no seed rays)"] == int(by_cut.sum())
+    # a cube the cut keeps whole: nothing to ask about, not one ray
+    cube, _ = scenes.unit_cube()
+    whole = remove_interior(cube, visibility="both", seed=0)
+    assert whole.keep.all() and whole.visibility.rays["total"] == 0
