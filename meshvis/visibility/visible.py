@@ -5,8 +5,12 @@ random seed rays (more per face in every round); ``method="guided"`` then propag
 new sighting by adaptive border sampling and reverse sampling (GVS §3.4) until no new face
 turns up, ``method="random"`` does not (the baseline).  The first round visits the faces in
 a random order in chunks, so that faces found by propagation from an earlier chunk need no
-seed rays at all.  It stops when a round finds fewer than ``min_new`` new faces per million
-rays (GVS §3.5, judged over at least a million rays), when every face is seen, or at the ray budget.
+seed rays at all; later rounds go from the largest unseen face to the smallest in chunks of
+about a million rays.  After every chunk of the later rounds the stop rule looks at the rays
+since its last look (at least a million): it stops when they found fewer than ``min_new``
+new faces per million rays (GVS §3.5) or less than ``min_new_area`` of the model's area per
+million rays.  It also stops when every face is seen, or at the ray budget (by default only
+a cap: :func:`default_budget`).
 
 A seen side is certain (a free line of sight was traced); an unseen one is an upper bound on
 "hidden".

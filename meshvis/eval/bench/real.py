@@ -176,7 +176,7 @@ def run_model(
 
     t = time.perf_counter()
     conv = converged_search(soup, seed + 1)
-    rows["view, converged (stop rule / 10, next seed)"] = (
+    rows["view converged (rule / 10, seed+1)"] = (
         conv.seen,
         conv.rays["total"],
         time.perf_counter() - t,
