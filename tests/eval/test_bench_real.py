@@ -25,7 +25,7 @@ def test_bench_real_judges_every_method_on_a_small_model(tmp_path, capsys):
         "object (graph cut)",
         "view (guided, outside)",
         "both",
-        "view converged (rule / 10, seed+1)",
+        "view converged (5 faces, seed+1)",
         "random, rays of view",
     ]
     assert 0 <= r["view_removes_of_converged"] <= 1 and r["view_stopped"] and r["converged_stopped"]
