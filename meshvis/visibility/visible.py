@@ -35,7 +35,7 @@ from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds
 SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
 #: the first round visits the faces in this many chunks (propagation runs after each)
 FIRST_ROUND_CHUNKS = 16
-#: default stop rule: fewer new faces than this per million rays in a round (GVS §3.5 uses 50)
+#: default stop rule: fewer new faces than this per million rays (GVS §3.5 uses 50) ...
 MIN_NEW_PER_MILLION = 50.0
 #: ... or less new visible area than this fraction of the model's area per million rays.  What
 #: a viewer misses is area, not a face count: on finely tessellated models the faces found
@@ -48,10 +48,10 @@ MIN_NEW_AREA_PER_MILLION = 1e-5
 #: rays) or, on small models, this many rays per face, whichever is fewer
 STOP_WINDOW = 1_000_000
 STOP_WINDOW_PER_FACE = 64
-#: seed rounds after the first are cast in chunks of about this many rays, in a random order
-#: of the faces, and the stop rule is judged after every chunk: a round of 1,024 or 4,096
-#: rays per face would otherwise run to its end (tens of millions of rays) before the rule is
-#: asked, and a budget would cut it off at the faces of the lowest indices
+#: seed rounds after the first are cast in chunks of about this many rays, largest faces
+#: first, and the stop rule is judged after every chunk: a round of 1,024 or 4,096 rays per
+#: face would otherwise run to its end (tens of millions of rays) before the rule is asked,
+#: and a budget would cut it off at the faces of the lowest indices
 ROUND_CHUNK_RAYS = 1 << 20
 #: default budget, a cap only: the stop rule ends the search, the cap bounds its time on models
 #: where faces keep turning up (rays per face asked about, at least 2**22 rays since small models
