@@ -6,8 +6,9 @@
   one side is hidden, only the copy facing the seen side counts as kept by the cut.
 * ``visibility="view"``: every face that no line of sight from the region reached is removed
   (:func:`meshvis.visible_from`, DESIGN.md §9).
-* ``visibility="both"``: a face is removed only when the cut calls it hidden *and* a guided
-  search for a view of it (seed rays aimed at these faces only) failed.
+* ``visibility="both"`` (the default): a face is removed only when the cut calls it hidden
+  *and* a guided search for a view of it failed (seed rays aimed at these faces only,
+  propagation within a few rings of them; the report counts the faces left out).
 
 ``level="patch"`` or ``"part"`` removes a connected patch (faces sharing edges) or a named
 part only when all its faces are hidden; ``keep_border=N`` keeps N rings of hidden faces

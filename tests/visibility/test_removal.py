@@ -117,6 +117,7 @@ def test_both_searches_only_around_the_faces_the_cut_calls_hidden(scenes):
     by_cut = r.reason_code == REASONS.index("kept: an outside side by the cut")
     assert (~by_cut).any() and (r.visibility.seed_rays[by_cut] == 0).all()
     assert r.visibility.skipped["not asked about (no seed rays)"] == int(by_cut.sum())
+    assert any(k.startswith("not propagated from") for k in r.visibility.skipped)
     # a cube the cut keeps whole: nothing to ask about, not one ray
     cube, _ = scenes.unit_cube()
     whole = remove_interior(cube, visibility="both", seed=0)
