@@ -9,6 +9,7 @@ import time
 from meshvis.errors import ParameterError
 from meshvis.io.report import write_report
 from meshvis.repair.operation import CLASSIFY_DEFAULTS, OPERATION_DEFAULTS
+from meshvis.repair.remove_modes import LEVELS, VISIBILITY_MODES
 
 from .common import check_output, point, positive_int, say, staged_outputs
 
@@ -180,7 +181,7 @@ def removal_options(p: argparse.ArgumentParser) -> None:
     d = OPERATION_DEFAULTS["remove-interior"]
     p.add_argument(
         "--visibility",
-        choices=("object", "view", "both"),
+        choices=VISIBILITY_MODES,
         default=d["visibility"],
         help="remove what the cut calls hidden (object), what no view from --from reaches (view), "
         "or only what both call hidden (default both)",
@@ -188,7 +189,7 @@ def removal_options(p: argparse.ArgumentParser) -> None:
     region_option(p, d["from_region"], "where viewers are: outside (default)")
     p.add_argument(
         "--level",
-        choices=("face", "patch", "part"),
+        choices=LEVELS,
         default=d["level"],
         help="remove single faces, or whole patches / parts whose faces are all hidden",
     )

@@ -102,7 +102,7 @@ def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str]
     orient_acc = float((area * right * ok).sum() / (area * ok).sum())
     say(f"orient: flipped {int(o.flipped.sum())} faces; correct on {100 * orient_acc:.2f}% of the area")
 
-    r = remove_interior(soup, classification=c)
+    r = remove_interior(soup, classification=c, visibility="object")  # the cut, judged by its truth
     save(r.kept, os.path.join(folder, "exterior.obj"))
     save(r.removed, os.path.join(folder, "interior.obj"))
     shot(r.kept, "exterior.png")

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from meshvis.errors import ParameterError
+from meshvis.repair.remove_modes import DEFAULT_VISIBILITY
 
 #: operations that classify a model and write a result
 OPERATIONS = ("classify", "orient", "remove-interior", "layers")
@@ -45,7 +46,7 @@ OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
         "up": "auto",
     },
     "remove-interior": {
-        "visibility": "both",
+        "visibility": DEFAULT_VISIBILITY,
         "from_region": "outside",
         "level": "face",
         "keep_border": 0,

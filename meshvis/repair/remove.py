@@ -6,8 +6,9 @@
   one side is hidden, only the copy facing the seen side counts as kept by the cut.
 * ``visibility="view"``: every face that no line of sight from the region reached is removed
   (:func:`meshvis.visible_from`, DESIGN.md §9).
-* ``visibility="both"``: a face is removed only when the cut calls it hidden *and* a guided
-  search for a view of it (seed rays aimed at these faces only) failed.
+* ``visibility="both"`` (the default): a face is removed only when the cut calls it hidden
+  *and* a guided search for a view of it failed (seed rays aimed at these faces only,
+  propagation within a few rings of them; the report counts the faces left out).
 
 ``level="patch"`` or ``"part"`` removes a connected patch (faces sharing edges) or a named
 part only when all its faces are hidden; ``keep_border=N`` keeps N rings of hidden faces
@@ -27,11 +28,9 @@ from meshvis.geometry.adjacency import components, edges, face_adjacency, weld
 from meshvis.geometry.duplicates import hidden_copies, opposite_copies
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.io import as_soup
+from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, LEVELS, VISIBILITY_MODES
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, visible_from
-
-VISIBILITY_MODES = ("object", "view", "both")
-LEVELS = ("face", "patch", "part")
 
 #: reason of each face, by code
 REASONS = (
@@ -105,7 +104,7 @@ def remove_interior(
     model: Any,
     *,
     classification: Classification | None = None,
-    visibility: str = "object",
+    visibility: str = DEFAULT_VISIBILITY,
     region="outside",
     level: str = "face",
     keep_border: int = 0,
@@ -121,7 +120,9 @@ def remove_interior(
     model : anything :func:`meshvis.classify` accepts
     classification : reuse an existing classification of the same model
     visibility : {"object", "view", "both"}
-        The graph cut alone, sight from ``region`` alone, or both must call a face hidden.
+        The graph cut alone, sight from ``region`` alone, or both must call a face hidden
+        (default :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`, ``"both"``; pass
+        ``"object"`` for the cut alone).
     region : str or Region
         Where viewers may be, for ``"view"`` and ``"both"`` (see :func:`meshvis.parse_region`).
     level : {"face", "patch", "part"}
@@ -150,9 +151,11 @@ def remove_interior(
     >>> import trimesh, numpy as np
     >>> a, b = trimesh.creation.icosphere(2), trimesh.creation.icosphere(2)
     >>> v = np.vstack([a.vertices, 0.5 * b.vertices]); f = np.vstack([a.faces, b.faces + len(a.vertices)])
-    >>> r = remove_interior((v, f), seed=0)
+    >>> r = remove_interior((v, f), seed=0)  # visibility="both"
     >>> r.kept.n_faces, r.removed.n_faces
     (320, 320)
+    >>> remove_interior((v, f), visibility="object", seed=0).removed.n_faces
+    320
     >>> remove_interior((v, f), visibility="view", seed=0).removed.n_faces
     320
     """

@@ -20,13 +20,15 @@ def test_bench_real_judges_every_method_on_a_small_model(tmp_path, capsys):
     assert main(argv + ["--json", str(out), "--curve", str(curve), "--worst", str(tmp_path / "w")]) == 0
     r = json.loads(out.read_text())["results"][0]
     methods = [row["method"] for row in r["rows"]]
-    assert methods[:5] == [
+    assert methods[:6] == [
         "reference (dense random)",
         "object (graph cut)",
         "view (guided, outside)",
         "both",
+        "view converged (5 faces, seed+1)",
         "random, rays of view",
     ]
+    assert 0 <= r["view_removes_of_converged"] <= 1 and r["view_stopped"] and r["converged_stopped"]
     for row in r["rows"]:
         assert 0 <= row["removed_area"] <= 1 and row["false_pixels_worst"] >= row["false_pixels_mean"] >= 0
     ref = r["rows"][0]

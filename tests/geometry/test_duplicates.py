@@ -43,7 +43,7 @@ def test_orient_keeps_both_copies():
 
 def test_remove_interior_keeps_the_copy_facing_the_viewer():
     v, f, top = _box_with_double_sided_top()
-    r = remove_interior((v, f), seed=0)
+    r = remove_interior((v, f), visibility="object", seed=0)  # the cut's rule for the copies
     m = len(f) - len(top)
     np.testing.assert_array_equal(r.keep[:m], True)  # the box, its top faces outward included
     np.testing.assert_array_equal(r.keep[m:], False)  # the inward copies

@@ -30,12 +30,22 @@ def test_both_keeps_a_large_triangle_passing_into_a_closed_box(scenes):
     assert not (r.keep < obj.keep).any()  # both never removes what object keeps
 
 
-def test_object_mode_is_the_default_result_unchanged(scenes):
+def test_both_is_the_default_of_the_library_cli_and_batch(scenes):
+    import inspect
+
+    from meshvis.repair.operation import default_options
+    from meshvis.repair.remove_modes import DEFAULT_VISIBILITY
+
+    assert DEFAULT_VISIBILITY == "both"
+    assert inspect.signature(remove_interior).parameters["visibility"].default == DEFAULT_VISIBILITY
+    assert default_options("remove-interior")["visibility"] == DEFAULT_VISIBILITY
     soup, _, _ = scenes.slot_box()
-    a = remove_interior(soup, seed=0)
-    b = remove_interior(soup, seed=0, visibility="object")
+    a = remove_interior(soup, seed=0, budget=100_000)
+    b = remove_interior(soup, seed=0, budget=100_000, visibility="both")
     np.testing.assert_array_equal(a.keep, b.keep)
-    assert a.mode == "object" and a.visibility is None
+    assert a.mode == "both" and a.visibility is not None and a.classification is not None
+    obj = remove_interior(soup, seed=0, visibility="object")
+    assert obj.mode == "object" and obj.visibility is None
 
 
 def test_part_level_keeps_a_part_with_one_seen_face(scenes):
@@ -99,3 +109,16 @@ def test_cli_flags_of_remove_interior_and_visible(scenes, tmp_path, capsys):
         == 0
     )
     assert main(["visible", str(src), "--from", "nowhere", "-q"]) == 2
+
+
+def test_both_searches_only_around_the_faces_the_cut_calls_hidden(scenes):
+    soup, bottom, truth = scenes.sealed_pocket()
+    r = remove_interior(soup, visibility="both", seed=0)
+    by_cut = r.reason_code == REASONS.index("kept: an outside side by the cut")
+    assert (~by_cut).any() and (r.visibility.seed_rays[by_cut] == 0).all()
+    assert r.visibility.skipped["not asked about (no seed rays)"] == int(by_cut.sum())
+    assert any(k.startswith("not propagated from") for k in r.visibility.skipped)
+    # a cube the cut keeps whole: nothing to ask about, not one ray
+    cube, _ = scenes.unit_cube()
+    whole = remove_interior(cube, visibility="both", seed=0)
+    assert whole.keep.all() and whole.visibility.rays["total"] == 0

@@ -139,3 +139,34 @@ def test_bad_arguments_are_parameter_errors(scenes):
 def test_public_api():
     assert meshvis.visible_from is visible_from
     assert meshvis.parse_region is parse_region
+
+
+def test_the_default_budget_is_a_cap_that_the_stop_rule_ends_before(scenes, monkeypatch):
+    from meshvis import limits
+    from meshvis.visibility.visible import DEFAULT_MIN_BUDGET, MAX_RAYS_PER_FACE, default_budget
+
+    assert default_budget(10) == DEFAULT_MIN_BUDGET
+    assert default_budget(10_000) == MAX_RAYS_PER_FACE * 10_000
+    assert default_budget(10**9) == limits.MAX_RAYS
+    monkeypatch.setattr(limits, "MAX_RAYS", 1000)
+    assert default_budget(10) == 1000  # the cap is read at call time
+    monkeypatch.undo()
+    soup, strip, truth = scenes.slot_box()
+    vis = visible_from(soup, seed=0, per_side=True)
+    assert vis.stopped in ("few new faces", "little new area", "all seen")
+    np.testing.assert_array_equal(vis.seen_side, truth)
+
+
+def test_later_rounds_seed_the_largest_unseen_faces_first():
+    from meshvis.visibility.visible import _round_order, _State
+
+    soup = meshvis.as_soup(
+        (
+            np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [3, 0, 1], [0, 3, 1.0]]),
+            np.array([[0, 1, 2], [3, 4, 5]]),
+        )
+    )
+    state = _State(soup, 100, 50.0, 1e-4)
+    rng = np.random.default_rng(0)
+    assert _round_order(state, rng, np.array([True, True]), 1).tolist() == [1, 0]
+    assert _round_order(state, rng, np.array([True, False]), 1).tolist() == [0]

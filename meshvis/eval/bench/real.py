@@ -1,8 +1,9 @@
 """Inside removal on real scenes, judged by false pixels and the dense reference (DESIGN.md §10).
 
 For every real model with hidden geometry: the dense random reference (cached), meshvis
-``remove-interior`` with ``visibility`` object / view / both, random sampling with the rays
-of view, and MeshLab ambient occlusion on both sides.  Per method: removed area, share of
+``remove-interior`` with ``visibility`` object / view / both, a converged guided search
+(:func:`converged_search`; the share of what it removes that ``view`` removes too), random
+sampling with the rays of view, and MeshLab ambient occlusion on both sides.  Per method: removed area, share of
 the reference-hidden area removed, false pixels per million (mean and worst view, over the
 whole sphere and, for scenes standing on the ground, over the views from above), rays and
 time; and the curve of false pixels against rays for guided and random sampling (GVS Fig. 8).
@@ -49,6 +50,13 @@ QUICK = (
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 #: random sampling for the curve gets this many times the rays of guided sampling
 CURVE_RANDOM_FACTOR = 4
+#: the converged search that ``view`` is judged against: the stop rule at a tenth of GVS's
+#: face count (5 new faces per million rays) and at the default area threshold (1e-5 of the
+#: model's area per million rays), capped only by :data:`meshvis.limits.MAX_RAYS`, with the
+#: next seed (with the same seed the default search is the start of the converged one, and
+#: removes all it removes by construction)
+CONVERGED_MIN_NEW = 5.0
+CONVERGED_MIN_NEW_AREA = 1e-5
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -169,6 +177,14 @@ def run_model(
     )
 
     t = time.perf_counter()
+    conv = converged_search(soup, seed + 1)
+    rows["view converged (5 faces, seed+1)"] = (
+        conv.seen,
+        conv.rays["total"],
+        time.perf_counter() - t,
+    )
+
+    t = time.perf_counter()
     rand = visible_from(soup, budget=view.visibility.rays["total"], seed=seed, method="random")
     rows["random, rays of view"] = (rand.seen, rand.rays["total"], time.perf_counter() - t)
 
@@ -206,6 +222,9 @@ def run_model(
         "rows": out_rows,
         "curves": curves,
         "view_over_object_time": rows["view (guided, outside)"][2] / max(t_obj, 1e-9),
+        "view_stopped": view.visibility.stopped,
+        "converged_stopped": conv.stopped,
+        "view_removes_of_converged": share_removed(soup.areas, view.keep, conv.seen),
     }
     if worst:
         os.makedirs(worst, exist_ok=True)
@@ -213,6 +232,55 @@ def run_model(
             soup, {"object": ~obj.keep, "both": ~both.keep}, table, os.path.join(worst, f"{stem}.png")
         )
     return result
+
+
+def converged_search(soup, seed: int):
+    """From-outside guided search run to convergence (:data:`CONVERGED_MIN_NEW`, :data:`CONVERGED_MIN_NEW_AREA`).
+
+    Parameters
+    ----------
+    soup : Soup
+    seed : int
+
+    Returns
+    -------
+    Visibility
+    """
+    from meshvis import limits
+
+    return visible_from(
+        soup,
+        budget=limits.MAX_RAYS,
+        seed=seed,
+        min_new=CONVERGED_MIN_NEW,
+        min_new_area=CONVERGED_MIN_NEW_AREA,
+    )
+
+
+def share_removed(areas: np.ndarray, keep: np.ndarray, kept_by_other: np.ndarray) -> float:
+    """Share of the area another method removes that ``keep`` removes too.
+
+    Parameters
+    ----------
+    areas : (m,) float
+    keep : (m,) bool
+        Faces the judged method keeps.
+    kept_by_other : (m,) bool
+        Faces the other method keeps.
+
+    Returns
+    -------
+    float
+        1.0 when the other method removes nothing.
+
+    Examples
+    --------
+    >>> share_removed(np.ones(4), np.array([0, 0, 1, 1], bool), np.array([0, 1, 1, 1], bool))
+    1.0
+    """
+    other = ~np.asarray(kept_by_other, bool)
+    total = float(areas[other].sum())
+    return float(areas[other & ~np.asarray(keep, bool)].sum()) / total if total else 1.0
 
 
 def _judge(name, areas, keep, ref_hidden, table, up, rays, seconds) -> dict:
@@ -240,15 +308,29 @@ def _judge(name, areas, keep, ref_hidden, table, up, rays, seconds) -> dict:
 def _curves(soup, guided, table, seed: int) -> dict:
     """False pixels after r rays, from the ray count at which each face was first seen."""
     budget = CURVE_RANDOM_FACTOR * guided.rays["total"]
-    rand = visible_from(soup, budget=budget, seed=seed, method="random", min_new=0.0)
-    out = {}
-    for name, vis in (("guided", guided), ("random", rand)):
-        total = max(vis.rays["total"], 1)
-        grid = np.unique(np.geomspace(max(total / 1000, 1), total, 40).astype(np.int64))
-        fs = vis.first_seen
-        fps = [false_pixels(table, ~((fs >= 0) & (fs <= r)))["mean"] for r in grid]
-        out[name] = {"rays": grid.tolist(), "false_pixels_mean": fps}
-    return out
+    # no stop rule: the curve runs to the budget
+    rand = visible_from(soup, budget=budget, seed=seed, method="random", min_new=0.0, min_new_area=0.0)
+    return {"guided": curve(guided, table), "random": curve(rand, table)}
+
+
+def curve(vis, table) -> dict:
+    """False pixels (mean) of removing every face not seen after r rays, on a log grid of r.
+
+    Parameters
+    ----------
+    vis : Visibility
+    table : FacePixels
+
+    Returns
+    -------
+    dict
+        ``rays`` and ``false_pixels_mean``, lists of 40 or fewer.
+    """
+    total = max(vis.rays["total"], 1)
+    grid = np.unique(np.geomspace(max(total / 1000, 1), total, 40).astype(np.int64))
+    fs = vis.first_seen
+    fps = [false_pixels(table, ~((fs >= 0) & (fs <= r)))["mean"] for r in grid]
+    return {"rays": grid.tolist(), "false_pixels_mean": fps}
 
 
 def plot_curves(results: list[dict], path: str) -> None:
@@ -321,7 +403,9 @@ def worst_view_picture(soup, removed: dict, table, path: str, size: int = 512) -
 def format_model(r: dict) -> str:
     lines = [
         f"{r['model']}: {r['faces']} faces, reference-hidden area {100 * r['reference_hidden_area']:.1f} %, "
-        f"view/object time {r['view_over_object_time']:.2f}"
+        f"view/object time {r['view_over_object_time']:.2f}",
+        f"  view stopped: {r['view_stopped']}; converged search stopped: {r['converged_stopped']}; "
+        f"view removes {100 * r['view_removes_of_converged']:.1f} % of the area the converged search removes",
     ]
     head = f"  {'method':34s} {'removed':>8s} {'ref-hid':>8s} {'fp mean':>9s} {'fp worst':>9s}"
     head += f" {'up mean':>8s} {'up worst':>8s} {'rays':>12s} {'s':>7s}"
