@@ -48,28 +48,21 @@ def _diagonal(vertices: np.ndarray, faces: np.ndarray) -> float:
 def _exact_groups(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Distinct rows of ``pts`` in lexicographic order, and the row of each input point.
 
-    The same answer as ``np.unique(pts, axis=0, return_inverse=True)``, 5-20x faster: the
-    points are grouped by sorting a 64-bit hash of their bits (one int64 argsort), each
-    group is checked to hold one point only (a hash collision falls back to ``np.unique``)
-    and only the distinct points are sorted lexicographically.
+    The same answer as ``np.unique(pts, axis=0, return_inverse=True)``, about 10x faster:
+    equal points are grouped through a hash table on a 64-bit hash of their bits (a numba
+    kernel, rows compared in full), and only the distinct points are sorted
+    lexicographically.  The points must not hold ``-0.0`` (add ``0.0`` first) or NaN.
     """
-    bits = np.ascontiguousarray(pts).view(np.uint64)
+    from meshvis.geometry._kernels import exact_groups
+
+    bits = np.ascontiguousarray(pts, np.float64).view(np.uint64)
     h = _mix(_mix(_mix(bits[:, 0] + _MIX[2]) ^ bits[:, 1]) ^ bits[:, 2])
-    order = np.argsort(h, kind="stable")
-    hs, s = h[order], pts[order]
-    new = np.ones(len(pts), bool)
-    new[1:] = hs[1:] != hs[:-1]
-    group = np.cumsum(new) - 1
-    first = s[np.flatnonzero(new)]
-    if np.any(first[group] != s):  # two different points with one hash: rare, stay exact
-        uniq, inverse = np.unique(pts, axis=0, return_inverse=True)
-        return uniq, inverse.reshape(-1)
+    group, first_row = exact_groups(bits, h)
+    first = pts[first_row]
     lex = np.lexsort((first[:, 2], first[:, 1], first[:, 0]))
     rank = np.empty(len(first), np.int64)
     rank[lex] = np.arange(len(first))
-    inverse = np.empty(len(pts), np.int64)
-    inverse[order] = rank[group]
-    return first[lex], inverse
+    return first[lex], rank[group]
 
 
 def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tuple[np.ndarray, np.ndarray]:
@@ -322,13 +315,10 @@ def degenerate_faces(
     f = np.asarray(faces, np.int64).reshape(-1, 3)
     if len(f) == 0:
         return np.zeros(0, bool)
-    t = v[f]
-    lo = t.reshape(-1, 3).min(axis=0)
-    t = t - lo  # keep magnitudes small before the cross product
-    e = np.roll(t, -1, axis=1) - t
-    twice_area = np.linalg.norm(np.cross(e[:, 0], e[:, 1]), axis=1)
-    longest = np.linalg.norm(e, axis=2).max(axis=1)
-    out = twice_area <= tol * _diagonal(v, f) * longest
+    from meshvis.geometry._kernels import flat_faces
+
+    lo = v[used_vertices(f, len(v))].min(axis=0)  # keep magnitudes small before the cross product
+    out = flat_faces(v, f, lo, tol * _diagonal(v, f))
     if faces_welded is not None:
         out |= collapsed(faces_welded)
     return out
