@@ -430,3 +430,38 @@ def grid_cells(lo, hi, h, top, bits):
                     key[e] = ((c0[f, 0] + x) << (2 * bits)) | ((c0[f, 1] + y) << bits) | (c0[f, 2] + z)
                     e += 1
     return owner, key, c0
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _root(parent, x):
+    while parent[x] != x:
+        parent[x] = parent[parent[x]]  # path halving
+        x = parent[x]
+    return x
+
+
+@numba.njit(cache=True, nogil=True)
+def component_labels(n, a, b):
+    """Connected components of ``n`` nodes linked by the edges ``(a[k], b[k])`` (union-find).
+
+    Returns (n,) int64 labels numbered in the order of each component's smallest node, the
+    numbering of ``scipy.sparse.csgraph.connected_components``.
+    """
+    parent = np.arange(n)
+    for k in range(a.shape[0]):
+        x = _root(parent, a[k])
+        y = _root(parent, b[k])
+        if x < y:
+            parent[y] = x
+        elif y < x:
+            parent[x] = y
+    label = np.empty(n, np.int64)
+    count = 0
+    for i in range(n):
+        r = _root(parent, i)
+        if r == i:
+            label[i] = count
+            count += 1
+        else:
+            label[i] = label[r]
+    return label
