@@ -59,6 +59,19 @@ def _in_wedge(T, c, n, dx, dy, dz):
     return a >= s and b >= s
 
 
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _sides(T):
+    """Side vectors ``T[s + 1] - T[s]`` (3, 3) and their lengths (3,) of one triangle."""
+    E = np.empty((3, 3))
+    L = np.empty(3)
+    for s in range(3):
+        t = (s + 1) % 3
+        for d in range(3):
+            E[s, d] = T[t, d] - T[s, d]
+        L[s] = math.sqrt(E[s, 0] * E[s, 0] + E[s, 1] * E[s, 1] + E[s, 2] * E[s, 2])
+    return E, L
+
+
 @numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def narrow_phase(
     order,
@@ -69,8 +82,6 @@ def narrow_phase(
     has_normal,
     low,
     high,
-    edges,
-    edge_len,
     pairs,
     eps,
     near,
@@ -137,13 +148,15 @@ def narrow_phase(
         if nshared == 0:
             # stage 2: edge x edge axes while the pair is still within reach
             if max_gap <= pad_r:
+                Ei, Li = _sides(Ti)
+                Ej, Lj = _sides(Tj)
                 for a in range(3):
                     for b in range(3):
-                        ex = edges[i, a, 1] * edges[j, b, 2] - edges[i, a, 2] * edges[j, b, 1]
-                        ey = edges[i, a, 2] * edges[j, b, 0] - edges[i, a, 0] * edges[j, b, 2]
-                        ez = edges[i, a, 0] * edges[j, b, 1] - edges[i, a, 1] * edges[j, b, 0]
+                        ex = Ei[a, 1] * Ej[b, 2] - Ei[a, 2] * Ej[b, 1]
+                        ey = Ei[a, 2] * Ej[b, 0] - Ei[a, 0] * Ej[b, 2]
+                        ez = Ei[a, 0] * Ej[b, 1] - Ei[a, 1] * Ej[b, 0]
                         length = math.sqrt(ex * ex + ey * ey + ez * ez)
-                        if not length > tau * edge_len[i, a] * edge_len[j, b]:
+                        if not length > tau * Li[a] * Lj[b]:
                             continue
                         g, p0, p1, p2 = _proj_gap(ex, ey, ez, Ti, 0.0, 0.0)
                         lo_i = min(p0, min(p1, p2))
@@ -259,34 +272,26 @@ def face_axes(tri, tau):
 
     The arithmetic is that of the numpy formulation (``cross``, ``norm``, one division per
     component), written per face; the projection intervals are widened by
-    :data:`PROJ_SLACK`.  Returns ``edges`` (m, 3, 3) (side ``s``: corner ``s`` to
-    ``s + 1``), ``edge_len`` (m, 3), ``axes`` (m, 4, 3) (zero rows are unusable), ``valid``
+    :data:`PROJ_SLACK`.  Returns ``axes`` (m, 4, 3) (zero rows are unusable), ``valid``
     (m, 4), ``has_normal`` (m,) and the projection interval ``low``, ``high`` (m, 4) of the
     face on each axis.
     """
     m = tri.shape[0]
-    edges = np.empty((m, 3, 3))
-    edge_len = np.empty((m, 3))
     axes = np.zeros((m, 4, 3))
     valid = np.zeros((m, 4), np.bool_)
     has_normal = np.zeros(m, np.bool_)
     low = np.empty((m, 4))
     high = np.empty((m, 4))
     for f in numba.prange(m):
-        for s in range(3):
-            t = (s + 1) % 3
-            for d in range(3):
-                edges[f, s, d] = tri[f, t, d] - tri[f, s, d]
-            e = edges[f, s]
-            edge_len[f, s] = math.sqrt(e[0] * e[0] + e[1] * e[1] + e[2] * e[2])
-        a = edges[f, 0]
-        b = edges[f, 1]
+        edges, edge_len = _sides(tri[f])
+        a = edges[0]
+        b = edges[1]
         nx = a[1] * b[2] - a[2] * b[1]
         ny = a[2] * b[0] - a[0] * b[2]
         nz = a[0] * b[1] - a[1] * b[0]
         n_len = math.sqrt(nx * nx + ny * ny + nz * nz)
         # a normal is reliable when sin(angle between two sides) exceeds tau
-        if n_len > tau * edge_len[f, 0] * edge_len[f, 1]:
+        if n_len > tau * edge_len[0] * edge_len[1]:
             has_normal[f] = True
             valid[f, 0] = True
             axes[f, 0, 0] = nx / n_len
@@ -296,7 +301,7 @@ def face_axes(tri, tau):
         uy = axes[f, 0, 1]
         uz = axes[f, 0, 2]
         for s in range(3):
-            e = edges[f, s]
+            e = edges[s]
             wx = uy * e[2] - uz * e[1]
             wy = uz * e[0] - ux * e[2]
             wz = ux * e[1] - uy * e[0]
@@ -315,7 +320,7 @@ def face_axes(tri, tau):
                 hi = max(hi, p)
             low[f, k] = lo - PROJ_SLACK
             high[f, k] = hi + PROJ_SLACK
-    return edges, edge_len, axes, valid, has_normal, low, high
+    return axes, valid, has_normal, low, high
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

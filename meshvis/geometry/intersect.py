@@ -122,7 +122,7 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
 
     Returns
     -------
-    (p, 2) int64, pairs ``i < j`` whose closed boxes overlap, sorted
+    (p, 2) int32 (int64 from 2**31 boxes), pairs ``i < j`` whose closed boxes overlap, sorted
     """
     lower = np.asarray(lower, np.float64)
     upper = np.asarray(upper, np.float64)
@@ -145,10 +145,15 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
         out += grids[L].pairs_within(lo, hi, own_low)
     for L in list(grids)[1:]:
         out += grids[L].pairs_from_finer(lo, hi, np.flatnonzero(level < L), own_low)
-    keys = np.sort(np.concatenate(out)) if out else np.zeros(0, np.int64)  # i * m + j, i < j
-    pairs = np.empty((len(keys), 2), np.int64)
-    np.floor_divide(keys, m, out=pairs[:, 0])
-    np.remainder(keys, m, out=pairs[:, 1])
+    del grids, own_low, lo, hi
+    keys = np.concatenate(out) if out else np.zeros(0, np.int64)  # i * m + j, i < j
+    del out
+    keys.sort()
+    # int32 ids where they fit: the pairs are the largest array of the intersection tests
+    pairs = np.empty((len(keys), 2), np.int32 if m < 2**31 else np.int64)
+    pairs[:, 0] = keys // m
+    keys %= m
+    pairs[:, 1] = keys
     return pairs
 
 
@@ -281,7 +286,7 @@ def classify_pairs(
     # (~ machine eps / tau, relative to unit coordinates) must stay far below eps
     tau = min(1e-3, 100 * np.finfo(np.float64).eps / min(eps, near))
     tri = np.ascontiguousarray(triangles, np.float64)
-    edges, edge_len, axes, valid, has_normal, low, high = face_axes(tri, float(tau))
+    axes, valid, has_normal, low, high = face_axes(tri, float(tau))
     fw = np.ascontiguousarray(faces_welded, np.int64)
     order = np.arange(len(tri)) if order is None else np.asarray(order, np.int64)
     out = np.zeros((3, len(pairs)), bool)
@@ -296,8 +301,6 @@ def classify_pairs(
             has_normal,
             low,
             high,
-            edges,
-            edge_len,
             np.ascontiguousarray(pairs[sl]),
             float(eps),
             float(near),
