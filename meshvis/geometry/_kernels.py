@@ -378,13 +378,16 @@ def exact_groups(bits, h):
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def flat_faces(v, faces, lo, bound):
-    """(m,) bool: twice the area at most ``bound`` times the longest side (:func:`degenerate_faces`).
+    """Per face: twice the area at most ``bound`` times the longest side, and zero area.
 
-    The corners are shifted by ``lo`` first; the arithmetic is that of the numpy
-    formulation (sides ``e_s = t_{s+1} - t_s``, ``|e_0 x e_1|``, norms summed x, y, z).
+    The first test is that of :func:`meshvis.geometry.adjacency.degenerate_faces` (corners
+    shifted by ``lo`` first), the second the ``areas <= 0`` of :class:`meshvis.soup.Soup`
+    (``|(t1 - t0) x (t2 - t0)|`` of the unshifted corners); the arithmetic is that of the
+    numpy formulations (norms summed x, y, z).  Returns two (m,) bool arrays.
     """
     m = faces.shape[0]
-    out = np.empty(m, np.bool_)
+    flat = np.empty(m, np.bool_)
+    zero = np.empty(m, np.bool_)
     t = np.empty((3, 3))
     e = np.empty((3, 3))
     for f in range(m):
@@ -399,8 +402,21 @@ def flat_faces(v, faces, lo, bound):
         nx = e[0, 1] * e[1, 2] - e[0, 2] * e[1, 1]
         ny = e[0, 2] * e[1, 0] - e[0, 0] * e[1, 2]
         nz = e[0, 0] * e[1, 1] - e[0, 1] * e[1, 0]
-        out[f] = math.sqrt(nx * nx + ny * ny + nz * nz) <= bound * longest
-    return out
+        flat[f] = math.sqrt(nx * nx + ny * ny + nz * nz) <= bound * longest
+        a0 = faces[f, 0]
+        a1 = faces[f, 1]
+        a2 = faces[f, 2]
+        ux = v[a1, 0] - v[a0, 0]
+        uy = v[a1, 1] - v[a0, 1]
+        uz = v[a1, 2] - v[a0, 2]
+        wx = v[a2, 0] - v[a0, 0]
+        wy = v[a2, 1] - v[a0, 1]
+        wz = v[a2, 2] - v[a0, 2]
+        cx = uy * wz - uz * wy
+        cy = uz * wx - ux * wz
+        cz = ux * wy - uy * wx
+        zero[f] = 0.5 * math.sqrt(cx * cx + cy * cy + cz * cz) <= 0
+    return flat, zero
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

@@ -285,7 +285,11 @@ def components(n_faces: int, pairs: np.ndarray) -> tuple[int, np.ndarray]:
 
 
 def degenerate_faces(
-    vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL, faces_welded: np.ndarray | None = None
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    tol: float = WELD_TOL,
+    faces_welded: np.ndarray | None = None,
+    zero_area: bool = False,
 ) -> np.ndarray:
     """(m,) bool: faces of (near-)zero area.
 
@@ -305,6 +309,9 @@ def degenerate_faces(
         Fraction of the bounding-box diagonal (default :data:`WELD_TOL`).
     faces_welded : (m, 3) int array, optional
         The ``faces_welded`` output of :func:`weld`, to also flag collapsed faces.
+    zero_area : bool
+        Also flag the faces of zero area as :attr:`meshvis.soup.Soup.areas` computes it
+        (the same arithmetic, without caching the soup's triangles).
 
     Returns
     -------
@@ -318,7 +325,8 @@ def degenerate_faces(
     from meshvis.geometry._kernels import flat_faces
 
     lo = v[used_vertices(f, len(v))].min(axis=0)  # keep magnitudes small before the cross product
-    out = flat_faces(v, f, lo, tol * _diagonal(v, f))
+    flat, zero = flat_faces(v, f, lo, tol * _diagonal(v, f))
+    out = flat | zero if zero_area else flat
     if faces_welded is not None:
         out |= collapsed(faces_welded)
     return out

@@ -113,12 +113,14 @@ def _cells(lo: np.ndarray, hi: np.ndarray, h: float) -> tuple[np.ndarray, np.nda
     return grid_cells(np.ascontiguousarray(lo), np.ascontiguousarray(hi), float(h), top, _BITS)
 
 
-def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
+def candidate_pairs(lower: np.ndarray, upper: np.ndarray, *, overwrite: bool = False) -> np.ndarray:
     """All pairs of overlapping axis-aligned boxes, through a hierarchical uniform grid.
 
     Parameters
     ----------
     lower, upper : (m, 3) float arrays, box corners (inflate them by the tolerance first)
+    overwrite : bool
+        The arrays are float64 temporaries of the caller: shift them in place (less memory).
 
     Returns
     -------
@@ -130,7 +132,8 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray) -> np.ndarray:
     if m < 2:
         return np.zeros((0, 2), np.int64)
     origin = lower.min(axis=0)
-    lo, hi = lower - origin, upper - origin
+    lo = np.subtract(lower, origin, out=lower if overwrite else None)
+    hi = np.subtract(upper, origin, out=upper if overwrite else None)
     size = float((hi.max(axis=0)).max())
     if size <= 0:  # every box is the same point
         i, j = np.triu_indices(m, 1)
@@ -436,8 +439,9 @@ def intersection_flags(
     corner = [tri[:, c] for c in range(3)]
     lower = np.minimum(np.minimum(corner[0], corner[1]), corner[2]) - pad
     upper = np.maximum(np.maximum(corner[0], corner[1]), corner[2]) + pad
-    pairs = candidate_pairs(lower, upper)
-    del lower, upper, corner
+    del corner
+    pairs = candidate_pairs(lower, upper, overwrite=True)
+    del lower, upper
     report = progress or (lambda fraction: None)
     report(0.4)
     inter, copl, close = classify_pairs(
