@@ -486,3 +486,20 @@ def component_labels(n, a, b):
         else:
             label[i] = label[r]
     return label
+
+
+@numba.njit(cache=True, nogil=True)
+def corner_bounds(v, faces):
+    """(2, 3) min and max corner over the vertices the faces use (no mask, no gather)."""
+    out = np.empty((2, 3))
+    for d in range(3):
+        out[0, d] = np.inf
+        out[1, d] = -np.inf
+    for f in range(faces.shape[0]):
+        for c in range(3):
+            p = faces[f, c]
+            for d in range(3):
+                x = v[p, d]
+                out[0, d] = min(out[0, d], x)
+                out[1, d] = max(out[1, d], x)
+    return out

@@ -38,11 +38,18 @@ def used_vertices(faces: np.ndarray, n_vertices: int) -> np.ndarray:
     return np.flatnonzero(mask)
 
 
+def _bounds(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(2, 3) bounding box of the used vertices (a numba pass over the corners)."""
+    from meshvis.geometry._kernels import corner_bounds
+
+    return corner_bounds(np.asarray(vertices, np.float64), np.asarray(faces))
+
+
 def _diagonal(vertices: np.ndarray, faces: np.ndarray) -> float:
     if len(faces) == 0:
         return 0.0
-    used = vertices[used_vertices(faces, len(vertices))]
-    return float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    lo, hi = _bounds(vertices, faces)
+    return float(np.linalg.norm(hi - lo))
 
 
 def _exact_groups(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
@@ -187,6 +194,23 @@ class EdgeTable:
         return out
 
 
+def _stable_order(keys: np.ndarray, bound: int) -> np.ndarray:
+    """``np.argsort(keys, kind="stable")`` for int64 keys in ``[0, bound)``.
+
+    When ``bound * len(keys)`` fits in int64 the keys are made unique by their position
+    (``key * len + position``) and sorted by value (a SIMD sort, about 5x faster than a
+    stable argsort of 4 M keys); the positions are the stable order.
+    """
+    h = len(keys)
+    if h == 0 or bound * h >= 2**63:
+        return np.argsort(keys, kind="stable")
+    composite = keys * np.int64(h)
+    composite += np.arange(h, dtype=np.int64)
+    composite.sort()
+    composite %= h
+    return composite
+
+
 def edges(faces_welded: np.ndarray) -> EdgeTable:
     """Unique undirected edges of welded faces, their face counts and traversal directions.
 
@@ -213,7 +237,7 @@ def edges(faces_welded: np.ndarray) -> EdgeTable:
     forward = (a < b).ravel()
     face = np.repeat(np.flatnonzero(ok), 3)
     keys = lo * np.int64(n) + hi
-    order = np.argsort(keys, kind="stable")
+    order = _stable_order(keys, n * n)
     sorted_keys = keys[order]
     new = np.ones(len(keys), bool)
     new[1:] = sorted_keys[1:] != sorted_keys[:-1]
@@ -324,8 +348,8 @@ def degenerate_faces(
         return np.zeros(0, bool)
     from meshvis.geometry._kernels import flat_faces
 
-    lo = v[used_vertices(f, len(v))].min(axis=0)  # keep magnitudes small before the cross product
-    flat, zero = flat_faces(v, f, lo, tol * _diagonal(v, f))
+    lo, hi = _bounds(v, f)  # corners shifted by lo: small magnitudes before the cross product
+    flat, zero = flat_faces(v, f, lo, tol * float(np.linalg.norm(hi - lo)))
     out = flat | zero if zero_area else flat
     if faces_welded is not None:
         out |= collapsed(faces_welded)

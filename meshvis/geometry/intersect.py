@@ -359,7 +359,8 @@ def spatial_order(points: np.ndarray) -> np.ndarray:
         | (_spread_bits(q[:, 1]) << np.uint64(1))
         | (_spread_bits(q[:, 2]) << np.uint64(2))
     )
-    return np.argsort(code, kind="stable")
+    # a tie (same cell) may come out in any order: the results never depend on the storage order
+    return np.argsort(code)
 
 
 def _normalised(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
