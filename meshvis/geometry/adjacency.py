@@ -194,7 +194,7 @@ class EdgeTable:
         return out
 
 
-def _stable_order(keys: np.ndarray, bound: int) -> np.ndarray:
+def stable_order(keys: np.ndarray, bound: int) -> np.ndarray:
     """``np.argsort(keys, kind="stable")`` for int64 keys in ``[0, bound)``.
 
     When ``bound * len(keys)`` fits in int64 the keys are made unique by their position
@@ -237,7 +237,7 @@ def edges(faces_welded: np.ndarray) -> EdgeTable:
     forward = (a < b).ravel()
     face = np.repeat(np.flatnonzero(ok), 3)
     keys = lo * np.int64(n) + hi
-    order = _stable_order(keys, n * n)
+    order = stable_order(keys, n * n)
     sorted_keys = keys[order]
     new = np.ones(len(keys), bool)
     new[1:] = sorted_keys[1:] != sorted_keys[:-1]
