@@ -373,7 +373,12 @@ def duplicate_faces(faces_welded: np.ndarray) -> np.ndarray:
     """
     f = np.sort(np.asarray(faces_welded, np.int64).reshape(-1, 3), axis=1)
     m = len(f)
-    order = np.lexsort((np.arange(m), f[:, 2], f[:, 1], f[:, 0]))
+    n = int(f.max()) + 1 if m else 1
+    if n**3 < 2**63:  # one int64 key per sorted corner triple: one stable sort, not a lexsort
+        key = (f[:, 0] * np.int64(n) + f[:, 1]) * np.int64(n) + f[:, 2]
+        order = stable_order(key, n**3)
+    else:
+        order = np.lexsort((np.arange(m), f[:, 2], f[:, 1], f[:, 0]))
     s = f[order]
     new = np.ones(m, bool)
     new[1:] = np.any(s[1:] != s[:-1], axis=1)
