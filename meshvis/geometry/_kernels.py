@@ -503,3 +503,16 @@ def corner_bounds(v, faces):
                 out[0, d] = min(out[0, d], x)
                 out[1, d] = max(out[1, d], x)
     return out
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def gather_normalised(v, faces, centre, scale):
+    """(m, 3, 3) corners ``(v[faces] - centre) * scale``, in that order of operations."""
+    m = faces.shape[0]
+    out = np.empty((m, 3, 3))
+    for f in numba.prange(m):
+        for c in range(3):
+            p = faces[f, c]
+            for d in range(3):
+                out[f, c, d] = (v[p, d] - centre[d]) * scale
+    return out

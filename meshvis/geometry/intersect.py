@@ -364,16 +364,15 @@ def spatial_order(points: np.ndarray) -> np.ndarray:
 
 
 def _normalised(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
-    v = np.asarray(vertices, np.float64)
-    used = v[np.asarray(faces).ravel()]
-    lo, hi = used.min(axis=0), used.max(axis=0)
-    del used
+    """(m, 3, 3) corners centred on the bounding box and scaled to unit diagonal, and the diagonal."""
+    from meshvis.geometry._kernels import corner_bounds, gather_normalised
+
+    v = np.ascontiguousarray(vertices, np.float64)
+    faces = np.ascontiguousarray(faces)
+    lo, hi = corner_bounds(v, faces) if len(faces) else np.zeros((2, 3))
     diag = float(np.linalg.norm(hi - lo))
     scale = 1.0 / diag if diag > 0 else 1.0
-    t = v[faces]
-    t -= 0.5 * (lo + hi)
-    t *= scale
-    return t, diag
+    return gather_normalised(v, faces, 0.5 * (lo + hi), scale), diag
 
 
 def intersection_flags(
