@@ -10,6 +10,9 @@ Pipeline
 --------
 1. Normalise: centre on the bounding-box centre, scale to unit diagonal.  Every tolerance
    below is then a plain number, and the flags do not change under scaling or translation.
+   The faces are stored in Morton order (:func:`spatial_order`) so that the two faces of a
+   candidate pair are near each other in memory; every result is mapped back to the
+   input's face ids, and a pair is always tested with its smaller input id first.
 2. Broad phase (:func:`candidate_pairs`): axis-aligned boxes inflated by ``eps``, sorted
    into a *hierarchical uniform grid*.  Level ``L`` has cells of size ``h0 * 2**L`` (``h0``
    the median box size); a triangle lives on the finest level where its box covers at most
@@ -21,7 +24,8 @@ Pipeline
    ``searchsorted``; large outputs are produced in bounded chunks.
 3. Narrow phase (:func:`classify_pairs`, one numba loop over the pairs): a
    separating-axis test on the 17 axes that separate two triangles — the two normals, the
-   six in-plane edge normals (precomputed per face) and the 9 edge x edge directions.  Each
+   six in-plane edge normals (precomputed per face, :func:`meshvis.geometry._kernels.face_axes`)
+   and the 9 edge x edge directions.  Each
    axis gives a gap between the two projected intervals; a gap along a unit axis is a lower
    bound of the true distance, so "no axis shows a gap above ``eps``" holds for every pair
    closer than ``eps`` (conservative).  Axes that are numerically unreliable (a cross
