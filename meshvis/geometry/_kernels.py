@@ -19,6 +19,11 @@ import numpy as np
 SLACK = 1e-12
 #: angular slack of the wedge test at a shared corner (as in the vectorised version)
 WEDGE_SLACK = 1e-9
+#: widening of each face's projection interval on its own axes (unit-diagonal coordinates,
+#: so a projection is below 1): above the rounding of a 3-term dot product in any order or
+#: with fused multiply-adds (a few 1e-16), so that the interval contains the one of any
+#: other evaluation order and the gaps can only shrink (more reports, never fewer)
+PROJ_SLACK = 1e-15
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
@@ -54,11 +59,41 @@ def _in_wedge(T, c, n, dx, dy, dz):
     return a >= s and b >= s
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy")
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def _sides(T):
+    """Side vectors ``T[s + 1] - T[s]`` (3, 3) and their lengths (3,) of one triangle."""
+    E = np.empty((3, 3))
+    L = np.empty(3)
+    for s in range(3):
+        t = (s + 1) % 3
+        for d in range(3):
+            E[s, d] = T[t, d] - T[s, d]
+        L[s] = math.sqrt(E[s, 0] * E[s, 0] + E[s, 1] * E[s, 1] + E[s, 2] * E[s, 2])
+    return E, L
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
 def narrow_phase(
-    tri, fw, axes, valid, has_normal, low, high, edges, edge_len, pairs, eps, near, tau, cos_angle, cos_fold
+    order,
+    tri,
+    fw,
+    axes,
+    valid,
+    has_normal,
+    low,
+    high,
+    pairs,
+    eps,
+    near,
+    tau,
+    cos_angle,
+    cos_fold,
 ):
-    """Per-pair (intersects, coplanar, too_close, folded) flags; see ``classify_pairs``."""
+    """Per-pair (intersects, coplanar, too_close, folded) flags; see ``classify_pairs``.
+
+    Faces are stored in the spatial order ``order`` (input id of each row); a pair is
+    tested with the face of the smaller input id first, whatever its rows.
+    """
     p = pairs.shape[0]
     inter = np.zeros(p, np.bool_)
     copl = np.zeros(p, np.bool_)
@@ -68,9 +103,11 @@ def narrow_phase(
     eps_r = eps * (1 + SLACK)
     near_r = near * (1 + SLACK)
     pad_r = pad * (1 + SLACK)
-    for q in range(p):
+    for q in numba.prange(p):
         i = pairs[q, 0]
         j = pairs[q, 1]
+        if order[i] > order[j]:  # as (smaller, larger) input id, the orientation of the tests
+            i, j = j, i
         Ti = tri[i]
         Tj = tri[j]
         nshared = 0
@@ -111,13 +148,15 @@ def narrow_phase(
         if nshared == 0:
             # stage 2: edge x edge axes while the pair is still within reach
             if max_gap <= pad_r:
+                Ei, Li = _sides(Ti)
+                Ej, Lj = _sides(Tj)
                 for a in range(3):
                     for b in range(3):
-                        ex = edges[i, a, 1] * edges[j, b, 2] - edges[i, a, 2] * edges[j, b, 1]
-                        ey = edges[i, a, 2] * edges[j, b, 0] - edges[i, a, 0] * edges[j, b, 2]
-                        ez = edges[i, a, 0] * edges[j, b, 1] - edges[i, a, 1] * edges[j, b, 0]
+                        ex = Ei[a, 1] * Ej[b, 2] - Ei[a, 2] * Ej[b, 1]
+                        ey = Ei[a, 2] * Ej[b, 0] - Ei[a, 0] * Ej[b, 2]
+                        ez = Ei[a, 0] * Ej[b, 1] - Ei[a, 1] * Ej[b, 0]
                         length = math.sqrt(ex * ex + ey * ey + ez * ez)
-                        if not length > tau * edge_len[i, a] * edge_len[j, b]:
+                        if not length > tau * Li[a] * Lj[b]:
                             continue
                         g, p0, p1, p2 = _proj_gap(ex, ey, ez, Ti, 0.0, 0.0)
                         lo_i = min(p0, min(p1, p2))
@@ -225,3 +264,255 @@ def broad_pairs(first, starts, counts, ent, low_a, low_b, key, lo, hi, bits, m):
                 out[n] = min(a, b) * m + max(a, b)
                 n += 1
     return out[:n]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+def face_axes(tri, tau):
+    """Per-face separating axes of the narrow phase: unit normal and three in-plane edge normals.
+
+    The arithmetic is that of the numpy formulation (``cross``, ``norm``, one division per
+    component), written per face; the projection intervals are widened by
+    :data:`PROJ_SLACK`.  Returns ``axes`` (m, 4, 3) (zero rows are unusable), ``valid``
+    (m, 4), ``has_normal`` (m,) and the projection interval ``low``, ``high`` (m, 4) of the
+    face on each axis.
+    """
+    m = tri.shape[0]
+    axes = np.zeros((m, 4, 3))
+    valid = np.zeros((m, 4), np.bool_)
+    has_normal = np.zeros(m, np.bool_)
+    low = np.empty((m, 4))
+    high = np.empty((m, 4))
+    for f in numba.prange(m):
+        edges, edge_len = _sides(tri[f])
+        a = edges[0]
+        b = edges[1]
+        nx = a[1] * b[2] - a[2] * b[1]
+        ny = a[2] * b[0] - a[0] * b[2]
+        nz = a[0] * b[1] - a[1] * b[0]
+        n_len = math.sqrt(nx * nx + ny * ny + nz * nz)
+        # a normal is reliable when sin(angle between two sides) exceeds tau
+        if n_len > tau * edge_len[0] * edge_len[1]:
+            has_normal[f] = True
+            valid[f, 0] = True
+            axes[f, 0, 0] = nx / n_len
+            axes[f, 0, 1] = ny / n_len
+            axes[f, 0, 2] = nz / n_len
+        ux = axes[f, 0, 0]
+        uy = axes[f, 0, 1]
+        uz = axes[f, 0, 2]
+        for s in range(3):
+            e = edges[s]
+            wx = uy * e[2] - uz * e[1]
+            wy = uz * e[0] - ux * e[2]
+            wz = ux * e[1] - uy * e[0]
+            w_len = math.sqrt(wx * wx + wy * wy + wz * wz)
+            if w_len > 0:
+                valid[f, s + 1] = True
+                axes[f, s + 1, 0] = wx / w_len
+                axes[f, s + 1, 1] = wy / w_len
+                axes[f, s + 1, 2] = wz / w_len
+        for k in range(4):
+            lo = np.inf
+            hi = -np.inf
+            for c in range(3):
+                p = axes[f, k, 0] * tri[f, c, 0] + axes[f, k, 1] * tri[f, c, 1] + axes[f, k, 2] * tri[f, c, 2]
+                lo = min(lo, p)
+                hi = max(hi, p)
+            low[f, k] = lo - PROJ_SLACK
+            high[f, k] = hi + PROJ_SLACK
+    return axes, valid, has_normal, low, high
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def grid_levels(lo, hi, h0, top, max_cells):
+    """Finest level ``L < top`` whose cells of size ``h0 * 2**L`` a box covers at most ``max_cells`` of (else ``top``)."""
+    m = lo.shape[0]
+    level = np.full(m, top, np.int64)
+    for f in range(m):
+        h = h0
+        for L in range(top):
+            covered = 1.0
+            for d in range(3):
+                covered *= math.floor(hi[f, d] / h) - math.floor(lo[f, d] / h) + 1
+            if covered <= max_cells:
+                level[f] = L
+                break
+            h *= 2.0
+    return level
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def exact_groups(bits, h):
+    """Group equal rows of ``bits`` (n, 3) uint64 through an open-addressing table on the hashes ``h``.
+
+    Returns ``group`` (n,) int64, numbered by first occurrence, and ``first`` (k,) int64, the
+    first row of each group.  Rows are compared in full, so a hash collision costs a probe,
+    never a wrong group.
+    """
+    n = bits.shape[0]
+    size = 1
+    while size < 2 * n:
+        size *= 2
+    mask = np.uint64(size - 1)
+    table = np.full(size, -1, np.int64)
+    group = np.empty(n, np.int64)
+    first = np.empty(n, np.int64)
+    k = 0
+    for r in range(n):
+        slot = h[r] & mask
+        while True:
+            g = table[slot]
+            if g < 0:
+                table[slot] = k
+                first[k] = r
+                group[r] = k
+                k += 1
+                break
+            q = first[g]
+            if bits[q, 0] == bits[r, 0] and bits[q, 1] == bits[r, 1] and bits[q, 2] == bits[r, 2]:
+                group[r] = g
+                break
+            slot = (slot + np.uint64(1)) & mask
+    return group, first[:k]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def flat_faces(v, faces, lo, bound):
+    """Per face: twice the area at most ``bound`` times the longest side, and zero area.
+
+    The first test is that of :func:`meshvis.geometry.adjacency.degenerate_faces` (corners
+    shifted by ``lo`` first), the second the ``areas <= 0`` of :class:`meshvis.soup.Soup`
+    (``|(t1 - t0) x (t2 - t0)|`` of the unshifted corners); the arithmetic is that of the
+    numpy formulations (norms summed x, y, z).  Returns two (m,) bool arrays.
+    """
+    m = faces.shape[0]
+    flat = np.empty(m, np.bool_)
+    zero = np.empty(m, np.bool_)
+    t = np.empty((3, 3))
+    e = np.empty((3, 3))
+    for f in range(m):
+        for c in range(3):
+            for d in range(3):
+                t[c, d] = v[faces[f, c], d] - lo[d]
+        longest = 0.0
+        for s in range(3):
+            for d in range(3):
+                e[s, d] = t[(s + 1) % 3, d] - t[s, d]
+            longest = max(longest, math.sqrt(e[s, 0] * e[s, 0] + e[s, 1] * e[s, 1] + e[s, 2] * e[s, 2]))
+        nx = e[0, 1] * e[1, 2] - e[0, 2] * e[1, 1]
+        ny = e[0, 2] * e[1, 0] - e[0, 0] * e[1, 2]
+        nz = e[0, 0] * e[1, 1] - e[0, 1] * e[1, 0]
+        flat[f] = math.sqrt(nx * nx + ny * ny + nz * nz) <= bound * longest
+        a0 = faces[f, 0]
+        a1 = faces[f, 1]
+        a2 = faces[f, 2]
+        ux = v[a1, 0] - v[a0, 0]
+        uy = v[a1, 1] - v[a0, 1]
+        uz = v[a1, 2] - v[a0, 2]
+        wx = v[a2, 0] - v[a0, 0]
+        wy = v[a2, 1] - v[a0, 1]
+        wz = v[a2, 2] - v[a0, 2]
+        cx = uy * wz - uz * wy
+        cy = uz * wx - ux * wz
+        cz = ux * wy - uy * wx
+        zero[f] = 0.5 * math.sqrt(cx * cx + cy * cy + cz * cz) <= 0
+    return flat, zero
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def grid_cells(lo, hi, h, top, bits):
+    """Cells of size ``h`` covered by the boxes ``[lo, hi]`` (broad phase).
+
+    Returns ``owner`` (e,) int64 (the box of each entry, boxes in order, cells in x, then
+    y, then z order), ``key`` (e,) int64 (``x << 2 bits | y << bits | z``) and ``c0`` (m, 3)
+    int64, the lower cell of each box (cell coordinates clipped to ``[0, top]``).
+    """
+    m = lo.shape[0]
+    c0 = np.empty((m, 3), np.int64)
+    span = np.empty((m, 3), np.int64)
+    total = 0
+    for f in range(m):
+        n = 1
+        for d in range(3):
+            a = min(max(math.floor(lo[f, d] / h), 0.0), top)
+            b = min(max(math.floor(hi[f, d] / h), 0.0), top)
+            c0[f, d] = np.int64(a)
+            span[f, d] = np.int64(b) - np.int64(a) + 1
+            n *= span[f, d]
+        total += n
+    owner = np.empty(total, np.int64)
+    key = np.empty(total, np.int64)
+    e = 0
+    for f in range(m):
+        for z in range(span[f, 2]):
+            for y in range(span[f, 1]):
+                for x in range(span[f, 0]):
+                    owner[e] = f
+                    key[e] = ((c0[f, 0] + x) << (2 * bits)) | ((c0[f, 1] + y) << bits) | (c0[f, 2] + z)
+                    e += 1
+    return owner, key, c0
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _root(parent, x):
+    while parent[x] != x:
+        parent[x] = parent[parent[x]]  # path halving
+        x = parent[x]
+    return x
+
+
+@numba.njit(cache=True, nogil=True)
+def component_labels(n, a, b):
+    """Connected components of ``n`` nodes linked by the edges ``(a[k], b[k])`` (union-find).
+
+    Returns (n,) int64 labels numbered in the order of each component's smallest node, the
+    numbering of ``scipy.sparse.csgraph.connected_components``.
+    """
+    parent = np.arange(n)
+    for k in range(a.shape[0]):
+        x = _root(parent, a[k])
+        y = _root(parent, b[k])
+        if x < y:
+            parent[y] = x
+        elif y < x:
+            parent[x] = y
+    label = np.empty(n, np.int64)
+    count = 0
+    for i in range(n):
+        r = _root(parent, i)
+        if r == i:
+            label[i] = count
+            count += 1
+        else:
+            label[i] = label[r]
+    return label
+
+
+@numba.njit(cache=True, nogil=True)
+def corner_bounds(v, faces):
+    """(2, 3) min and max corner over the vertices the faces use (no mask, no gather)."""
+    out = np.empty((2, 3))
+    for d in range(3):
+        out[0, d] = np.inf
+        out[1, d] = -np.inf
+    for f in range(faces.shape[0]):
+        for c in range(3):
+            p = faces[f, c]
+            for d in range(3):
+                x = v[p, d]
+                out[0, d] = min(out[0, d], x)
+                out[1, d] = max(out[1, d], x)
+    return out
+
+
+@numba.njit(cache=True, nogil=True, parallel=True)
+def gather_normalised(v, faces, centre, scale):
+    """(m, 3, 3) corners ``(v[faces] - centre) * scale``, in that order of operations."""
+    m = faces.shape[0]
+    out = np.empty((m, 3, 3))
+    for f in numba.prange(m):
+        for c in range(3):
+            p = faces[f, c]
+            for d in range(3):
+                out[f, c, d] = (v[p, d] - centre[d]) * scale
+    return out

@@ -38,38 +38,38 @@ def used_vertices(faces: np.ndarray, n_vertices: int) -> np.ndarray:
     return np.flatnonzero(mask)
 
 
+def _bounds(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(2, 3) bounding box of the used vertices (a numba pass over the corners)."""
+    from meshvis.geometry._kernels import corner_bounds
+
+    return corner_bounds(np.asarray(vertices, np.float64), np.asarray(faces))
+
+
 def _diagonal(vertices: np.ndarray, faces: np.ndarray) -> float:
     if len(faces) == 0:
         return 0.0
-    used = vertices[used_vertices(faces, len(vertices))]
-    return float(np.linalg.norm(used.max(axis=0) - used.min(axis=0)))
+    lo, hi = _bounds(vertices, faces)
+    return float(np.linalg.norm(hi - lo))
 
 
 def _exact_groups(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Distinct rows of ``pts`` in lexicographic order, and the row of each input point.
 
-    The same answer as ``np.unique(pts, axis=0, return_inverse=True)``, 5-20x faster: the
-    points are grouped by sorting a 64-bit hash of their bits (one int64 argsort), each
-    group is checked to hold one point only (a hash collision falls back to ``np.unique``)
-    and only the distinct points are sorted lexicographically.
+    The same answer as ``np.unique(pts, axis=0, return_inverse=True)``, about 10x faster:
+    equal points are grouped through a hash table on a 64-bit hash of their bits (a numba
+    kernel, rows compared in full), and only the distinct points are sorted
+    lexicographically.  The points must not hold ``-0.0`` (add ``0.0`` first) or NaN.
     """
-    bits = np.ascontiguousarray(pts).view(np.uint64)
+    from meshvis.geometry._kernels import exact_groups
+
+    bits = np.ascontiguousarray(pts, np.float64).view(np.uint64)
     h = _mix(_mix(_mix(bits[:, 0] + _MIX[2]) ^ bits[:, 1]) ^ bits[:, 2])
-    order = np.argsort(h, kind="stable")
-    hs, s = h[order], pts[order]
-    new = np.ones(len(pts), bool)
-    new[1:] = hs[1:] != hs[:-1]
-    group = np.cumsum(new) - 1
-    first = s[np.flatnonzero(new)]
-    if np.any(first[group] != s):  # two different points with one hash: rare, stay exact
-        uniq, inverse = np.unique(pts, axis=0, return_inverse=True)
-        return uniq, inverse.reshape(-1)
+    group, first_row = exact_groups(bits, h)
+    first = pts[first_row]
     lex = np.lexsort((first[:, 2], first[:, 1], first[:, 0]))
     rank = np.empty(len(first), np.int64)
     rank[lex] = np.arange(len(first))
-    inverse = np.empty(len(pts), np.int64)
-    inverse[order] = rank[group]
-    return first[lex], inverse
+    return first[lex], rank[group]
 
 
 def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tuple[np.ndarray, np.ndarray]:
@@ -194,6 +194,23 @@ class EdgeTable:
         return out
 
 
+def stable_order(keys: np.ndarray, bound: int) -> np.ndarray:
+    """``np.argsort(keys, kind="stable")`` for int64 keys in ``[0, bound)``.
+
+    When ``bound * len(keys)`` fits in int64 the keys are made unique by their position
+    (``key * len + position``) and sorted by value (a SIMD sort, about 5x faster than a
+    stable argsort of 4 M keys); the positions are the stable order.
+    """
+    h = len(keys)
+    if h == 0 or bound * h >= 2**63:
+        return np.argsort(keys, kind="stable")
+    composite = keys * np.int64(h)
+    composite += np.arange(h, dtype=np.int64)
+    composite.sort()
+    composite %= h
+    return composite
+
+
 def edges(faces_welded: np.ndarray) -> EdgeTable:
     """Unique undirected edges of welded faces, their face counts and traversal directions.
 
@@ -220,7 +237,7 @@ def edges(faces_welded: np.ndarray) -> EdgeTable:
     forward = (a < b).ravel()
     face = np.repeat(np.flatnonzero(ok), 3)
     keys = lo * np.int64(n) + hi
-    order = np.argsort(keys, kind="stable")
+    order = stable_order(keys, n * n)
     sorted_keys = keys[order]
     new = np.ones(len(keys), bool)
     new[1:] = sorted_keys[1:] != sorted_keys[:-1]
@@ -292,7 +309,11 @@ def components(n_faces: int, pairs: np.ndarray) -> tuple[int, np.ndarray]:
 
 
 def degenerate_faces(
-    vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL, faces_welded: np.ndarray | None = None
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    tol: float = WELD_TOL,
+    faces_welded: np.ndarray | None = None,
+    zero_area: bool = False,
 ) -> np.ndarray:
     """(m,) bool: faces of (near-)zero area.
 
@@ -312,6 +333,9 @@ def degenerate_faces(
         Fraction of the bounding-box diagonal (default :data:`WELD_TOL`).
     faces_welded : (m, 3) int array, optional
         The ``faces_welded`` output of :func:`weld`, to also flag collapsed faces.
+    zero_area : bool
+        Also flag the faces of zero area as :attr:`meshvis.soup.Soup.areas` computes it
+        (the same arithmetic, without caching the soup's triangles).
 
     Returns
     -------
@@ -322,13 +346,11 @@ def degenerate_faces(
     f = np.asarray(faces, np.int64).reshape(-1, 3)
     if len(f) == 0:
         return np.zeros(0, bool)
-    t = v[f]
-    lo = t.reshape(-1, 3).min(axis=0)
-    t = t - lo  # keep magnitudes small before the cross product
-    e = np.roll(t, -1, axis=1) - t
-    twice_area = np.linalg.norm(np.cross(e[:, 0], e[:, 1]), axis=1)
-    longest = np.linalg.norm(e, axis=2).max(axis=1)
-    out = twice_area <= tol * _diagonal(v, f) * longest
+    from meshvis.geometry._kernels import flat_faces
+
+    lo, hi = _bounds(v, f)  # corners shifted by lo: small magnitudes before the cross product
+    flat, zero = flat_faces(v, f, lo, tol * float(np.linalg.norm(hi - lo)))
+    out = flat | zero if zero_area else flat
     if faces_welded is not None:
         out |= collapsed(faces_welded)
     return out
@@ -351,7 +373,12 @@ def duplicate_faces(faces_welded: np.ndarray) -> np.ndarray:
     """
     f = np.sort(np.asarray(faces_welded, np.int64).reshape(-1, 3), axis=1)
     m = len(f)
-    order = np.lexsort((np.arange(m), f[:, 2], f[:, 1], f[:, 0]))
+    n = int(f.max()) + 1 if m else 1
+    if n**3 < 2**63:  # one int64 key per sorted corner triple: one stable sort, not a lexsort
+        key = (f[:, 0] * np.int64(n) + f[:, 1]) * np.int64(n) + f[:, 2]
+        order = stable_order(key, n**3)
+    else:
+        order = np.lexsort((np.arange(m), f[:, 2], f[:, 1], f[:, 0]))
     s = f[order]
     new = np.ones(m, bool)
     new[1:] = np.any(s[1:] != s[:-1], axis=1)

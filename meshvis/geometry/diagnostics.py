@@ -113,7 +113,7 @@ def analyse(
     table = adjacency.edges(fw)
     lap("edges", 0.25)
     collapsed = adjacency.collapsed(fw)
-    degenerate = adjacency.degenerate_faces(v, f, tol=DEGENERATE_TOL) | (soup.areas <= 0)
+    degenerate = adjacency.degenerate_faces(v, f, tol=DEGENERATE_TOL, zero_area=True)
     lap("degenerate", 0.3)
     first = adjacency.duplicate_faces(fw)
     lap("duplicates", 0.35)

@@ -20,9 +20,8 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
+from meshvis.geometry._kernels import component_labels
 from meshvis.geometry.adjacency import EdgeTable
 
 
@@ -110,8 +109,7 @@ def cluster_sides(
         cross = (~consistent).astype(np.int64)
         rows = np.concatenate([2 * f, 2 * f + 1])
         cols = np.concatenate([2 * g + cross, 2 * g + 1 - cross])
-        graph = sp.coo_matrix((np.ones(len(rows), np.int8), (rows, cols)), shape=(2 * m, 2 * m)).tocsr()
-        return connected_components(graph, directed=False)[1]
+        return component_labels(2 * m, rows, cols)
 
     label = components(f, g, consistent)
     bad_face = label[0::2] == label[1::2]

@@ -11,6 +11,8 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from meshvis.geometry.adjacency import stable_order
+
 #: escape share above which a side counts as open to the outside (see :func:`inside_prior`).
 #: Measured: the holes in the bottom of the Stanford bunny let 2.1% of its inner side's
 #: rays escape, a box with one wall 60% open 4.4%, hairline cracks and a few missing faces
@@ -85,8 +87,11 @@ def edge_weights(
     w : (k,) float64 array
         Edge weight.
     """
-    coo = sp.coo_matrix(hits)
-    r, c, n_ij = coo.row.astype(np.int64), coo.col.astype(np.int64), coo.data
+    h = sp.csr_matrix(hits)
+    h.sum_duplicates()
+    n = len(area)
+    r = np.repeat(np.arange(n, dtype=np.int64), np.diff(h.indptr))
+    c, n_ij = h.indices.astype(np.int64), h.data
     off = r != c
     r, c, n_ij = r[off], c[off], n_ij[off]
     t = area[r] * n_ij / np.maximum(counted[r], 1)
@@ -94,11 +99,17 @@ def edge_weights(
     # a term from a point node towards a cluster node is dropped; the other one counts fully
     mixed = is_point[r] != is_point[c]
     t *= np.where(mixed, np.where(is_point[r], 0.0, 1.0), 0.5)
-    n = len(area)
-    T = sp.csr_matrix((t, (r, c)), shape=(n, n))
-    W = sp.triu(T + T.T, k=1, format="coo")  # sparse addition merges (i,j) with (j,i)
-    keep = W.data > 0
-    return W.row[keep].astype(np.int64), W.col[keep].astype(np.int64), W.data[keep]
+    # merge (i, j) with (j, i): runs of equal undirected keys in one stable sort
+    key = np.minimum(r, c) * np.int64(n) + np.maximum(r, c)
+    order = stable_order(key, n * n)
+    key, t = key[order], t[order]
+    new = np.ones(len(key), bool)
+    new[1:] = key[1:] != key[:-1]
+    starts = np.flatnonzero(new)
+    w = np.add.reduceat(t, starts) if len(t) else t
+    key = key[starts]
+    keep = w > 0
+    return key[keep] // n, key[keep] % n, w[keep]
 
 
 def outside_weights(escaped: np.ndarray, counted: np.ndarray, area: np.ndarray) -> np.ndarray:

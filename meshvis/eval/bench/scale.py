@@ -112,9 +112,22 @@ def one(spec: str, seed: int) -> dict:
     }
 
 
+def warm_up() -> None:
+    """Classify a small soup once, so that the numba kernels are compiled and cached on disk.
+
+    Run in a child of its own before the measured sizes: a fresh checkout compiles its
+    kernels on first use (tens of seconds), which would otherwise land in the first row.
+    """
+    from meshvis.graphcut.classify import classify
+
+    classify(generated(2), seed=0)
+
+
 def run(specs: list[str], seed: int = 0) -> list[dict]:
     """Run every spec (``ico:N`` or a path) in its own subprocess; return their results."""
     out = []
+    code = "from meshvis.eval.bench.scale import warm_up; warm_up()"
+    subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
     with tempfile.TemporaryDirectory() as tmp:
         for spec in specs:
             out.append(_run_one(spec, seed, tmp))
