@@ -295,11 +295,12 @@ class _EditState:
 
     def _buffer(self, index: int) -> bytes:
         """The input data of a buffer (an external one read from the input's folder once)."""
-        if self.original[index] is None:
+        data = self.original[index]
+        if data is None:
             uri = self.doc["buffers"][index]["uri"]
             with open(os.path.join(self.folder, unquote(uri)), "rb") as fh:
-                self.original[index] = fh.read()
-        return self.original[index]
+                data = self.original[index] = fh.read()
+        return data
 
     def read_accessor(self, index: int) -> np.ndarray:
         """(count, components) values of an accessor in its own component type, sparse applied."""

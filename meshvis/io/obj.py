@@ -611,6 +611,7 @@ def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:
         tri_n = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
         rec_n = np.column_stack([np.bincount(src_face, tri_n[:, j], len(src.record_line)) for j in range(3)])
     for r in np.flatnonzero(turned).tolist():
+        assert normals is not None  # made above whenever a record is turned
         no = src.record_line[r]
         body, hash_, comment = lines[no].partition("#")
         tokens = body.split()[1:]
@@ -628,6 +629,7 @@ def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:
             for k in order[a:b].tolist():
                 c = src.corners[edits.origin[k]]
                 if edits.flipped[k]:
+                    assert normals is not None  # made above whenever a face is flipped
                     t = normals.turn([tokens[i] for i in c[[0, 2, 1]]], no, -tri_n[edits.origin[k]])
                 else:
                     t = [tokens[i] for i in c]
