@@ -1,9 +1,11 @@
-"""Pictures of docs/benchmarks.md, "Orientation on real scenes": where the cut and layer
-votes alone (steps 1-2 of meshvis.repair.orient) turn visible faces away from the viewer,
+"""Pictures of docs/benchmarks.md, "Orientation on real scenes".
+
+Where the cut and layer votes alone (steps 1-2 of meshvis.repair.orient) turn visible faces away from the viewer,
 and the same view after all four steps: a close view of the largest face the reference
 (meshvis.eval.reference, cached in /tmp/meshvis-refcache) sees decisively from one side
 and the two steps turn away from it.  Orange = a back side seen, i.e. a face turned
-away from this viewer.
+away from this viewer.  ``<name>_left.png``: the same for the largest decisive face that
+all four steps still turn away from the side the reference sees (what is left).
 
     python docs/img/orientation/pictures.py   (writes docs/img/orientation/*.png)
 """
@@ -30,6 +32,7 @@ MODELS = {
 
 
 def two_steps(soup, c):
+    """The faces that steps 1-2 of ``meshvis.repair.orient`` alone turn over."""
     status, outer = O._own_sides(c, "keep")
     O._hidden_sides(c, status, outer, "layer")
     flip = outer == 1
@@ -37,7 +40,23 @@ def two_steps(soup, c):
     return flip
 
 
+def close_view(soup, ref, f):
+    """A camera 0.12 diagonals off face ``f``, on the side that the reference sees escape."""
+    centre = soup.triangles[f].mean(axis=0)
+    normal = soup.normals[f] * (1.0 if ref.outside_side[f] == 0 else -1.0)
+    return Camera(centre + normal * 0.12 * soup.diagonal, centre, up=(0.0, 1.0, 0.0), fov=50.0)
+
+
+def picture(before, after, cam, path):
+    """Both models from ``cam``, side by side; back-side pixels of each."""
+    ra, rb = render(before, cam, size=(400, 300)), render(after, cam, size=(400, 300))
+    gap = np.full((300, 8, 3), 255, np.uint8)
+    save_png(np.concatenate([ra.image, gap, rb.image], axis=1), path)
+    return int((ra.side == 1).sum()), int((rb.side == 1).sum())
+
+
 def main(root=SHARED):
+    """Write the pictures of every model in ``MODELS`` (read from ``root``)."""
     for name, rel in MODELS.items():
         soup = load(os.path.join(root, rel))
         r = O.orient(soup, seed=0)
@@ -50,13 +69,20 @@ def main(root=SHARED):
         two = two_steps(soup, r.classification)
         wrong = np.flatnonzero(ref.decisive & (two.astype(np.int8) != ref.outside_side))
         f = wrong[np.argmax(soup.areas[wrong])]
-        centre = soup.triangles[f].mean(axis=0)
-        normal = soup.normals[f] * (1.0 if ref.outside_side[f] == 0 else -1.0)
-        cam = Camera(centre + normal * 0.12 * soup.diagonal, centre, up=(0.0, 1.0, 0.0), fov=50.0)
-        ra, rb = render(before, cam, size=(400, 300)), render(after, cam, size=(400, 300))
-        gap = np.full((300, 8, 3), 255, np.uint8)
-        save_png(np.concatenate([ra.image, gap, rb.image], axis=1), os.path.join(HERE, f"{name}.png"))
-        print(name, f"face {f}: back-side pixels, two steps / all four:", int((ra.side == 1).sum()), int((rb.side == 1).sum()))
+        n = picture(before, after, close_view(soup, ref, f), os.path.join(HERE, f"{name}.png"))
+        print(name, f"face {f}: back-side pixels, two steps / all four:", *n)
+        left = np.flatnonzero(ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side))
+        if len(left):
+            g = left[np.argmax(soup.areas[left])]
+            n = picture(before, after, close_view(soup, ref, g), os.path.join(HERE, f"{name}_left.png"))
+            share = soup.areas[g] / soup.areas[ref.decisive].sum()
+            print(
+                name,
+                f"left: face {g} ({100 * share:.3f} % of the decisive area), escapes",
+                ref.escaped[g],
+                "back-side pixels:",
+                *n,
+            )
 
 
 if __name__ == "__main__":
