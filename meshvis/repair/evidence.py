@@ -19,7 +19,8 @@ Rays are cast in rounds, each for the faces the rounds before leave open:
    rays), so that the decision rests on 512 rays, as in the reference of DESIGN.md §10;
 3. :data:`LAST_RAYS` more where the side not shown escaped and the evidence is not yet
    decisive either way (a face seen rarely, or from both sides about equally: 512 rays
-   leave it to chance whether it reaches :data:`MIN_ESCAPES`, or which side wins).
+   leave it to chance whether it reaches :data:`MIN_ESCAPES`, or which side wins); at
+   most :data:`LAST_SHARE` times the rays of the first round, largest faces first.
 
 Most faces cost 64 rays.  A face's evidence is *decisive* when at least
 :data:`MIN_ESCAPES` rays escape and one side escapes at least ``dominance`` (default
@@ -44,6 +45,10 @@ MORE_RAYS = 448
 #: more rays per face in the third round, for the faces whose evidence is not decisive
 #: after the second though their side not shown escaped
 LAST_RAYS = 2048
+#: the third round casts at most this many times the rays of the first round, on the
+#: largest of its faces first: an open sheet seen from both sides (a scan) leaves most of
+#: its faces undecided, and 2048 rays for each would cost 30x the rest of ``orient``
+LAST_SHARE = 1.0
 #: evidence is decisive from this many escaping rays ...
 MIN_ESCAPES = 8
 #: ... when one side escapes at least this many times as often as the other
@@ -164,6 +169,10 @@ def seen_side(
         rays += MORE_RAYS * len(again)
     other, own = escaped[k, 1 - shown], escaped[k, shown]
     last = np.flatnonzero((other > 0) & (DOMINANCE * other > own) & ~decisive(escaped))
+    cap = int(LAST_SHARE * 2 * FIRST_RAYS * len(faces)) // LAST_RAYS
+    if len(last) > cap:  # the largest faces first: the error is measured in area
+        by_area = np.argsort(-soup.areas[faces[last]], kind="stable")
+        last = np.sort(last[by_area[:cap]])
     if len(last):
         escaped[last] += escapes(soup, caster, faces[last], LAST_RAYS, rng)
         rays += LAST_RAYS * len(last)

@@ -59,8 +59,9 @@ from meshvis.soup import Soup
 ONE_SIDED, TWO_SIDED, HIDDEN, CONFLICT, DEGENERATE = 0, 1, 2, 3, 4
 STATUS_NAMES = ("one-sided", "two-sided", "hidden", "conflict", "degenerate")
 #: a face of an open patch whose own sides the cut did not settle (two-sided, or flagged
-#: with sample points that disagree) is seen from both sides, and its patch does not speak
-#: for it across the surface it crosses: the side its own rays see more often wins (any
+#: with sample points that disagree) is seen from both sides, and where the input does not
+#: wind its patch consistently the patch does not speak for it across the surface it
+#: crosses: the side its own rays see more often wins (any
 #: dominance above 1 leaves a face seen 1.4x as often from one side to its patch; on the
 #: monastery such faces made up most of the error)
 BOTH_SEEN_DOMINANCE = 1.0
@@ -420,6 +421,19 @@ def _clearly_one_sided(c: Classification, outer: np.ndarray) -> np.ndarray:
     return clear
 
 
+def _consistently_wound(p: Patches) -> np.ndarray:
+    """(m,) bool: the face's patch has all its fronts on one side as the input winds them."""
+    patch = p.clustering.cluster
+    front = p.clustering.side_node[:, 0]
+    ok = patch >= 0
+    n = max(p.clustering.n_clusters, 1)
+    lo = np.full(n, np.iinfo(np.int64).max)
+    hi = np.full(n, -1)
+    np.minimum.at(lo, patch[ok], front[ok])
+    np.maximum.at(hi, patch[ok], front[ok])
+    return ok & (lo[np.maximum(patch, 0)] == hi[np.maximum(patch, 0)])
+
+
 def _visible_sides(
     c: Classification, p: Patches, status: np.ndarray, outer: np.ndarray, movable: np.ndarray, seed: int
 ) -> tuple[np.ndarray, int, int]:
@@ -443,7 +457,9 @@ def _visible_sides(
     turned = np.zeros(len(outer), bool)
     if len(test) == 0:
         return turned, 0, 0
-    both = np.isin(status[test], (TWO_SIDED, CONFLICT))
+    # inside a patch that the input winds consistently, a face leaves its patch only on
+    # decisive evidence (a scan seen from both sides is not speckled with turned faces)
+    both = np.isin(status[test], (TWO_SIDED, CONFLICT)) & ~_consistently_wound(p)[test]
     dominance = np.where(both, BOTH_SEEN_DOMINANCE, evidence.DOMINANCE)
     # a generator of its own (seeded from the classification's seed), so that the test
     # does not shift the random numbers of anything else

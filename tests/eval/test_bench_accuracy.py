@@ -2,6 +2,7 @@
 
 import csv
 import math
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -191,12 +192,17 @@ def test_compare_one_case_and_its_checks():
     assert "| two_spheres |" in text and "## Targets" in text
 
 
+REAL = Path(__file__).resolve().parents[3] / "shared" / "models" / "real"
+
+
 @pytest.mark.slow
+@pytest.mark.skipif(not REAL.is_dir(), reason="shared real models not present")
 def test_accuracy_quick_writes_finite_errors(tmp_path):
     from meshvis.cli.main import main
 
     out = tmp_path / "acc"
-    assert main(["bench", "accuracy", "--quick", "--quiet", "--out", str(out)]) == 0
+    args = ["bench", "accuracy", "--quick", "--quiet", "--out", str(out), "--models", str(REAL)]
+    assert main(args) == 0
     for name in (
         "accuracy.csv",
         "accuracy.md",
