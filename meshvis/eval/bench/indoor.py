@@ -59,6 +59,13 @@ def run_scene(path: str, region: str | None = None, seed: int = 0) -> dict:
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the options of ``meshvis bench indoor`` to ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The benchmark's sub-parser.
+    """
     p.add_argument("scenes", nargs="*", help=f"scene files (default: {', '.join(SCENES)})")
     p.add_argument("--region", help="the viewers' region for every scene (default: a box at the centre)")
     p.add_argument("--seed", type=int, default=0)

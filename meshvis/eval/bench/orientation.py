@@ -20,7 +20,7 @@ instead: they are left out of the error, and the pairs a method writes with one 
 (losing a side) are counted.
 
 Output under ``DIR``: ``orientation.csv`` (one row per run), ``orientation.md`` (the
-machine, a table per input kind, the targets of issue 14 checked on the numbers) and
+machine, a table per input kind, the orientation targets checked on the numbers) and
 ``orientation.png`` (error against time, one panel per model).
 """
 
@@ -50,7 +50,7 @@ SWEEP_FULL = (2, 8, 64)
 SWEEP_QUICK = (4,)
 #: the inputs of ``--quick``
 QUICK = ("cow.obj", "ferrari348_lowpoly.glb", "mannequiny.glb", "suzanne.obj")
-#: the targets of issue 14
+#: the orientation targets (error at most the best baseline's and this share, time at most 1/5 of libigl's)
 ERROR_TARGET = 1e-3
 SPEED_TARGET = 5.0
 #: errors below this are drawn on the floor of the log axis
@@ -136,8 +136,11 @@ def _meshvis(soup, rays_per_node: int | None, seed: int):
 
 
 def run_input(name: str, kind: str, soup, turned, ref, *, sweep, seed: int, log) -> list[Run]:
-    """Every method on one input; ``turned`` says which faces the input turned over
-    relative to the file the reference was computed on."""
+    """Run every method on one input and judge it by the reference.
+
+    ``turned`` says which faces the input turned over relative to the file the reference
+    was computed on.
+    """
     from meshvis.geometry.adjacency import weld
     from meshvis.geometry.duplicates import opposite_copies
 
@@ -202,6 +205,15 @@ def run(paths: list[str], *, quick: bool, seed: int, cache: str, log=print) -> l
 
 # ====================================================================== reporting
 def write_csv(path: str, runs: list[Run]) -> None:
+    """Write one CSV row per run to ``path`` (atomically).
+
+    Parameters
+    ----------
+    path : str
+        The CSV file.
+    runs : list of Run
+        The runs, in order.
+    """
     from meshvis.io import atomic_write
 
     buf = io.StringIO()
@@ -221,7 +233,7 @@ def _get(runs, model, kind, method, rays=0):
 
 
 def checks(runs: list[Run], model: str, kind: str) -> list[str]:
-    """The targets of issue 14 on one input: which of them fail ('' when all hold)."""
+    """The orientation targets on one input: which of them fail ('' when all hold)."""
     mv = _get(runs, model, kind, "meshvis")
     inp = _get(runs, model, kind, "input")
     base = [r for r in (_get(runs, model, kind, b) for b in METHODS[1:]) if r is not None and r.ok]
@@ -245,6 +257,24 @@ def _pct(x: float) -> str:
 
 
 def markdown(runs: list[Run], machine: dict, command: str, seconds: float) -> str:
+    """Format the runs as the Markdown report: a table per input kind and the targets.
+
+    Parameters
+    ----------
+    runs : list of Run
+        The runs of :func:`run`.
+    machine : dict
+        The machine description of ``cases.machine``.
+    command : str
+        The command line that made the runs.
+    seconds : float
+        Wall time of the whole benchmark.
+
+    Returns
+    -------
+    str
+        The report.
+    """
     lines = [
         "Orientation on real scenes: error = decisive area whose front is not the side that escapes "
         "more, over the decisive area (dense random reference, DESIGN.md §10); time = wall time of the "
@@ -369,6 +399,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    """Run ``meshvis bench orientation`` and write its CSV, table and chart.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The options of :func:`add_arguments`.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+    """
     paths = model_paths(args.only, args.quick, args.models_dir)
     prepare_out(args.out, OUTPUTS, args.force)
     log = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))

@@ -60,6 +60,13 @@ CONVERGED_MIN_NEW_AREA = 1e-5
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
+    """Add the options of ``meshvis bench real`` to ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The benchmark's sub-parser.
+    """
     p.add_argument(
         "--only",
         nargs="*",
@@ -86,6 +93,18 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
 
 
 def main(args: argparse.Namespace) -> int:
+    """Run ``meshvis bench real`` on the selected models and print and store the results.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The options of :func:`add_arguments`.
+
+    Returns
+    -------
+    int
+        Exit status 0.
+    """
     from meshvis.io.jsonfile import write_json
 
     todo = _selection(args)
@@ -401,6 +420,18 @@ def worst_view_picture(soup, removed: dict, table, path: str, size: int = 512) -
 
 
 def format_model(r: dict) -> str:
+    """Format one model's results as the lines the benchmark prints.
+
+    Parameters
+    ----------
+    r : dict
+        One model's results, as stored in the JSON output.
+
+    Returns
+    -------
+    str
+        The printed block.
+    """
     lines = [
         f"{r['model']}: {r['faces']} faces, reference-hidden area {100 * r['reference_hidden_area']:.1f} %, "
         f"view/object time {r['view_over_object_time']:.2f}",

@@ -28,6 +28,13 @@ REAL = ("real/pybullet__samurai_monastry.obj", "real2/zdm2_level.glb", "real2/pa
 
 
 def add_arguments(p) -> None:
+    """Add the options of ``meshvis bench scale`` to ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The benchmark's sub-parser.
+    """
     p.add_argument("models", nargs="*", help="real models (default: the largest shared ones)")
     p.add_argument(
         "--sizes", type=int, nargs="*", default=list(SUBDIVISIONS), help="icosphere subdivisions (5..9)"
@@ -136,8 +143,11 @@ def run(specs: list[str], seed: int = 0) -> list[dict]:
 
 
 def _run_one(spec: str, seed: int, tmp: str) -> dict:
-    """One child process.  A generated size is made here and handed over as an .npz file,
-    so that the child's peak memory is that of loading and classifying only."""
+    """Measure one size or model in a child process.
+
+    A generated size is made here and handed over as an .npz file, so that the child's
+    peak memory is that of loading and classifying only.
+    """
     import numpy as np
 
     if spec.startswith("ico:"):
