@@ -114,3 +114,101 @@ def face_edits(soup: Soup, formats: tuple[str, ...]) -> FaceEdits | None:
     if not (same | turned).all():
         return None
     return FaceEdits(rec, origin, turned & ~same)
+
+
+@dataclass(eq=False)
+class VertexSplit:
+    """How the vertices of turned faces get turned shading normals.
+
+    A vertex used only by turned faces keeps its row and has its normal negated; a vertex
+    used by turned and unturned faces is copied (appended after the input's rows) with the
+    normal negated, and the turned faces' corners point at the copy.
+
+    Parameters
+    ----------
+    rows : (n + s,) int64
+        Input row of every output vertex: ``0 .. n-1``, then the ``s`` copied rows.
+    negate : (n + s,) bool
+        Output vertices whose normal is turned.
+    indices : (k,) int64
+        The corner indices with the turned corners moved to the copies.
+    not_split : int
+        Shared vertices left without a copy because ``limit`` did not allow it.
+    """
+
+    rows: np.ndarray
+    negate: np.ndarray
+    indices: np.ndarray
+    not_split: int = 0
+
+
+def split_turned_vertices(
+    indices: np.ndarray,
+    corner_turned: np.ndarray,
+    n_vertices: int,
+    *,
+    valid: np.ndarray | None = None,
+    limit: int | None = None,
+) -> VertexSplit:
+    """Plan the vertex copies and normal turns of a repair that turned faces over.
+
+    Parameters
+    ----------
+    indices : (k,) int
+        Vertex index of every face corner, as written.
+    corner_turned : (k,) bool
+        Whether the corner's face is turned over (and its normals are to be turned).
+    n_vertices : int
+        Number of input vertices.
+    valid : (k,) bool, optional
+        Corners whose index refers to a vertex (others are left as they are).
+    limit : int, optional
+        Largest vertex index the file can store: no copy is made when copies would pass it.
+
+    Returns
+    -------
+    VertexSplit
+
+    Examples
+    --------
+    >>> s = split_turned_vertices(np.array([0, 1, 2, 2, 1, 3]), np.repeat([False, True], 3), 4)
+    >>> s.rows.tolist(), s.negate.tolist(), s.indices.tolist()
+    ([0, 1, 2, 3, 1, 2], [False, False, False, True, True, True], [0, 1, 2, 5, 4, 3])
+    """
+    idx = np.asarray(indices, np.int64)
+    ok = np.ones(len(idx), bool) if valid is None else np.asarray(valid, bool)
+    safe = np.where(ok, idx, 0)
+    turned_use = np.bincount(idx[ok & corner_turned], minlength=n_vertices)[:n_vertices] > 0
+    kept_use = np.bincount(idx[ok & ~corner_turned], minlength=n_vertices)[:n_vertices] > 0
+    split = np.flatnonzero(turned_use & kept_use)
+    not_split = 0
+    if limit is not None and len(split) and n_vertices + len(split) - 1 > limit:
+        not_split, split = len(split), split[:0]
+    copy_of = np.full(n_vertices, -1, np.int64)
+    copy_of[split] = n_vertices + np.arange(len(split))
+    move = ok & corner_turned & (copy_of[safe] >= 0)
+    return VertexSplit(
+        rows=np.concatenate([np.arange(n_vertices), split]),
+        negate=np.concatenate([turned_use & ~kept_use, np.ones(len(split), bool)]),
+        indices=np.where(move, copy_of[safe], idx),
+        not_split=not_split,
+    )
+
+
+def negate_in_type(values: np.ndarray) -> np.ndarray:
+    """``-values`` in their own type (integers clipped: -(-128) is 127 in a signed byte).
+
+    Parameters
+    ----------
+    values : ndarray
+        Normals or tangent signs, float or (normalised) integer.
+
+    Returns
+    -------
+    ndarray
+        The negated values, same dtype.
+    """
+    if values.dtype.kind == "f":
+        return -values
+    info = np.iinfo(values.dtype)
+    return np.clip(-values.astype(np.int64), info.min, info.max).astype(values.dtype)

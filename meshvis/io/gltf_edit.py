@@ -42,7 +42,7 @@ import numpy as np
 
 from meshvis.errors import ModelFormatError
 from meshvis.io._common import atomic_write
-from meshvis.io.edits import FaceEdits
+from meshvis.io.edits import FaceEdits, negate_in_type, split_turned_vertices
 
 GLB_MAGIC = b"glTF"
 JSON_CHUNK = 0x4E4F534A
@@ -519,27 +519,19 @@ def turn_normals(state: _EditState, prim: dict, local: np.ndarray, turned: np.nd
         )
     if not turned.any():
         return local
-    flat = local.reshape(-1)
-    corner_turned = np.repeat(turned, 3)
-    turned_use = np.bincount(flat[corner_turned], minlength=n)[:n] > 0
-    kept_use = np.bincount(flat[~corner_turned], minlength=n)[:n] > 0
-    split = np.flatnonzero(turned_use & kept_use)
-    rows = np.concatenate([np.arange(n), split])
-    negate = np.concatenate([turned_use & ~kept_use, np.ones(len(split), bool)])
+    plan = split_turned_vertices(local.reshape(-1), np.repeat(turned, 3), n)
+    rows, negate, copied = plan.rows, plan.negate, len(plan.rows) > n
     for table, is_target in [(attrs, False)] + [(t, True) for t in prim.get("targets", [])]:
         for name, index in list(table.items()):
-            if len(split) == 0 and name not in ("NORMAL", "TANGENT"):
+            if not copied and name not in ("NORMAL", "TANGENT"):
                 continue
             values = state.read_accessor(index)[rows]
             if name == "NORMAL":
-                values[negate] = _negate(values[negate])
+                values[negate] = negate_in_type(values[negate])
             elif name == "TANGENT" and not is_target:  # a target's TANGENT is an xyz delta
-                values[negate, 3:] = _negate(values[negate, 3:])
+                values[negate, 3:] = negate_in_type(values[negate, 3:])
             table[name] = state.add_accessor(state.doc["accessors"][index], values)
-    copy_of = np.full(n, -1, np.int64)
-    copy_of[split] = n + np.arange(len(split))
-    moved = np.where(corner_turned & (copy_of[flat] >= 0), copy_of[flat], flat)
-    return moved.reshape(-1, 3)
+    return plan.indices.reshape(-1, 3)
 
 
 def already_front(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray) -> np.ndarray:
@@ -565,14 +557,6 @@ def already_front(positions: np.ndarray, normals: np.ndarray, faces: np.ndarray)
     p = positions[faces]
     g = np.cross(p[:, 1] - p[:, 0], p[:, 2] - p[:, 0])
     return np.einsum("tcj,tj->t", normals[faces], g) > 0
-
-
-def _negate(values: np.ndarray) -> np.ndarray:
-    """``-values`` in their own type (normalized integers clipped: -(-128) is 127 in a byte)."""
-    if values.dtype.kind == "f":
-        return -values
-    info = np.iinfo(values.dtype)
-    return np.clip(-values.astype(np.int64), info.min, info.max).astype(values.dtype)
 
 
 def _drop_mesh(doc: dict, users: list[int]) -> None:

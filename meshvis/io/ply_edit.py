@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshvis.io._common import atomic_write
-from meshvis.io.edits import FaceEdits
+from meshvis.io.edits import FaceEdits, negate_in_type, split_turned_vertices
 
 
 @dataclass(frozen=True)
@@ -141,24 +141,16 @@ def _turned_normals(src, columns: dict, corner_turned: np.ndarray):
     corner_turned = corner_turned & ~front
     if not corner_turned.any():
         return None
-    turned_use = np.bincount(idx[ok & corner_turned], minlength=n) > 0
-    kept_use = np.bincount(idx[ok & ~corner_turned], minlength=n) > 0
-    split = np.flatnonzero(turned_use & kept_use)
     index_type = np.asarray(columns[src.index_name][1]).dtype
-    if len(split) and n + len(split) - 1 > np.iinfo(index_type).max:
+    plan = split_turned_vertices(idx, corner_turned, n, valid=ok, limit=int(np.iinfo(index_type).max))
+    if plan.not_split:
         warnings.warn(
-            f"{len(split)} vertices shared by turned and unturned faces keep their normals: their "
+            f"{plan.not_split} vertices shared by turned and unturned faces keep their normals: their "
             f"copies would not fit the file's {index_type} vertex indices",
             stacklevel=4,
         )
-        split = split[:0]
-    copy_of = np.full(n, -1, np.int64)
-    copy_of[split] = n + np.arange(len(split))
-    move = ok & corner_turned & (copy_of[np.where(ok, idx, 0)] >= 0)
-    new_idx = np.where(move, copy_of[np.where(ok, idx, 0)], idx)
-    columns[src.index_name] = (counts, new_idx.astype(columns[src.index_name][1].dtype))
-    rows = np.concatenate([np.arange(n), split])
-    negate = np.concatenate([turned_use & ~kept_use, np.ones(len(split), bool)])
+    columns[src.index_name] = (counts, plan.indices.astype(index_type))
+    rows, negate = plan.rows, plan.negate
     out = {}
     for p in props:
         col = vert[p.name]
@@ -173,7 +165,7 @@ def _turned_normals(src, columns: dict, corner_turned: np.ndarray):
         col = np.asarray(col)[rows]
         if p.name in _NORMAL:
             col = col.copy()
-            col[negate] = _negate(col[negate])
+            col[negate] = negate_in_type(col[negate])
         out[p.name] = col
     return at, out, props, len(rows)
 
@@ -195,14 +187,6 @@ def _rows_front(src, idx: np.ndarray, counts: np.ndarray, normals: np.ndarray) -
     g = np.column_stack([np.bincount(row, cross[:, j], len(counts)) for j in range(3)])
     dots = np.einsum("ij,ij->i", normals[idx], g[row])
     return (np.bincount(row, dots, len(counts)) > 0)[row]
-
-
-def _negate(values: np.ndarray) -> np.ndarray:
-    """``-values`` in their own type (integers clipped: -(-128) is 127 in a signed byte)."""
-    if values.dtype.kind == "f":
-        return -values
-    info = np.iinfo(values.dtype)
-    return np.clip(-values.astype(np.int64), info.min, info.max).astype(values.dtype)
 
 
 def _face_rows(edits: FaceEdits, src, added: list) -> tuple[dict, np.ndarray]:
