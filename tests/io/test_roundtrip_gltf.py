@@ -1,29 +1,19 @@
 """glTF/GLB round trips on real models: a repair edits the input document, it does not rebuild it."""
 
-import json
 import os
-import shutil
-import subprocess
 
 import numpy as np
 import pytest
+from helpers import real_model, validate_gltf, write_glb
 
 import meshvis
 from meshvis.io.gltf_edit import read_container
 
-REAL = "/work/shared/models/real"
 HERE = os.path.dirname(__file__)
 MODELS = ["CesiumMilkTruck.glb", "pins.glb"]
 #: top-level glTF properties a face edit never touches
 KEPT = ("asset", "scene", "scenes", "materials", "textures", "images", "samplers", "animations", "skins",
         "cameras", "extensionsUsed", "extensionsRequired", "extensions", "extras")  # fmt: skip
-
-
-def _model(name):
-    path = os.path.join(REAL, name)
-    if not os.path.exists(path):
-        pytest.skip(f"{path} not available")
-    return path
 
 
 def _index_accessors(doc):
@@ -73,7 +63,7 @@ def _assert_only_faces_changed(src, out):
 
 @pytest.mark.parametrize("name", MODELS)
 def test_unchanged_repair_gives_the_same_document(name, tmp_path):
-    src = _model(name)
+    src = real_model(name)
     out = str(tmp_path / name)
     meshvis.save(meshvis.load(src), out)
     a, abuf, _ = read_container(src, "in")
@@ -84,7 +74,7 @@ def test_unchanged_repair_gives_the_same_document(name, tmp_path):
 
 
 def test_truck_keeps_normals_tree_animation_and_texture(tmp_path):
-    src = _model("CesiumMilkTruck.glb")
+    src = real_model("CesiumMilkTruck.glb")
     soup = meshvis.load(src)
     out = str(tmp_path / "o.glb")
     meshvis.save(meshvis.orient(soup).soup, out)
@@ -98,7 +88,7 @@ def test_truck_keeps_normals_tree_animation_and_texture(tmp_path):
 
 @pytest.mark.parametrize("name", MODELS)
 def test_removal_changes_only_the_removed_faces(name, tmp_path):
-    src = _model(name)
+    src = real_model(name)
     soup = meshvis.load(src)
     keep = np.ones(soup.n_faces, bool)
     keep[::3] = False
@@ -111,7 +101,7 @@ def test_removal_changes_only_the_removed_faces(name, tmp_path):
 
 @pytest.mark.parametrize("name", MODELS)
 def test_flips_change_only_the_flipped_faces(name, tmp_path):
-    src = _model(name)
+    src = real_model(name)
     soup = meshvis.load(src)
     flip = np.zeros(soup.n_faces, bool)
     flip[:40] = True  # faces of the first piece only
@@ -128,7 +118,7 @@ def test_flips_change_only_the_flipped_faces(name, tmp_path):
 
 
 def test_shared_mesh_is_split_only_for_the_instance_that_differs(tmp_path):
-    src = _model("pins.glb")
+    src = real_model("pins.glb")
     soup = meshvis.load(src)
     a, _, _ = read_container(src, "in")
     dowel = soup.part_id == 2  # one of the six instances of the shared dowel mesh
@@ -142,93 +132,41 @@ def test_shared_mesh_is_split_only_for_the_instance_that_differs(tmp_path):
     assert np.array_equal(back.normals[dowel].round(4), -soup.normals[dowel].round(4))
 
 
-def _validator():
-    node = shutil.which("node")
-    roots = [
-        os.environ.get("NODE_PATH", ""),
-        os.path.join(HERE, "..", "..", ".tools", "gltf", "node_modules"),
-    ]
-    for root in roots:
-        if node and root and os.path.isdir(os.path.join(root, "gltf-validator")):
-            return node, root
-    return None
-
-
 @pytest.mark.parametrize("name", MODELS)
 @pytest.mark.parametrize("change", ["none", "remove", "flip"])
 def test_outputs_pass_the_khronos_validator(name, change, tmp_path):
-    found = _validator()
-    if found is None:
-        pytest.skip("gltf-validator (npm) not installed; .ci/run installs it")
-    node, root = found
-    soup = meshvis.load(_model(name))
+    soup = meshvis.load(real_model(name))
     if change == "remove":
         soup = soup.subset(np.arange(soup.n_faces) % 4 != 0)
     elif change == "flip":
         soup = soup.flipped(np.arange(soup.n_faces) % 5 == 0)
     out = str(tmp_path / name)
     meshvis.save(soup, out)
-    run = subprocess.run(
-        [node, os.path.join(HERE, "validate_gltf.js"), out],
-        capture_output=True,
-        text=True,
-        env={**os.environ, "NODE_PATH": root},
-        timeout=120,
-    )
-    report = json.loads(run.stdout)
+    report = validate_gltf(out)
     assert report["errors"] == 0, report["messages"]
-
-
-def _validate(path):
-    found = _validator()
-    if found is None:
-        pytest.skip("gltf-validator (npm) not installed; .ci/run installs it")
-    node, root = found
-    run = subprocess.run(
-        [node, os.path.join(HERE, "validate_gltf.js"), path],
-        capture_output=True,
-        text=True,
-        env={**os.environ, "NODE_PATH": root},
-        timeout=300,
-    )
-    return json.loads(run.stdout)
 
 
 @pytest.mark.parametrize(
     "name", ["ferrari348_lowpoly.glb", "van_gogh_room.glb", "zdm2_level.glb", "mannequiny.glb"]
 )
 def test_edits_of_larger_models_add_no_validator_error(name, tmp_path):
-    src = os.path.join(REAL, "..", "real2", name)
-    if not os.path.exists(src):
-        pytest.skip(f"{src} not available")
+    src = real_model(name)
     soup = meshvis.load(src)
     out = str(tmp_path / name)
     meshvis.save(soup.flipped(np.arange(soup.n_faces) % 2 == 0).subset(np.arange(soup.n_faces) % 3 != 0), out)
-    before, after = _validate(src), _validate(out)
+    before, after = validate_gltf(src), validate_gltf(out)
     codes = {m.split()[0] for m in before["messages"]}
     assert after["errors"] <= before["errors"]
     assert {m.split()[0] for m in after["messages"]} <= codes, after["messages"]
     _assert_only_faces_changed(src, out)
 
 
-def _write_glb(doc, blob, path):
-    import struct
-
-    js = json.dumps(doc).encode()
-    js += b" " * ((-len(js)) % 4)
-    blob += b"\x00" * ((-len(blob)) % 4)
-    with open(path, "wb") as fh:
-        fh.write(struct.pack("<4sII", b"glTF", 2, 28 + len(js) + len(blob)))
-        fh.write(struct.pack("<II", len(js), 0x4E4F534A) + js)
-        fh.write(struct.pack("<II", len(blob), 0x004E4942) + blob)
-
-
 def test_a_mirrored_instance_is_edited_in_the_file_winding(tmp_path):
-    doc, buffers, _ = read_container(_model("pins.glb"), "pins")
+    doc, buffers, _ = read_container(real_model("pins.glb"), "pins")
     m = doc["nodes"][3]["matrix"]
     doc["nodes"][3]["matrix"] = [-v for v in m[:4]] + m[4:]  # mirror the third node's x axis
     src = str(tmp_path / "mirror.glb")
-    _write_glb(doc, bytes(buffers[0]), src)
+    write_glb(doc, bytes(buffers[0]), src)
     soup = meshvis.load(src)
     mirrored = soup.part_id == soup.part_names.index(doc["nodes"][3]["name"])
     flip = mirrored | (soup.part_id == soup.part_names.index(doc["nodes"][2]["name"]))

@@ -5,20 +5,13 @@ from collections import Counter
 
 import numpy as np
 import pytest
+from helpers import real_model
 
 import meshvis
 
-REAL = "/work/shared/models/real"
 MODELS = ["spot.obj", "suzanne.obj", "bunny10k_textured.obj"]
 #: statements a face edit never touches (mtllib is rewritten to the output's MTL file)
 KEPT = ("v", "vt", "vn", "vp", "s", "o", "g", "usemtl", "#", "l")
-
-
-def _model(name):
-    path = os.path.join(REAL, name)
-    if not os.path.exists(path):
-        pytest.skip(f"{path} not available")
-    return path
 
 
 def _lines(path):
@@ -57,7 +50,7 @@ def _sorted_triangles(soup):
 
 @pytest.mark.parametrize("name", MODELS)
 def test_unchanged_repair_writes_the_input_lines(name, tmp_path):
-    src = _model(name)
+    src = real_model(name)
     out = str(tmp_path / name)  # same stem: no part name to keep
     meshvis.save(meshvis.load(src), out)
     a = [ln for ln in _lines(src) if not ln.startswith("mtllib")]
@@ -68,7 +61,7 @@ def test_unchanged_repair_writes_the_input_lines(name, tmp_path):
 
 @pytest.mark.parametrize("name", MODELS)
 def test_removal_and_flips_change_only_those_faces(name, tmp_path):
-    src = _model(name)
+    src = real_model(name)
     soup = meshvis.load(src)
     flip = np.arange(soup.n_faces) % 2 == 0
     result = soup.flipped(flip).subset(np.arange(soup.n_faces) % 3 != 0)
@@ -84,7 +77,7 @@ def test_removal_and_flips_change_only_those_faces(name, tmp_path):
 
 
 def test_suzanne_keeps_normals_comments_and_quads(tmp_path):
-    src = _model("suzanne.obj")
+    src = real_model("suzanne.obj")
     soup = meshvis.load(src)
     out = str(tmp_path / "s.obj")
     r = meshvis.orient(soup)
@@ -101,7 +94,7 @@ def test_suzanne_keeps_normals_comments_and_quads(tmp_path):
 
 
 def test_smoothing_groups_objects_and_materials_are_kept(tmp_path):
-    src = _model("chair_model.obj")
+    src = real_model("chair_model.obj")
     soup = meshvis.load(src)
     out = str(tmp_path / "c.obj")
     meshvis.save(soup.subset(np.arange(soup.n_faces) % 2 == 0), out)
@@ -110,7 +103,7 @@ def test_smoothing_groups_objects_and_materials_are_kept(tmp_path):
 
 
 def test_a_turned_over_polygon_stays_one_polygon(tmp_path):
-    src = _model("suzanne.obj")
+    src = real_model("suzanne.obj")
     soup = meshvis.load(src)
     first_quad = soup.source_face == soup.source_face[np.argmax(np.bincount(soup.source_face) == 2)]
     out = str(tmp_path / "s.obj")
@@ -127,7 +120,7 @@ def test_a_turned_over_polygon_stays_one_polygon(tmp_path):
 
 
 def test_a_partly_kept_polygon_becomes_its_kept_triangles(tmp_path):
-    src = _model("suzanne.obj")
+    src = real_model("suzanne.obj")
     soup = meshvis.load(src)
     quad = int(np.flatnonzero(np.bincount(soup.source_face) == 2)[0])
     drop = np.flatnonzero(soup.source_face == quad)[0]

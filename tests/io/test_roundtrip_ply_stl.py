@@ -1,21 +1,11 @@
 """PLY and STL round trips: every element, property, type, comment and header byte kept."""
 
-import os
-
 import numpy as np
 import pytest
+from helpers import real_model
 
 import meshvis
 from meshvis.io.ply import read_elements
-
-REAL = "/work/shared/models/real"
-
-
-def _model(name):
-    path = os.path.join(REAL, name)
-    if not os.path.exists(path):
-        pytest.skip(f"{path} not available")
-    return path
 
 
 def _equal_columns(a, b):
@@ -37,7 +27,7 @@ def _sorted_triangles(soup):
 
 @pytest.mark.parametrize("name", ["pymeshlab_face000.ply", "pyvista__ant.ply"])
 def test_unchanged_ply_is_the_same_file(name, tmp_path):
-    src = _model(name)
+    src = real_model(name)
     out = str(tmp_path / name)
     meshvis.save(meshvis.load(src), out)
     with open(src, "rb") as fa, open(out, "rb") as fb:
@@ -45,7 +35,7 @@ def test_unchanged_ply_is_the_same_file(name, tmp_path):
 
 
 def test_ply_repair_changes_only_the_faces(tmp_path):
-    src = _model("pymeshlab_face000.ply")
+    src = real_model("pymeshlab_face000.ply")
     soup = meshvis.load(src)
     result = soup.flipped(np.arange(soup.n_faces) % 2 == 0).subset(np.arange(soup.n_faces) % 3 != 0)
     out = str(tmp_path / "o.ply")
@@ -131,7 +121,7 @@ def test_turned_polygon_stays_a_polygon_in_its_format(fmt, tmp_path):
 
 
 def test_binary_stl_keeps_its_header_and_attributes(tmp_path):
-    src = _model("dm_control__SKINbody.stl")
+    src = real_model("dm_control__SKINbody.stl")
     with open(src, "rb") as fh:
         data = fh.read()
     soup = meshvis.load(src)
@@ -169,7 +159,7 @@ def test_ascii_stl_stays_ascii(tmp_path):
 
 
 def test_layers_add_face_properties_to_the_edited_ply(tmp_path):
-    src = _model("pymeshlab_face000.ply")
+    src = real_model("pymeshlab_face000.ply")
     soup = meshvis.load(src)
     layer = np.arange(soup.n_faces) % 3 + 1
     out = str(tmp_path / "l.ply")

@@ -9,24 +9,16 @@ import os
 
 import numpy as np
 import pytest
+from helpers import real_model
 
 import meshvis
 from meshvis.io.gltf_edit import read_container
 from meshvis.io.ply import read_elements
 from meshvis.repair.operation import run_operation
 
-REAL = "/work/shared/models/real"
-
-
-def _model(name):
-    path = os.path.join(REAL, name)
-    if not os.path.exists(path):
-        pytest.skip(f"{path} not available")
-    return path
-
 
 def _repair(op, name, tmp_path, ext=None, **options):
-    src = _model(name)
+    src = real_model(name)
     soup = meshvis.load(src)
     out = str(tmp_path / ("out" + (ext or os.path.splitext(name)[1])))
     notes = []
@@ -125,7 +117,7 @@ def test_repairs_of_a_binary_stl_keep_its_header_and_records(op, tmp_path):
 
 
 def test_a_cross_format_output_says_what_it_lacks(tmp_path):
-    soup = meshvis.load(_model("suzanne.obj"))
+    soup = meshvis.load(real_model("suzanne.obj"))
     notes = []
     run_operation("orient", soup, {"output": str(tmp_path / "s.ply"), "seed": 0}, say=notes.append)
     [note] = [n for n in notes if "written anew" in n]

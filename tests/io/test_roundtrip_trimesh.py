@@ -1,26 +1,16 @@
 """trimesh objects in, the same kind back with their visuals (Soup.to_trimesh)."""
 
-import os
 import warnings
 
 import numpy as np
-import pytest
 import trimesh
+from helpers import real_model
 
 import meshvis
 
-REAL = "/work/shared/models/real"
-
-
-def _model(name):
-    path = os.path.join(REAL, name)
-    if not os.path.exists(path):
-        pytest.skip(f"{path} not available")
-    return path
-
 
 def test_a_textured_trimesh_comes_back_with_uvs_and_texture():
-    mesh = trimesh.load(_model("spot.obj"), process=False)
+    mesh = trimesh.load(real_model("spot.obj"), process=False)
     result = meshvis.orient(mesh)
     back = result.soup.to_trimesh()
     assert isinstance(back, trimesh.Trimesh)
@@ -45,7 +35,7 @@ def test_removal_keeps_face_colours_of_the_kept_faces():
 
 
 def test_a_scene_comes_back_as_a_scene_with_its_instancing():
-    scene = trimesh.load(_model("pins.glb"))
+    scene = trimesh.load(real_model("pins.glb"))
     soup = meshvis.as_soup(scene)
     one_dowel = soup.part_id == 2
     back = soup.flipped(one_dowel).to_trimesh()
@@ -60,7 +50,7 @@ def test_a_scene_comes_back_as_a_scene_with_its_instancing():
 
 
 def test_float32_input_gives_no_warnings():
-    mesh = trimesh.load(_model("spot.obj"), process=False)
+    mesh = trimesh.load(real_model("spot.obj"), process=False)
     vertices = np.asarray(mesh.vertices, np.float32)
     with warnings.catch_warnings():
         warnings.simplefilter("error")
@@ -70,6 +60,6 @@ def test_float32_input_gives_no_warnings():
 
 
 def test_a_soup_without_trimesh_source_gives_its_geometry():
-    soup = meshvis.load(_model("suzanne.obj"))
+    soup = meshvis.load(real_model("suzanne.obj"))
     mesh = soup.to_trimesh()
     assert np.array_equal(mesh.faces, soup.faces)

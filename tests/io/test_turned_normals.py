@@ -6,26 +6,16 @@ unturned faces keep theirs; a vertex shared by turned and unturned faces is copi
 Each test states the exact expected normal of every corner.
 """
 
-import json
 import os
-import struct
-import subprocess
 
 import numpy as np
 import pytest
+from helpers import real_model, validate_gltf, write_glb
 
 import meshvis
 from meshvis.io.gltf_edit import _EditState, read_container
 
-REAL = "/work/shared/models/real"
 HERE = os.path.dirname(__file__)
-
-
-def _model(name):
-    path = os.path.join(REAL, name)
-    if not os.path.exists(path):
-        pytest.skip(f"{path} not available")
-    return path
 
 
 def _newell(p):
@@ -77,7 +67,7 @@ def _turn(v, vn, corners, n_geo, turned):
 
 
 def test_obj_turned_faces_point_at_negated_normals(tmp_path):
-    src = _model("suzanne.obj")
+    src = real_model("suzanne.obj")
     soup = meshvis.load(src)
     flip = np.arange(soup.n_faces) % 3 == 0  # splits many quads: vertices shared by both kinds
     out = str(tmp_path / "suzanne.obj")
@@ -104,7 +94,7 @@ def test_obj_turned_faces_point_at_negated_normals(tmp_path):
 
 
 def test_obj_orient_of_broken_windings_with_right_normals_gives_the_original(tmp_path):
-    src = _model("suzanne.obj")
+    src = real_model("suzanne.obj")
     lines = open(src).read().splitlines()
     f_at = [i for i, ln in enumerate(lines) if ln.startswith("f ")]
     broken = list(lines)
@@ -141,7 +131,7 @@ def _ply_with_normals(path, ascii):
     """pyvista's ant with float vertex normals and a colour, binary or ASCII."""
     import trimesh
 
-    s = meshvis.load(_model("pyvista__ant.ply"))
+    s = meshvis.load(real_model("pyvista__ant.ply"))
     n, m = len(s.vertices), len(s.faces)
     vn = trimesh.Trimesh(s.vertices, s.faces, process=False).vertex_normals.astype("<f4")
     red = (np.arange(n) % 256).astype("u1")
@@ -245,19 +235,9 @@ def _turned_per_primitive(soup, flip):
     return {(int(p[0]), int(p[2])): flip[p[5] : e] for p, e in zip(pieces, ends)}
 
 
-def _write_glb(doc, blob, path):
-    js = json.dumps(doc).encode()
-    js += b" " * ((-len(js)) % 4)
-    blob += b"\x00" * ((-len(blob)) % 4)
-    with open(path, "wb") as fh:
-        fh.write(struct.pack("<4sII", b"glTF", 2, 28 + len(js) + len(blob)))
-        fh.write(struct.pack("<II", len(js), 0x4E4F534A) + js)
-        fh.write(struct.pack("<II", len(blob), 0x004E4942) + blob)
-
-
 def _truck_with_tangents(path):
     """The milk truck with a TANGENT on every primitive: xyz perpendicular to the normal, w = 1."""
-    doc, buffers, _ = read_container(_model("CesiumMilkTruck.glb"), "truck")
+    doc, buffers, _ = read_container(real_model("CesiumMilkTruck.glb"), "truck")
     state = _EditState(doc, [bytearray(b) for b in buffers], 0)
     blob = bytearray(buffers[0])
     for mesh in doc["meshes"]:
@@ -279,24 +259,7 @@ def _truck_with_tangents(path):
             )
             prim["attributes"]["TANGENT"] = len(doc["accessors"]) - 1
     doc["buffers"][0]["byteLength"] = len(blob)
-    _write_glb(doc, bytes(blob), path)
-
-
-def _validate(path):
-    import shutil
-
-    node = shutil.which("node")
-    root = os.environ.get("NODE_PATH") or os.path.join(HERE, "..", "..", ".tools", "gltf", "node_modules")
-    if not node or not os.path.isdir(os.path.join(root, "gltf-validator")):
-        pytest.skip("gltf-validator (npm) not installed; .ci/run installs it")
-    run = subprocess.run(
-        [node, os.path.join(HERE, "validate_gltf.js"), path],
-        capture_output=True,
-        text=True,
-        env={**os.environ, "NODE_PATH": root},
-        timeout=120,
-    )
-    return json.loads(run.stdout)
+    write_glb(doc, bytes(blob), path)
 
 
 def test_gltf_turned_faces_turn_normals_and_tangent_handedness(tmp_path):
@@ -326,11 +289,11 @@ def test_gltf_turned_faces_turn_normals_and_tangent_handedness(tmp_path):
         n_split += len(p1) - len(p0)
     assert n_split > 0
     assert len(doc["meshes"]) == 3  # the wheels' instances needed different changes
-    assert _validate(out)["errors"] == 0
+    assert validate_gltf(out)["errors"] == 0
 
 
 def test_gltf_orient_of_broken_windings_with_right_normals_restores_them(tmp_path):
-    src = _model("CesiumMilkTruck.glb")
+    src = real_model("CesiumMilkTruck.glb")
     doc, buffers, _ = read_container(src, "truck")
     blob = bytearray(buffers[0])
     state = _EditState(doc, [blob], 0)
@@ -342,7 +305,7 @@ def test_gltf_orient_of_broken_windings_with_right_normals_restores_them(tmp_pat
         at = doc["bufferViews"][acc["bufferView"]].get("byteOffset", 0) + acc.get("byteOffset", 0)
         blob[at : at + idx.nbytes] = idx.astype(idx.dtype.newbyteorder("<")).tobytes()
     bad = str(tmp_path / "broken.glb")
-    _write_glb(doc, bytes(blob), bad)
+    write_glb(doc, bytes(blob), bad)
     soup = meshvis.load(bad)
     broken = np.zeros(soup.n_faces, bool)
     for p, e in zip(soup.source.data.pieces, np.append(soup.source.data.pieces[1:, 5], soup.n_faces)):
@@ -368,7 +331,7 @@ def test_gltf_orient_of_broken_windings_with_right_normals_restores_them(tmp_pat
         assert np.array_equal(n1[f1], n0[f0] * sign)
         n_disagree += int((turned & ~agreed).sum())
     assert n_disagree < 0.01 * soup.n_faces
-    assert _validate(out)["errors"] == 0
+    assert validate_gltf(out)["errors"] == 0
 
 
 def test_obj_relative_normal_indices_resolve_and_stay_valid(tmp_path):

@@ -1,24 +1,14 @@
 """One up-axis rule for everything that draws: glTF y (its specification), OBJ y, others z."""
 
-import os
-
 import numpy as np
 import pytest
+from helpers import real_model
 
 import meshvis
 from meshvis.cli.main import main
 from meshvis.labeling import layout
 from meshvis.labeling.pipeline import fit_camera
 from meshvis.rays.camera import Camera, model_up, up_axis
-
-REAL = "/work/shared/models/real"
-
-
-def _model(name):
-    path = os.path.join(REAL, name)
-    if not os.path.exists(path):
-        pytest.skip(f"{path} not available")
-    return path
 
 
 @pytest.mark.parametrize(
@@ -44,7 +34,7 @@ def test_disagreeing_files_and_no_file_fall_back_to_z():
 
 
 def test_library_and_cli_agree_on_the_truck():
-    path = _model("CesiumMilkTruck.glb")
+    path = real_model("CesiumMilkTruck.glb")
     soup = meshvis.load(path)
     assert model_up(soup) == model_up(path) == (0.0, 1.0, 0.0)
     assert np.allclose(Camera.fit(soup).up, [0, 1, 0])
@@ -54,7 +44,7 @@ def test_library_and_cli_agree_on_the_truck():
 
 
 def test_teapot_is_drawn_y_up():
-    soup = meshvis.load(_model("teapot.obj"))
+    soup = meshvis.load(real_model("teapot.obj"))
     camera = Camera.fit(soup)
     assert np.allclose(camera.up, [0, 1, 0])
     # the camera looks at the teapot from above its horizon, not from its side

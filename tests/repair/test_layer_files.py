@@ -4,20 +4,12 @@ import os
 
 import numpy as np
 import pytest
+from helpers import real_model, validate_gltf
 
 import meshvis
 from meshvis.io.gltf_edit import read_container
 from meshvis.io.ply import read_elements
 from meshvis.repair.operation import layer_paths, run_operation
-
-REAL = "/work/shared/models/real"
-
-
-def _model(name):
-    path = os.path.join(REAL, name)
-    if not os.path.exists(path):
-        pytest.skip(f"{path} not available")
-    return path
 
 
 def _sorted_triangles(soup):
@@ -38,7 +30,7 @@ def _layers(report):
 
 @pytest.mark.parametrize("name", ["CesiumMilkTruck.glb", "pins.glb"])
 def test_gltf_layers_output_is_the_input_with_a_child_node_per_deeper_layer(name, tmp_path):
-    src = _model(name)
+    src = real_model(name)
     out = str(tmp_path / name)
     soup, report, notes = _run(src, out)
     layer = _layers(report)
@@ -68,32 +60,12 @@ def test_gltf_layers_output_is_the_input_with_a_child_node_per_deeper_layer(name
         assert np.array_equal(
             _sorted_triangles(back.subset(got == k)), _sorted_triangles(soup.subset(layer == k))
         )
-    assert _validate(out)["errors"] == 0
-
-
-def _validate(path):
-    import json
-    import shutil
-    import subprocess
-
-    here = os.path.join(os.path.dirname(__file__), "..", "io")
-    node = shutil.which("node")
-    root = os.environ.get("NODE_PATH") or os.path.join(here, "..", "..", ".tools", "gltf", "node_modules")
-    if not node or not os.path.isdir(os.path.join(root, "gltf-validator")):
-        pytest.skip("gltf-validator (npm) not installed; .ci/run installs it")
-    run = subprocess.run(
-        [node, os.path.join(here, "validate_gltf.js"), path],
-        capture_output=True,
-        text=True,
-        env={**os.environ, "NODE_PATH": root},
-        timeout=120,
-    )
-    return json.loads(run.stdout)
+    assert validate_gltf(out)["errors"] == 0
 
 
 @pytest.mark.parametrize("name", ["suzanne.obj", "spot.obj"])
 def test_obj_layer_files_keep_normals_uvs_and_groups(name, tmp_path):
-    src = _model(name)
+    src = real_model(name)
     out = str(tmp_path / name)
     soup, report, _ = _run(src, out)
     layer = _layers(report)
@@ -115,7 +87,7 @@ def test_obj_layer_files_keep_normals_uvs_and_groups(name, tmp_path):
 
 
 def test_ply_layers_output_is_the_input_with_a_layer_property(tmp_path):
-    src = _model("pyvista__ant.ply")
+    src = real_model("pyvista__ant.ply")
     out = str(tmp_path / "ant.ply")
     soup, report, notes = _run(src, out)
     assert "layer_files" not in report and not [n for n in notes if "written anew" in n]  # edited
