@@ -49,10 +49,11 @@ MIN_NEW_AREA_PER_MILLION = 1e-5
 #: the stop rule must hold twice: at the end of a window, and again on the first window of the
 #: next round, which gives the largest unseen faces 4 x the seed rays (the rest of the round,
 #: its smallest faces, is left out).  A round goes from large faces to small ones, so the rule
-#: first holds at a round's tail, while large faces seen through rare gaps have had only that
-#: round's seeds: on the so101 assembly the search with seed 0 stopped (the rule holding on one
-#: window) at 9.1 false pixels per million, 15 of its 21 missed visible faces 190 to 1,500 x
-#: the median face area after 256 seeds each; with seed 1 at 3.3 (docs/benchmarks.md)
+#: first holds part-way through a round, among its smaller faces, while large faces seen
+#: through rare gaps have had only that round's seeds: on the so101 assembly, the rule holding once, seed 0 stopped at 9.1 false
+#: pixels per million (16 of its 21 missed visible faces 165 to 1,504 x the median face area,
+#: after 256 seeds each) and seed 3 at 43.3; holding twice, seeds 0 to 3 end at 2.0 to 2.5
+#: with 1.03 to 1.41 x the rays (docs/benchmarks.md, "Seed spread of the default search")
 CONFIRM_NEXT_ROUND = True
 #: the stop rule is judged over at least this many rays (GVS counts new faces per million
 #: rays) or, on small models, this many rays per face, whichever is fewer
