@@ -66,8 +66,9 @@ CURVE_RANDOM_FACTOR = 4
 CONVERGED_MIN_NEW = 5.0
 CONVERGED_MIN_NEW_AREA = 1e-5
 #: converged searches (seeds seed+1 .. seed+K) whose sightings, with the reference's, make
-#: the estimate of the truly hidden area (:func:`unseen_by_all`); 3 costs about 3 minutes on
-#: the largest scene and the shares change by a point or less from 2 to 3 (docs/benchmarks.md)
+#: the estimate of the truly hidden area (:func:`unseen_by_all`): the three take 7 minutes on
+#: the largest scene (so101) and about 1.5 on the monastery, and from K = 2 to 3 the share
+#: ``view`` removes rises by 0.02 to 2 points (docs/benchmarks.md)
 SEARCHES = 3
 #: the methods whose share of the area no search saw is reported for every K = 1 .. SEARCHES
 BY_K_METHODS = ("object (graph cut)", "view (guided, outside)", "both")
