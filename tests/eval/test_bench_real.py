@@ -33,5 +33,12 @@ def test_bench_real_judges_every_method_on_a_small_model(tmp_path, capsys):
         assert 0 <= row["removed_area"] <= 1 and row["false_pixels_worst"] >= row["false_pixels_mean"] >= 0
     ref = r["rows"][0]
     assert ref["reference_hidden_removed"] == 1.0
+    # what no search saw shrinks with every search added; the reference and the first
+    # converged search each removed all of it (they saw none of it)
+    assert r["searches"] == 3 and len(r["converged_rays"]) == 3
+    assert r["unseen_area"] == sorted(r["unseen_area"], reverse=True)
+    assert ref["unseen_removed"] == 1.0 and r["rows"][4]["unseen_removed"] == 1.0
+    for shares in r["unseen_removed_by_k"].values():
+        assert len(shares) == 3 and all(0 <= x <= 1 for x in shares)
     assert curve.stat().st_size > 1000 and (tmp_path / "nested.seed0.npz").is_file()
     assert "nested" in capsys.readouterr().out

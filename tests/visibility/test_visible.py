@@ -170,3 +170,28 @@ def test_later_rounds_seed_the_largest_unseen_faces_first():
     rng = np.random.default_rng(0)
     assert _round_order(state, rng, np.array([True, True]), 1).tolist() == [1, 0]
     assert _round_order(state, rng, np.array([True, False]), 1).tolist() == [0]
+
+
+def test_the_stop_rule_is_confirmed_on_the_next_rounds_largest_faces(monkeypatch):
+    import trimesh
+
+    from meshvis.visibility import visible
+
+    # a ball of 80 faces sealed in a cube: the ball is never seen, so the stop rule ends the
+    # search, and it holds first in the round of 256 seeds per face (not the last round)
+    cube, ball = trimesh.creation.box(extents=(2, 2, 2)), trimesh.creation.icosphere(1, radius=0.5)
+    soup = meshvis.as_soup(trimesh.util.concatenate([cube, ball]))
+    inner = np.arange(12, soup.n_faces)
+    once = {}
+    for confirm in (False, True):
+        monkeypatch.setattr(visible, "CONFIRM_NEXT_ROUND", confirm)
+        once[confirm] = visible_from(soup, seed=3)
+    first, confirmed = once[False], once[True]
+    assert first.stopped in ("few new faces", "little new area") and confirmed.stopped == first.stopped
+    assert (first.seed_rays[inner] < sum(visible.SEED_ROUNDS)).all()
+    # the confirmed search is the first one and then the next round's first window
+    assert confirmed.rays["total"] > first.rays["total"]
+    assert (confirmed.seed_rays[inner] > first.seed_rays[inner]).all()
+    seen = first.first_seen >= 0
+    np.testing.assert_array_equal(confirmed.first_seen[seen], first.first_seen[seen])
+    assert confirmed.seen[:12].all() and not confirmed.seen[inner].any()
