@@ -317,7 +317,8 @@ def classify(
     stages: list[Stage] = []
     report = progress or (lambda stage, frac: None)
     caster = _scene(soup, caster, offset, stages, report)
-    pre = _preprocess(soup, stages, report)
+    # the scene's vertex groups are the weld's first step (unless the caller's caster is of another soup)
+    pre = _preprocess(soup, caster.vertex_groups if caster.soup is soup else None, stages, report)
     nodes = _nodes(soup, pre, caster, samples_per_face, sampling_scheme, stages)
     hint_out, hint_in, hint_rays = _hints(caster, nodes, hints, rng, stages)
     loop = _Sampling(
@@ -370,11 +371,13 @@ def _scene(
     return caster
 
 
-def _preprocess(soup: Soup, stages: list[Stage], report) -> Preprocessed:
+def _preprocess(soup: Soup, vertex_groups, stages: list[Stage], report) -> Preprocessed:
     """Flags and clusters (appendix H §2); every face degenerate is a :class:`ModelError`."""
     t = time.perf_counter()
     report("preprocess", 0.0)
-    pre = preprocess(soup, progress=lambda stage, frac: report("preprocess", frac))
+    pre = preprocess(
+        soup, progress=lambda stage, frac: report("preprocess", frac), vertex_groups=vertex_groups
+    )
     if pre.degenerate.all():  # no side has an area: there is no graph to cut
         what = "the only face is" if soup.n_faces == 1 else f"all {soup.n_faces} faces are"
         raise ModelError(f"{what} degenerate (zero area): nothing to classify", soup.path)
