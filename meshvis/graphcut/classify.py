@@ -446,6 +446,7 @@ class _Sampling:
         give = ray_allocation(nodes, min(FIRST_ROUND_RAYS, rays_per_node) if progressive else rays_per_node)
         prev = prev_nodes = None
         while True:
+            t_sample, t_cut = self.t_sample, self.t_cut
             self._sample(give, cast, budget)
             cast += give
             self._cut()
@@ -456,6 +457,8 @@ class _Sampling:
                     "nodes_sampled": int((give > 0).sum()),
                     "edges": self.graph.n_edges,
                     "changed_area_fraction": changed,
+                    "sampling_seconds": self.t_sample - t_sample,
+                    "cut_seconds": self.t_cut - t_cut,
                 }
             )
             if not progressive:

@@ -48,6 +48,20 @@ def default_threads() -> int:
     return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
 
 
+def _used_bounds(soup, firsts: np.ndarray) -> np.ndarray:
+    """(2, 3) :attr:`Soup.bounds <meshvis.soup.Soup.bounds>`, from one vertex of each group.
+
+    A soup's groups are several times fewer than its corners.  The minimum and maximum are
+    the same numbers whatever the rows, except a zero extreme, whose sign bit depends on
+    the order of the reduction: then the soup's own bounds are used, so that the scene's
+    centre has exactly the bits it always had.
+    """
+    lo, hi = firsts.min(axis=0), firsts.max(axis=0)
+    if (lo == 0).any() or (hi == 0).any():
+        return soup.bounds
+    return np.stack([lo, hi])
+
+
 @dataclass
 class Hits:
     """First hits of a batch of rays, in input coordinates.
@@ -121,18 +135,19 @@ class RayCaster:
         self.soup = soup
         self.offset = _validate.real("offset", offset, 0.0, 0.1)
         self.threads = default_threads() if threads is None else _validate.integer("threads", threads, 1)
-        lo, hi = soup.bounds
+        groups = vertex_groups if vertex_groups is not None else group_vertices(soup.vertices, soup.faces)
+        #: the bit-identical vertex groups of the model (the scene's vertex buffer)
+        self.vertex_groups = groups
+        firsts = soup.vertices[groups.first]
+        lo, hi = _used_bounds(soup, firsts)
         self.center = 0.5 * (lo + hi)
-        diag = soup.diagonal
+        diag = float(np.linalg.norm(hi - lo))  # the arithmetic of Soup.diagonal
         # a model that is a single point (all faces degenerate) still gets a usable scale
         self.scale = 1.0 / diag if diag > 0 else 1.0
         self.diagonal = diag if diag > 0 else 1.0
         self.part_id = soup.part_id
-        groups = vertex_groups if vertex_groups is not None else group_vertices(soup.vertices, soup.faces)
-        #: the bit-identical vertex groups of the model (the scene's vertex buffer)
-        self.vertex_groups = groups
         # one vertex per group; a group's vertices have the same bits, so the same float32
-        v32 = ((soup.vertices[groups.first] - self.center) * self.scale).astype(np.float32)
+        v32 = ((firsts - self.center) * self.scale).astype(np.float32)
         # an extent beyond the float64 range (infinite diagonal) gives NaN: clamp it harmlessly
         v32[~np.isfinite(v32).all(axis=1)] = 0
         corners = groups.corner_groups(soup.faces, soup.n_vertices).astype(np.int32, copy=False)
