@@ -2,7 +2,8 @@
 
 Pipeline (DESIGN.md §4)::
 
-    soup → preprocess (flags, welding, clusters) → half-space nodes → visibility sampling
+    soup → vertex groups → Embree scene → preprocess (flags, welding, clusters)
+         → half-space nodes → visibility sampling
          → weights (Eq. 5–9) → s-t min cut → per-(face, side) labels
 
 Sampling is *progressive*: rays are cast in rounds and the loop stops as soon as a round
@@ -29,6 +30,7 @@ import numpy as np
 from meshvis import _validate
 from meshvis._version import __version__
 from meshvis.errors import ModelError, ParameterError
+from meshvis.geometry.adjacency import VertexGroups, group_vertices
 from meshvis.graphcut.hints import Hints, hint_weights
 from meshvis.graphcut.mincut import SOLVERS, Cut, VisibilityGraph
 from meshvis.graphcut.nodes import NodeSet, build_nodes
@@ -316,9 +318,9 @@ def classify(
     rng = np.random.default_rng(seed)
     stages: list[Stage] = []
     report = progress or (lambda stage, frac: None)
-    caster = _scene(soup, caster, offset, stages, report)
-    # the scene's vertex groups are the weld's first step (unless the caller's caster is of another soup)
-    pre = _preprocess(soup, caster.vertex_groups if caster.soup is soup else None, stages, report)
+    groups = _vertex_groups(soup, caster, stages)
+    caster = _scene(soup, caster, offset, groups, stages, report)
+    pre = _preprocess(soup, groups, stages, report)
     nodes = _nodes(soup, pre, caster, samples_per_face, sampling_scheme, stages)
     hint_out, hint_in, hint_rays = _hints(caster, nodes, hints, rng, stages)
     loop = _Sampling(
@@ -359,14 +361,32 @@ def classify(
 
 
 # ---------------------------------------------------------------------- the stages of classify
+def _vertex_groups(soup: Soup, caster: RayCaster | None, stages: list[Stage]) -> VertexGroups:
+    """The bit-identical vertex groups: the scene's vertex buffer and the weld's first step."""
+    if caster is not None and caster.soup is soup:
+        stages.append(Stage("groups", False, 0.0, "vertex groups of the given caster"))
+        return caster.vertex_groups
+    t = time.perf_counter()
+    groups = group_vertices(soup.vertices, soup.faces)
+    note = f"{len(groups.first)} distinct of {len(groups.used)} used vertices"
+    stages.append(Stage("groups", True, time.perf_counter() - t, note))
+    return groups
+
+
 def _scene(
-    soup: Soup, caster: RayCaster | None, offset: float | None, stages: list[Stage], report
+    soup: Soup,
+    caster: RayCaster | None,
+    offset: float | None,
+    groups: VertexGroups,
+    stages: list[Stage],
+    report,
 ) -> RayCaster:
-    """The Embree scene (or the caller's prebuilt one)."""
+    """The Embree scene on the vertex groups (or the caller's prebuilt one)."""
     t = time.perf_counter()
     report("scene", 0.0)
     if caster is None:
-        caster = RayCaster(soup) if offset is None else RayCaster(soup, offset=offset)
+        kw = {} if offset is None else {"offset": offset}
+        caster = RayCaster(soup, vertex_groups=groups, **kw)
     stages.append(Stage("scene", True, time.perf_counter() - t, "Embree scene on the normalised copy"))
     return caster
 

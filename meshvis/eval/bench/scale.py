@@ -183,7 +183,7 @@ def _run_one(spec: str, seed: int, tmp: str) -> dict:
 
 def format(results: list[dict], header: bool = True) -> str:
     """A table: faces, seconds, growth per 4x faces, peak memory, stage times, scene/raw."""
-    stages = ("scene", "preprocess", "nodes", "sampling", "cut")
+    stages = ("groups", "scene", "preprocess", "nodes", "sampling", "cut")
     lines = []
     if header:
         lines.append(
