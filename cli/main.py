@@ -30,11 +30,18 @@ COMMANDS = {
 }
 
 
-def build_parser() -> argparse.ArgumentParser:
+def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """Build the ``meshvis`` argument parser with one subcommand per module of :data:`COMMANDS`.
 
     Every subcommand module adds its parser through its ``add_parser(subparsers)``; a module
     that is not there at all is left out, so the other commands still work.
+
+    Parameters
+    ----------
+    command : str, optional
+        A name of :data:`COMMANDS`: add only the parser of its module (importing every
+        module, labeling and the benchmarks included, takes about half a second, which a
+        command that runs in seconds should not pay).  Default: every command.
 
     Returns
     -------
@@ -57,7 +64,7 @@ def build_parser() -> argparse.ArgumentParser:
     sub = parser.add_subparsers(dest="command", metavar="COMMAND")
     seen = set()
     for name, module in COMMANDS.items():
-        if module in seen:
+        if module in seen or (command is not None and name != command):
             continue
         try:
             mod = importlib.import_module(module)
@@ -96,7 +103,9 @@ def main(argv: list[str] | None = None) -> int:
     """
     from meshvis.errors import MeshvisError
 
-    parser = build_parser()
+    argv = sys.argv[1:] if argv is None else list(argv)
+    # the top level has only -h and --version, so a command is the first argument
+    parser = build_parser(argv[0] if argv and argv[0] in COMMANDS else None)
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()

@@ -428,8 +428,13 @@ def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -
         if np.abs(faces).max() >= 2**62:
             raise ModelError("face indices are out of range", path)
         faces = faces.astype(np.int64)
-    bad = ~np.isfinite(vertices).all(axis=1)
-    if bad.any():
+    from meshvis import limits
+
+    # one pass for the common case: every vertex finite and within the cap (NaN fails <=;
+    # a Python float, so no float32 overflow)
+    small = vertices.size == 0 or float(np.abs(vertices).max()) <= limits.MAX_COORDINATE
+    bad = None if small else ~np.isfinite(vertices).all(axis=1)
+    if bad is not None and bad.any():
         used_bad = np.intersect1d(np.flatnonzero(bad), faces.ravel())
         if len(used_bad):
             what = "vertex used by a face has" if len(used_bad) == 1 else "vertices used by faces have"
@@ -442,11 +447,11 @@ def validate(vertices: np.ndarray, faces: np.ndarray, path: str | None = None) -
         raise ModelError(f"negative vertex index {lo} in the faces", path)
     if hi >= len(vertices):
         raise ModelError(f"vertex index {hi} is out of range (the model has {len(vertices)} vertices)", path)
+    if small:  # the used vertices are within the cap too
+        return
     mask = np.zeros(len(vertices), bool)
     mask[faces.ravel().astype(np.intp, copy=False)] = True
     used = vertices[mask]
-    from meshvis import limits
-
     if float(np.abs(used).max()) > limits.MAX_COORDINATE:  # a Python float: no float32 overflow
         raise ModelError(
             f"coordinates too large to compute with (above {limits.MAX_COORDINATE:g}, the cap of meshvis.limits)",

@@ -52,30 +52,119 @@ def _diagonal(vertices: np.ndarray, faces: np.ndarray) -> float:
     return float(np.linalg.norm(hi - lo))
 
 
+@dataclass(frozen=True)
+class VertexGroups:
+    """The used vertices of a soup grouped by bit-identical coordinates.
+
+    Computed once per model (:func:`group_vertices`) and shared by the Embree scene, whose
+    vertex buffer holds one vertex per group (every corner keeps its exact float32
+    coordinates), and by :func:`weld`, which merges the groups further (``-0.0`` with
+    ``0.0``, then within the weld tolerance).
+
+    Attributes
+    ----------
+    used : (k,) int64 array
+        Sorted ids of the vertices some face uses.
+    group : (k,) int64 array
+        Group of each used vertex, numbered by first occurrence.
+    first : (g,) int64 array
+        Vertex id of the first vertex of each group.
+    """
+
+    used: np.ndarray
+    group: np.ndarray
+    first: np.ndarray
+
+    def corner_groups(self, faces: np.ndarray, n_vertices: int) -> np.ndarray:
+        """(m, 3) int32 or int64: the group of every corner of ``faces``."""
+        dtype = np.int32 if len(self.first) < 2**31 else np.int64
+        of_vertex = np.zeros(n_vertices, dtype)
+        of_vertex[self.used] = self.group
+        return of_vertex[np.asarray(faces)]
+
+
+def _hash_rows(bits: np.ndarray) -> np.ndarray:
+    """(n,) uint64 hash of the (n, 3) uint64 rows (splitmix64 over the three words)."""
+    return _mix(_mix(_mix(bits[:, 0] + _MIX[2]) ^ bits[:, 1]) ^ bits[:, 2])
+
+
+def group_vertices(vertices: np.ndarray, faces: np.ndarray) -> VertexGroups:
+    """Group the used vertices whose float64 coordinates are identical bit for bit.
+
+    Equal rows are found through a hash table on a 64-bit hash of their bits (a numba
+    kernel, rows compared in full, so a collision costs a probe, never a wrong group).
+
+    Parameters
+    ----------
+    vertices : (n, 3) float array
+        Vertex coordinates.
+    faces : (m, 3) int array
+        Vertex indices of each triangle.
+
+    Returns
+    -------
+    VertexGroups
+        The groups; ``-0.0`` and ``0.0`` are different bits, so different groups.
+
+    Examples
+    --------
+    >>> v = np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [1, 0, 0]], float)
+    >>> g = group_vertices(v, np.array([[0, 1, 2], [3, 2, 1]]))
+    >>> g.group.tolist(), g.first.tolist()
+    ([0, 1, 2, 1], [0, 1, 2])
+    """
+    from meshvis.geometry._kernels import exact_groups
+
+    vertices = np.asarray(vertices, np.float64)
+    used = used_vertices(faces, len(vertices))
+    bits = np.ascontiguousarray(vertices[used]).view(np.uint64)
+    group, first_row = exact_groups(bits, _hash_rows(bits))
+    return VertexGroups(used, group, used[first_row])
+
+
+def _lex_rank(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Distinct rows ``pts`` in lexicographic order, and the rank of each input row."""
+    lex = np.lexsort((pts[:, 2], pts[:, 1], pts[:, 0]))
+    rank = np.empty(len(pts), np.int64)
+    rank[lex] = np.arange(len(pts))
+    return pts[lex], rank
+
+
 def _exact_groups(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Distinct rows of ``pts`` in lexicographic order, and the row of each input point.
 
     The same answer as ``np.unique(pts, axis=0, return_inverse=True)``, about 10x faster:
-    equal points are grouped through a hash table on a 64-bit hash of their bits (a numba
-    kernel, rows compared in full), and only the distinct points are sorted
-    lexicographically.  The points must not hold ``-0.0`` (add ``0.0`` first) or NaN.
+    equal points are grouped by the hash table of :func:`group_vertices`, and only the
+    distinct points are sorted lexicographically.  The points must not hold ``-0.0`` (add
+    ``0.0`` first) or NaN.
     """
     from meshvis.geometry._kernels import exact_groups
 
     bits = np.ascontiguousarray(pts, np.float64).view(np.uint64)
-    h = _mix(_mix(_mix(bits[:, 0] + _MIX[2]) ^ bits[:, 1]) ^ bits[:, 2])
-    group, first_row = exact_groups(bits, h)
-    first = pts[first_row]
-    lex = np.lexsort((first[:, 2], first[:, 1], first[:, 0]))
-    rank = np.empty(len(first), np.int64)
-    rank[lex] = np.arange(len(first))
-    return first[lex], rank[group]
+    group, first_row = exact_groups(bits, _hash_rows(bits))
+    uniq, rank = _lex_rank(pts[first_row])
+    return uniq, rank[group]
 
 
-def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tuple[np.ndarray, np.ndarray]:
+def _distinct_points(vertices: np.ndarray, groups: VertexGroups) -> tuple[np.ndarray, np.ndarray]:
+    """Distinct used points up to the sign of zero, lexicographic, and the one of each group."""
+    # + 0.0 turns -0.0 into 0.0 so that both weld exactly
+    firsts = vertices[groups.first]
+    pts = firsts + 0.0
+    if np.signbit(firsts[pts == 0]).any():
+        return _exact_groups(pts)  # some groups differ only in the sign of a zero: merge them
+    return _lex_rank(pts)  # the groups are the distinct points already
+
+
+def weld(
+    vertices: np.ndarray,
+    faces: np.ndarray,
+    tol: float = WELD_TOL,
+    vertex_groups: VertexGroups | None = None,
+) -> tuple[np.ndarray, np.ndarray]:
     """Merge vertices that lie closer than ``tol`` times the bounding-box diagonal.
 
-    Exact duplicates are merged first (grouped by a hash of the coordinates); the remaining
+    Exact duplicates are merged first (the groups of :func:`group_vertices`); the remaining
     distinct points are paired with a k-d tree (``cKDTree.query_pairs``) and merged by
     connected components, so a chain of points each within ``tol`` of the next becomes one
     vertex (harmless at the tiny default tolerance).
@@ -89,6 +178,8 @@ def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tupl
     tol : float
         Weld distance as a fraction of the diagonal of the used vertices' bounding box
         (default :data:`WELD_TOL` = 1e-7).  ``0`` merges exact duplicates only.
+    vertex_groups : VertexGroups, optional
+        :func:`group_vertices` of the same arrays, when the caller has them already.
 
     Returns
     -------
@@ -110,10 +201,8 @@ def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tupl
     index = np.full(len(vertices), -1, np.int64)
     if len(faces) == 0:
         return index, faces.copy()
-    used = used_vertices(faces, len(vertices))
-    # + 0.0 turns -0.0 into 0.0 so that both weld exactly
-    pts = vertices[used] + 0.0
-    uniq, inverse = _exact_groups(pts)
+    groups = vertex_groups if vertex_groups is not None else group_vertices(vertices, faces)
+    uniq, of_group = _distinct_points(vertices, groups)
     label = np.arange(len(uniq))
     radius = tol * _diagonal(vertices, faces)
     if radius > 0 and len(uniq) > 1:
@@ -125,7 +214,7 @@ def weld(vertices: np.ndarray, faces: np.ndarray, tol: float = WELD_TOL) -> tupl
                 (np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(len(uniq), len(uniq))
             )
             _, label = connected_components(g, directed=False)
-    index[used] = label[inverse]
+    index[groups.used] = label[of_group][groups.group]
     return index, index[faces]
 
 

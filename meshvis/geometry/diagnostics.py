@@ -75,6 +75,7 @@ def analyse(
     weld_tol: float = adjacency.WELD_TOL,
     intersections: bool = True,
     progress: Progress | None = None,
+    vertex_groups: adjacency.VertexGroups | None = None,
 ) -> Analysis:
     """Weld, edges, degenerate, duplicate and intersecting faces of a soup, in one pass.
 
@@ -90,6 +91,9 @@ def analyse(
         Run the intersection / coplanarity tests (the slowest step).
     progress : callable, optional
         ``progress(stage, fraction)``, called between the steps.
+    vertex_groups : VertexGroups, optional
+        :func:`adjacency.group_vertices` of the soup, when the caller has them (the
+        classification's Embree scene is built on them).
 
     Returns
     -------
@@ -108,7 +112,7 @@ def analyse(
 
     report("analyse", 0.0)
     v, f = soup.vertices, soup.faces
-    _, fw = adjacency.weld(v, f, weld_tol)
+    _, fw = adjacency.weld(v, f, weld_tol, vertex_groups)
     lap("weld", 0.15)
     table = adjacency.edges(fw)
     lap("edges", 0.25)

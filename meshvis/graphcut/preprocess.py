@@ -12,7 +12,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from meshvis.geometry.adjacency import WELD_TOL
+from meshvis.geometry.adjacency import WELD_TOL, VertexGroups
 from meshvis.geometry.diagnostics import DEGENERATE_TOL, Analysis, analyse
 from meshvis.graphcut.clusters import Clustering, cluster_sides
 from meshvis.soup import Soup
@@ -53,6 +53,7 @@ def preprocess(
     eps: float | None = None,
     weld_tol: float = WELD_TOL,
     progress: Callable[[str, float], None] | None = None,
+    vertex_groups: VertexGroups | None = None,
 ) -> Preprocessed:
     """Flag difficult faces and cluster the others (appendix H §2).
 
@@ -65,12 +66,15 @@ def preprocess(
         Weld tolerance for adjacency (fraction of the diagonal).
     progress : callable, optional
         ``progress(stage, fraction)`` of the analysis pass.
+    vertex_groups : VertexGroups, optional
+        The soup's bit-identical vertex groups, when the caller has them (the Embree
+        scene's, :attr:`meshvis.rays.caster.RayCaster.vertex_groups`).
 
     Returns
     -------
     Preprocessed
     """
-    analysis = analyse(soup, eps=eps, weld_tol=weld_tol, progress=progress)
+    analysis = analyse(soup, eps=eps, weld_tol=weld_tol, progress=progress, vertex_groups=vertex_groups)
     flags, faces_welded, degenerate = analysis.flags, analysis.faces_welded, analysis.degenerate
     assert flags is not None  # analyse() tests intersections unless told not to
     flagged = (flags["intersects"] | flags["coplanar"]) & ~degenerate

@@ -1,6 +1,8 @@
 """Outputs of the repair commands: --removed when nothing is removed."""
 
 import json
+import subprocess
+import sys
 
 import trimesh
 
@@ -21,3 +23,17 @@ def test_removed_with_nothing_removed_writes_no_file_and_exits_0(tmp_path, capsy
     assert load(str(out)).n_faces == len(sphere.faces)
     assert not removed.exists()
     assert f"nothing was removed: {removed} not written" in capsys.readouterr().out
+
+
+def test_a_command_builds_only_its_own_parser(tmp_path):
+    # the labeling and benchmark parsers import their libraries; `info` needs neither
+    code = (
+        "import sys, trimesh; from meshvis.cli.main import main, build_parser;"
+        f"trimesh.creation.box().export({str(tmp_path / 'box.stl')!r});"
+        f"status = main(['info', {str(tmp_path / 'box.stl')!r}]);"
+        "print(status, 'meshvis.labeling' in sys.modules, 'meshvis.eval.bench.real_models' in sys.modules);"
+        "names = build_parser()._subparsers._group_actions[0].choices; print(sorted(names) == sorted("
+        "__import__('meshvis.cli.main', fromlist=['COMMANDS']).COMMANDS))"
+    )
+    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
+    assert out.splitlines()[-2:] == ["0 False False", "True"]

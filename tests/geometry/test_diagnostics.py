@@ -38,6 +38,31 @@ def test_weld_merges_within_tolerance_only():
     assert index0[0] != index0[3] and index0[2] == index0[5]
 
 
+def test_vertex_groups_are_bit_identical_rows():
+    v = np.array([[0, 0, 0], [1, 0, 0], [-0.0, 0, 0], [1, 0, 0], [5, 5, 5], [0, 0, 0]])
+    f = np.array([[0, 1, 2], [3, 5, 1]])
+    g = adjacency.group_vertices(v, f)
+    assert g.used.tolist() == [0, 1, 2, 3, 5]  # vertex 4 unused
+    assert g.group.tolist() == [0, 1, 2, 1, 0]  # -0.0 is other bits than 0.0
+    assert g.first.tolist() == [0, 1, 2]
+    assert g.corner_groups(f, len(v)).tolist() == [[0, 1, 2], [1, 0, 1]]
+
+
+def test_weld_on_given_groups_is_weld_of_unique_points():
+    rng = np.random.default_rng(3)
+    pool = rng.integers(-2, 3, (40, 3)).astype(float) * 0.5
+    pool[rng.random(pool.shape) < 0.2] *= -1  # zeros of both signs
+    v = pool[rng.integers(0, 40, 300)]
+    f = rng.permutation(300)[:297].reshape(-1, 3)
+    groups = adjacency.group_vertices(v, f)
+    index, fw = adjacency.weld(v, f, tol=0.0, vertex_groups=groups)
+    # the reference: np.unique of the used points with -0.0 made 0.0
+    used = np.unique(f)
+    _, inverse = np.unique(v[used] + 0.0, axis=0, return_inverse=True)
+    assert np.array_equal(index[used], inverse.ravel())
+    assert np.array_equal(adjacency.weld(v, f, tol=0.0)[1], fw)
+
+
 def test_weld_is_scale_invariant():
     v, f = cube_soup()
     v = v + np.random.default_rng(0).normal(scale=1e-9, size=v.shape)  # float noise

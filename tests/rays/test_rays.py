@@ -120,3 +120,27 @@ def test_part_ids():
     rc = RayCaster(s)
     h = rc.intersect(np.array([[0, 0, 5.0], [5, 0, 5.0], [20, 0, 5.0]]), np.array([[0, 0, -1.0]] * 3))
     assert rc.part_of(h.face).tolist() == [0, 1, -1]
+
+
+def test_scene_on_distinct_vertices_gives_the_hits_of_the_full_buffer():
+    import embreex.mesh_construction as mc
+    import embreex.rtcore_scene as rs
+
+    m = trimesh.creation.icosphere(3)
+    corners = m.vertices[m.faces].reshape(-1, 3)  # every face its own corners
+    corners[np.isclose(corners, 0)] *= -1.0  # and some zeros negative
+    v = np.vstack([corners, [[np.nan, 0, 0], [1e30, 1e30, 1e30]]])  # unused vertices
+    s = Soup(v, np.arange(len(corners)).reshape(-1, 3))
+    rc = RayCaster(s)
+    # the scene of the whole vertex buffer, as float32 of the same normalised copy
+    v32 = ((s.vertices - rc.center) * rc.scale).astype(np.float32)
+    v32[~np.isfinite(v32).all(axis=1)] = 0
+    full = rs.EmbreeScene()
+    mc.TriangleMesh(full, v32, s.faces.astype(np.int32))
+    rng = np.random.default_rng(5)
+    d = uniform_sphere(20_000, rng).astype(np.float32)
+    o = rng.uniform(-0.6, 0.6, (20_000, 3)).astype(np.float32)
+    a, b = rc._scene.run(o, d, output=1), full.run(o, d, output=1)
+    for key in ("primID", "tfar", "u", "v", "Ng"):
+        assert np.array_equal(a[key], b[key])
+    assert len(rc.vertex_groups.first) < len(corners)

@@ -4,7 +4,7 @@ The generated models are an icosphere subdivided ``5 .. 9`` times (20,480 .. 5,2
 4x per step), made into a soup by :func:`meshvis.eval.generators.soupify` (30 % of the faces
 turned over, every face its own corners, shuffled).  Real models are the largest of
 ``shared/models/real`` and ``real2`` (or the paths given).  Every size runs in a fresh
-subprocess so that the peak memory (``ru_maxrss`` of the child) is that of one
+subprocess so that the peak memory (:func:`peak_mb` of the child) is that of one
 classification alone, loading included.  Next to the scene stage the same triangles are
 put into a raw ``embreex`` scene (one empty query forces the BVH build), in the same
 process, so the ratio is measured side by side on a shared machine.
@@ -73,10 +73,28 @@ def raw_embree_seconds(soup) -> float:
     return time.perf_counter() - t
 
 
-def one(spec: str, seed: int) -> dict:
-    """Load/generate one model, classify it, and measure (run inside the child process)."""
+def peak_mb() -> float:
+    """Peak resident memory of this process, in MB.
+
+    ``VmHWM`` of ``/proc/self/status`` where there is one: Linux carries the parent's
+    resident size at the fork into the child's ``ru_maxrss`` across the ``exec``, so a child
+    started by a parent that had just built a 5 M-face soup reported the parent's peak.
+    ``VmHWM`` belongs to the child's own address space.  Elsewhere ``ru_maxrss``.
+    """
     import resource
 
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def one(spec: str, seed: int) -> dict:
+    """Load/generate one model, classify it, and measure (run inside the child process)."""
     from meshvis.graphcut.classify import classify
     from meshvis.io import load
 
@@ -94,7 +112,7 @@ def one(spec: str, seed: int) -> dict:
     t = time.perf_counter()
     c = classify(soup, seed=seed)
     total = time.perf_counter() - t
-    peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    peak = peak_mb()
     raw = raw_embree_seconds(soup)
     # the counts `meshvis info` prints must be the classification's (one shared pass)
     from meshvis.geometry.diagnostics import diagnose
@@ -165,7 +183,7 @@ def _run_one(spec: str, seed: int, tmp: str) -> dict:
 
 def format(results: list[dict], header: bool = True) -> str:
     """A table: faces, seconds, growth per 4x faces, peak memory, stage times, scene/raw."""
-    stages = ("scene", "preprocess", "nodes", "sampling", "cut")
+    stages = ("groups", "scene", "preprocess", "nodes", "sampling", "cut")
     lines = []
     if header:
         lines.append(

@@ -10,7 +10,9 @@ and ``compare`` with the new one (the file runs under any checkout's ``meshvis``
 ``compare`` prints one line per model with the faces that lost (``-``) or gained (``+``)
 each flag, and exits with status 1 when any face lost one.  ``snapshot --labels`` also
 stores the labels of ``classify(model, seed=0)``; ``compare`` then reports the faces whose
-labels differ (``labels =`` when none does).
+labels differ (``labels =`` when none does).  The folder name ``accuracy`` stands for the
+soups of the accuracy benchmark (:data:`meshvis.eval.bench.cases.CASES`, built from the real
+models' folder ``../shared/models/real``), stored as ``case:<name>``.
 """
 
 from __future__ import annotations
@@ -34,37 +36,59 @@ def model_files(folders: list[str]) -> list[Path]:
     )
 
 
+#: the folder name that stands for the accuracy benchmark's cases
+ACCURACY = "accuracy"
+
+
+def model_specs(folders: list[str]) -> list[tuple[str, str]]:
+    """(name, spec) of every model: a file path, or ``case:<name>`` for an accuracy case."""
+    from meshvis.eval.bench.cases import CASES
+
+    files = model_files([f for f in folders if f != ACCURACY])
+    cases = [(f"case_{n}", f"case:{n}") for n in CASES] if ACCURACY in folders else []
+    return [(p.name, str(p)) for p in files] + cases
+
+
+def load_spec(spec: str):
+    """The soup of a spec of :func:`model_specs` (an accuracy case built on its seed)."""
+    from meshvis.eval.bench.cases import CASES, load_case
+    from meshvis.io import load
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        if spec.startswith("case:"):
+            truth, note = load_case(CASES[spec[5:]])  # real cases from DEFAULT_MODELS
+            if truth is None:
+                raise FileNotFoundError(note)
+            return truth.soup
+        return load(spec)
+
+
 def snapshot(out: str, folders: list[str], labels: bool = False) -> None:
     """Write the flags (and the labels) of every model of ``folders`` to ``out/<name>.npz``."""
     from meshvis.geometry.intersect import intersection_flags
     from meshvis.graphcut.classify import classify
-    from meshvis.io import load
 
     os.makedirs(out, exist_ok=True)
-    for path in model_files(folders):
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            soup = load(path)
+    for name, spec in model_specs(folders):
+        soup = load_spec(spec)
         flags = intersection_flags(soup.vertices, soup.faces)
         extra = {"outside": classify(soup, seed=0).outside} if labels else {}
         np.savez_compressed(
-            os.path.join(out, path.name + ".npz"), path=str(path), **{k: flags[k] for k in FLAGS}, **extra
+            os.path.join(out, name + ".npz"), path=spec, **{k: flags[k] for k in FLAGS}, **extra
         )
-        print(path.name, soup.n_faces, *(int(flags[k].sum()) for k in FLAGS), flush=True)
+        print(name, soup.n_faces, *(int(flags[k].sum()) for k in FLAGS), flush=True)
 
 
 def compare(folder: str) -> int:
     """Compare the flags of this checkout with a snapshot; 1 when a face lost a flag."""
     from meshvis.geometry.intersect import intersection_flags
     from meshvis.graphcut.classify import classify
-    from meshvis.io import load
 
     lost_any = False
     for snap in sorted(Path(folder).glob("*.npz")):
         old = np.load(snap)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            soup = load(str(old["path"]))
+        soup = load_spec(str(old["path"]))
         new = intersection_flags(soup.vertices, soup.faces)
         cells = []
         for k in FLAGS:
