@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from meshvis.rays.caster import RayCaster
-from meshvis.rays.samples import uniform_in_triangles, uniform_sphere
+from meshvis.rays.samples import uniform_sphere
 from meshvis.soup import Soup
 
 #: rays per face and side in the first round
@@ -53,6 +53,9 @@ LAST_SHARE = 1.0
 MIN_ESCAPES = 8
 #: ... when one side escapes at least this many times as often as the other
 DOMINANCE = 4.0
+#: a ray that meets nothing within this many bounding-box diagonals of its origin (on
+#: the model) has left the model
+ESCAPE_REACH = 2.0
 #: rays traced per batch (bounded memory)
 BATCH_RAYS = 1 << 20
 
@@ -84,23 +87,42 @@ def escapes(
     faces = np.asarray(faces, np.int64)
     out = np.zeros((len(faces), 2), np.int64)
     per_batch = max(1, BATCH_RAYS // max(rays, 1))
+    reach = ESCAPE_REACH * caster.diagonal
     for lo in range(0, len(faces), per_batch):
         local = np.arange(lo, min(len(faces), lo + per_batch))
-        face = np.repeat(faces[local], rays)
-        points = uniform_in_triangles(soup.triangles[face], rng)
-        directions = uniform_sphere(len(face), rng)
-        along = np.einsum("ij,ij->i", directions, caster.normals[face])
+        k = len(local)
+        # per-face geometry broadcast over the face's rays (no per-ray gathers)
+        normal = caster.normals[faces[local]]
+        points = _points_in(soup.triangles[faces[local]], rays, rng)
+        directions = uniform_sphere(k * rays, rng).reshape(k, rays, 3)
+        along = np.einsum("krj,kj->kr", directions, normal)
         if through is not None:  # mirror the directions onto the asked hemisphere
-            want = np.repeat(np.asarray(through)[local], rays)
-            wrong = (along < 0) != (want == 1)
+            wrong = (along < 0) != (np.asarray(through)[local, None] == 1)
             directions[wrong] *= -1.0
             along[wrong] *= -1.0
-        side = (along < 0).astype(np.int64)
-        hits = caster.intersect_from_surface(points, face, side, directions)
-        slot = np.repeat(local - lo, rays) * 2 + side
-        counted = np.bincount(slot, weights=hits.face < 0, minlength=2 * len(local))
-        out[local] = counted.reshape(-1, 2).astype(np.int64)
+        back = along < 0
+        push = np.where(back, -1.0, 1.0) * caster.offset * caster.diagonal  # off the surface
+        origins = (points + normal[:, None, :] * push[..., None]).reshape(-1, 3)
+        # a ray escapes when nothing lies on it within the model's reach: an any-hit
+        # query, cheaper than finding the first hit
+        blocked = caster.occluded(origins, origins + directions.reshape(-1, 3) * reach)
+        free = ~blocked.reshape(k, rays)
+        out[local, 0] = (free & ~back).sum(axis=1)
+        out[local, 1] = (free & back).sum(axis=1)
     return out
+
+
+def _points_in(triangles: np.ndarray, rays: int, rng: np.random.Generator) -> np.ndarray:
+    """(k, rays, 3) uniform random points in each of ``triangles`` (k, 3, 3).
+
+    The same numbers and warp as :func:`meshvis.rays.samples.uniform_in_triangles` on the
+    triangles repeated ``rays`` times each, without building that (k * rays, 3, 3) copy.
+    """
+    shape = (len(triangles), rays)
+    u = np.sqrt(rng.random(shape))[..., None]
+    v = rng.random(shape)[..., None]
+    t = triangles[:, None]
+    return (1 - u) * t[..., 0, :] + u * (1 - v) * t[..., 1, :] + u * v * t[..., 2, :]
 
 
 def decisive(escaped: np.ndarray, dominance: float | np.ndarray = DOMINANCE) -> np.ndarray:
