@@ -359,8 +359,9 @@ def _hidden_sides(
     # where that body is closed (parity means nothing on an open one: those faces keep
     # their winding)
     open_ = hidden & ~own_layer & ~decisive
-    outer[open_ & ~_closed_body(c)] = 0
-    open_ &= _closed_body(c)
+    closed_body = _closed_body(c)
+    outer[open_ & ~closed_body] = 0
+    open_ &= closed_body
     n_parity = int(open_.sum())
     if n_parity:
         outer[open_] = parity_side(c, np.flatnonzero(open_), seed=int(c.params.get("seed", 0)))
