@@ -123,3 +123,26 @@ def test_significant_asks_for_less_dominance_as_the_escapes_grow():
     got = evidence.significant(escaped, 1e-3)
     np.testing.assert_array_equal(got, [True, True, False, False, False, True])
     assert not evidence.decisive(escaped[:2]).any()  # 2x is not 4x
+
+
+def test_escapes_counts_the_rays_that_meet_nothing():
+    """The any-hit count of ``escapes`` equals first hits traced one ray at a time over the
+    same points and directions (the spot model: folds, so many rays are blocked)."""
+    from meshvis.rays.caster import RayCaster
+    from meshvis.rays.samples import uniform_in_triangles, uniform_sphere
+
+    soup = _model("spot.obj")
+    caster = RayCaster(soup)
+    faces = np.arange(0, soup.n_faces, 7)
+    rays = 16
+    got = evidence.escapes(soup, caster, faces, rays, np.random.default_rng(4))
+    rng = np.random.default_rng(4)
+    face = np.repeat(faces, rays)
+    points = uniform_in_triangles(soup.triangles[face], rng)
+    directions = uniform_sphere(len(face), rng)
+    side = (np.einsum("ij,ij->i", directions, caster.normals[face]) < 0).astype(np.int64)
+    free = caster.intersect_from_surface(points, face, side, directions).face < 0
+    want = np.zeros((len(faces), 2), np.int64)
+    np.add.at(want, (np.repeat(np.arange(len(faces)), rays), side), free)
+    assert 0 < want.sum() < len(face)
+    np.testing.assert_array_equal(got, want)
