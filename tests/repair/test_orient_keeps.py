@@ -94,3 +94,55 @@ def test_decisive_takes_the_dominance_asked_for():
     escaped = np.array([[10, 6], [2, 3], [40, 9]])
     np.testing.assert_array_equal(evidence.decisive(escaped), [False, False, True])
     np.testing.assert_array_equal(evidence.decisive(escaped, 1.0), [True, False, True])
+
+
+def _sheet_under_roof(pinned: bool) -> Soup:
+    """A small square sheet (two faces, front up) under a wide roof; ``pinned``: a small
+    triangle stands through the sheet, so that both its faces are flagged."""
+    t = 0.05
+    sheet = [[-t, -t, 0.0], [t, -t, 0.0], [t, t, 0.0], [-t, t, 0.0]]
+    roof = [[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0]]
+    pin = [[0.0, -0.02, -0.02], [0.0, 0.02, -0.02], [0.0, 0.0, 0.02]]
+    faces = [[0, 1, 2], [0, 2, 3], [4, 5, 6], [4, 6, 7]] + ([[8, 9, 10]] if pinned else [])
+    return Soup(np.array(sheet + roof + (pin if pinned else [])), np.array(faces))
+
+
+def test_a_flagged_face_turns_to_the_side_seen_significantly_more_often():
+    """The sheet's back (open below) is seen more often than its front, but not 4x: the
+    consistently wound sheet keeps its winding, unless a surface crosses it (flagged faces
+    turn on a sign test, ``CROSSING_LEVEL``)."""
+    kept = orient(_sheet_under_roof(False), seed=0)
+    assert not kept.classification.flagged[:2].any() and not kept.flipped[:2].any()
+    crossed = orient(_sheet_under_roof(True), seed=0)
+    assert crossed.classification.flagged[:2].all() and crossed.flipped[:2].all()
+    assert not crossed.flipped[2:4].any()  # the roof shows its top
+
+
+def test_significant_asks_for_less_dominance_as_the_escapes_grow():
+    escaped = np.array([[66, 34], [34, 66], [7, 1], [50, 50], [530, 470], [570, 430]])
+    got = evidence.significant(escaped, 1e-3)
+    np.testing.assert_array_equal(got, [True, True, False, False, False, True])
+    assert not evidence.decisive(escaped[:2]).any()  # 2x is not 4x
+
+
+def test_escapes_counts_the_rays_that_meet_nothing():
+    """The any-hit count of ``escapes`` equals first hits traced one ray at a time over the
+    same points and directions (the spot model: folds, so many rays are blocked)."""
+    from meshvis.rays.caster import RayCaster
+    from meshvis.rays.samples import uniform_in_triangles, uniform_sphere
+
+    soup = _model("spot.obj")
+    caster = RayCaster(soup)
+    faces = np.arange(0, soup.n_faces, 7)
+    rays = 16
+    got = evidence.escapes(soup, caster, faces, rays, np.random.default_rng(4))
+    rng = np.random.default_rng(4)
+    face = np.repeat(faces, rays)
+    points = uniform_in_triangles(soup.triangles[face], rng)
+    directions = uniform_sphere(len(face), rng)
+    side = (np.einsum("ij,ij->i", directions, caster.normals[face]) < 0).astype(np.int64)
+    free = caster.intersect_from_surface(points, face, side, directions).face < 0
+    want = np.zeros((len(faces), 2), np.int64)
+    np.add.at(want, (np.repeat(np.arange(len(faces)), rays), side), free)
+    assert 0 < want.sum() < len(face)
+    np.testing.assert_array_equal(got, want)

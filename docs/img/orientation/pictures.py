@@ -6,6 +6,9 @@ and the same view after all four steps: a close view of the largest face the ref
 and the two steps turn away from it.  Orange = a back side seen, i.e. a face turned
 away from this viewer.  ``<name>_left.png``: the same for the largest decisive face that
 all four steps still turn away from the side the reference sees (what is left).
+``monastery_crossing.png``: the monastery with its flagged faces kept to their consistently
+wound patch unless 4x evidence turns them (``CROSSING_LEVEL = 0``, left) and as ``orient``
+returns it (right), at the largest decisive face that the left one turns away.
 
     python docs/img/orientation/pictures.py   (writes docs/img/orientation/*.png)
 """
@@ -83,6 +86,30 @@ def main(root=SHARED):
                 "back-side pixels:",
                 *n,
             )
+    crossing(root)
+
+
+def crossing(root=SHARED):
+    """``monastery_crossing.png``: the sign test on flagged faces off (left) and on."""
+    rel = MODELS["monastery"]
+    soup = load(os.path.join(root, rel))
+    stem = os.path.splitext(os.path.basename(rel))[0]
+    ref = reference(soup, seed=0, cache=os.path.join(CACHE, f"{stem}.seed0.npz"))
+    after = O.orient(soup, seed=0)
+    level = O.CROSSING_LEVEL
+    try:
+        O.CROSSING_LEVEL = 0.0
+        before = O.orient(soup, classification=after.classification)
+    finally:
+        O.CROSSING_LEVEL = level
+    total = soup.areas[ref.decisive].sum()
+    for label, r in (("off", before), ("on", after)):
+        wrong = ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side)
+        print(f"monastery, sign test {label}: {100 * soup.areas[wrong].sum() / total:.4f} % turned away")
+    wrong = np.flatnonzero(ref.decisive & (before.flipped.astype(np.int8) != ref.outside_side))
+    f = wrong[np.argmax(soup.areas[wrong])]
+    n = picture(before.soup, after.soup, close_view(soup, ref, f), os.path.join(HERE, "monastery_crossing.png"))
+    print("monastery crossing: face", f, "escapes", ref.escaped[f], "back-side pixels, off / on:", *n)
 
 
 if __name__ == "__main__":
