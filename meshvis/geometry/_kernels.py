@@ -11,9 +11,16 @@ operations can only add reports (the flags stay conservative).
 from __future__ import annotations
 
 import math
+import warnings
 
 import numba
 import numpy as np
+
+# Numba tries the TBB threading layer first and warns when the installed TBB is too old,
+# then falls back to OpenMP or its own work queue, which serve these kernels as well: the
+# warning says nothing a user of meshvis can act on (printed by every command that runs a
+# parallel kernel on such a machine).
+warnings.filterwarnings("ignore", message=".*The TBB threading layer requires", category=numba.NumbaWarning)
 
 #: relative slack of every reporting comparison (far above float64 reordering error)
 SLACK = 1e-12
