@@ -38,7 +38,7 @@ from meshvis.graphcut.preprocess import Preprocessed, preprocess
 from meshvis.graphcut.sampling import VisibilityCounts, sample_round
 from meshvis.graphcut.weights import DEFAULT_OPENING, graph_weights
 from meshvis.io import as_soup
-from meshvis.rays.caster import RayCaster
+from meshvis.rays.caster import DEFAULT_OFFSET, RayCaster
 from meshvis.soup import Soup
 
 #: rays of the first progressive round, per node (before the cluster-size factor)
@@ -385,8 +385,8 @@ def _scene(
     t = time.perf_counter()
     report("scene", 0.0)
     if caster is None:
-        kw = {} if offset is None else {"offset": offset}
-        caster = RayCaster(soup, vertex_groups=groups, **kw)
+        push = DEFAULT_OFFSET if offset is None else offset
+        caster = RayCaster(soup, offset=push, vertex_groups=groups)
     stages.append(Stage("scene", True, time.perf_counter() - t, "Embree scene on the normalised copy"))
     return caster
 
