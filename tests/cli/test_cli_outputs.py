@@ -35,5 +35,8 @@ def test_a_command_builds_only_its_own_parser(tmp_path):
         "names = build_parser()._subparsers._group_actions[0].choices; print(sorted(names) == sorted("
         "__import__('meshvis.cli.main', fromlist=['COMMANDS']).COMMANDS))"
     )
-    out = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, check=True).stdout
-    assert out.splitlines()[-2:] == ["0 False False", "True"]
+    # run outside the checkout: from its root, `-c` would import the source tree's meshvis,
+    # which has no `cli` (it is installed from the top-level cli/ folder)
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.splitlines()[-2:] == ["0 False False", "True"]
