@@ -265,6 +265,25 @@ def seen_side(
     """
     shown = np.asarray(shown, np.int64)
     escaped, rays = seen_counts(soup, caster, faces, shown, rng)
-    # the side that escapes more often; a tie keeps the side shown
-    side = np.where(escaped[:, 1] == escaped[:, 0], shown, escaped[:, 1] > escaped[:, 0]).astype(np.int8)
-    return side, decisive(escaped, dominance), rays
+    return more_seen(escaped, shown), decisive(escaped, dominance), rays
+
+
+def more_seen(escaped: np.ndarray, shown: np.ndarray) -> np.ndarray:
+    """The side whose rays escape more often; a tie keeps the side shown.
+
+    Parameters
+    ----------
+    escaped : (k, 2) int, escapes per face from its front and its back
+    shown : (k,) int, the side (0 front, 1 back) each face shows without the evidence
+
+    Returns
+    -------
+    (k,) int8, the side seen more often
+
+    Examples
+    --------
+    >>> more_seen(np.array([[3, 9], [5, 5], [7, 1]]), np.array([0, 1, 1])).tolist()
+    [1, 1, 0]
+    """
+    tie = escaped[:, 1] == escaped[:, 0]
+    return np.where(tie, shown, escaped[:, 1] > escaped[:, 0]).astype(np.int8)

@@ -482,9 +482,7 @@ def _visible_sides(
     escaped, rays = evidence.seen_counts(c.soup, c.caster, test, shown, rng)
     sure = evidence.decisive(escaped, dominance)
     sure |= c.flagged[test] & evidence.significant(escaped, CROSSING_LEVEL)
-    # the side that escapes more often (a tie keeps the side shown)
-    side = np.where(escaped[:, 1] == escaped[:, 0], shown, escaped[:, 1] > escaped[:, 0])
-    turned[test[sure & (side != shown)]] = True
+    turned[test[sure & (evidence.more_seen(escaped, shown) != shown)]] = True
     outer[turned] = 1 - outer[turned]
     return turned, len(test), rays
 
