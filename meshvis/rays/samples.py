@@ -9,8 +9,10 @@ from __future__ import annotations
 import numpy as np
 
 
-def uniform_in_triangles(triangles: np.ndarray, rng: np.random.Generator) -> np.ndarray:
-    """One uniform random point in each triangle.
+def uniform_in_triangles(
+    triangles: np.ndarray, rng: np.random.Generator, per: int | None = None
+) -> np.ndarray:
+    """Uniform random points in each triangle: one, or ``per`` of them.
 
     Parameters
     ----------
@@ -18,17 +20,26 @@ def uniform_in_triangles(triangles: np.ndarray, rng: np.random.Generator) -> np.
         Corner coordinates.
     rng : numpy.random.Generator
         The random generator.
+    per : int, optional
+        Points per triangle.  The numbers are those of one point per triangle on the
+        triangles repeated ``per`` times each, without building that (n * per, 3, 3) copy.
 
     Returns
     -------
-    (n, 3) float64 array
+    (n, 3) float64 array, or (n, per, 3) with ``per``
         The points, by the square-root warp ``p = (1-√u) a + √u (1-v) b + √u v c``.
+
+    Examples
+    --------
+    >>> tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
+    >>> uniform_in_triangles(tri, np.random.default_rng(0), per=4).shape
+    (1, 4, 3)
     """
-    n = len(triangles)
-    u = np.sqrt(rng.random(n))
-    v = rng.random(n)
-    w0, w1, w2 = 1 - u, u * (1 - v), u * v
-    return w0[:, None] * triangles[:, 0] + w1[:, None] * triangles[:, 1] + w2[:, None] * triangles[:, 2]
+    shape = (len(triangles),) if per is None else (len(triangles), per)
+    u = np.sqrt(rng.random(shape))[..., None]
+    v = rng.random(shape)[..., None]
+    t = np.asarray(triangles) if per is None else np.asarray(triangles)[:, None]
+    return (1 - u) * t[..., 0, :] + u * (1 - v) * t[..., 1, :] + u * v * t[..., 2, :]
 
 
 def cosine_hemisphere(

@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from meshvis.rays.caster import RayCaster
-from meshvis.rays.samples import uniform_sphere
+from meshvis.rays.samples import uniform_in_triangles, uniform_sphere
 from meshvis.soup import Soup
 
 #: rays per face and side in the first round
@@ -93,7 +93,7 @@ def escapes(
         k = len(local)
         # per-face geometry broadcast over the face's rays (no per-ray gathers)
         normal = caster.normals[faces[local]]
-        points = _points_in(soup.triangles[faces[local]], rays, rng)
+        points = uniform_in_triangles(soup.triangles[faces[local]], rng, per=rays)
         directions = uniform_sphere(k * rays, rng).reshape(k, rays, 3)
         along = np.einsum("krj,kj->kr", directions, normal)
         if through is not None:  # mirror the directions onto the asked hemisphere
@@ -110,19 +110,6 @@ def escapes(
         out[local, 0] = (free & ~back).sum(axis=1)
         out[local, 1] = (free & back).sum(axis=1)
     return out
-
-
-def _points_in(triangles: np.ndarray, rays: int, rng: np.random.Generator) -> np.ndarray:
-    """(k, rays, 3) uniform random points in each of ``triangles`` (k, 3, 3).
-
-    The same numbers and warp as :func:`meshvis.rays.samples.uniform_in_triangles` on the
-    triangles repeated ``rays`` times each, without building that (k * rays, 3, 3) copy.
-    """
-    shape = (len(triangles), rays)
-    u = np.sqrt(rng.random(shape))[..., None]
-    v = rng.random(shape)[..., None]
-    t = triangles[:, None]
-    return (1 - u) * t[..., 0, :] + u * (1 - v) * t[..., 1, :] + u * v * t[..., 2, :]
 
 
 def decisive(escaped: np.ndarray, dominance: float | np.ndarray = DOMINANCE) -> np.ndarray:
