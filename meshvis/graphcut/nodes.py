@@ -17,10 +17,10 @@ import numpy as np
 
 from meshvis.graphcut.clusters import Clustering
 from meshvis.rays.samples import (
-    cosine_hemisphere,
+    cosine_about_faces,
+    pushed_points_in_faces,
     sample_scheme_barycentric,
     tangent_frames,
-    uniform_in_triangles,
 )
 
 
@@ -358,17 +358,17 @@ def node_rays(
     side = np.empty(len(source), np.int8)
 
     cl = source < nodes.n_cluster
-    src_c = source[cl]
-    if len(src_c):
+    rows_c = np.flatnonzero(cl)
+    if len(rows_c):
+        src_c = source[rows_c]
         start = nodes.node_start[src_c]
         base = np.where(start > 0, nodes.entry_cumarea[np.maximum(start - 1, 0)], 0.0)
         target = base + rng.random(len(src_c)) * nodes.area[src_c]
         idx = np.searchsorted(nodes.entry_cumarea, target, side="right")
         idx = np.clip(idx, start, nodes.node_start[src_c + 1] - 1)
         f, s = nodes.entry_face[idx], nodes.entry_side[idx]
-        pts = uniform_in_triangles(triangles[f], rng)
-        origins[cl] = pts + offset * side_normals(normals[f], s)
-        face[cl], side[cl] = f, s
+        origins[rows_c] = pushed_points_in_faces(triangles, normals, f, s, offset, rng)
+        face[rows_c], side[rows_c] = f, s
 
     pn = ~cl
     if pn.any():
@@ -378,5 +378,5 @@ def node_rays(
         face[pn], side[pn] = nodes.point_face[p], s
     # tangent frames depend on the face only (flipping the normal keeps them orthogonal)
     t1, t2 = nodes.tangents
-    directions = cosine_hemisphere(side_normals(normals[face], side), rng, (t1[face], t2[face]))
+    directions = cosine_about_faces(normals, (t1, t2), face, side, rng)
     return source, origins, directions

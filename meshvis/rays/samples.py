@@ -8,6 +8,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from meshvis.rays import _kernels
+
 
 def uniform_in_triangles(
     triangles: np.ndarray, rng: np.random.Generator, per: int | None = None
@@ -67,15 +69,94 @@ def cosine_hemisphere(
         Unit directions with ``dot(d, normal) > 0``.
     """
     n = len(normals)
-    xi1, xi2 = rng.random(n), rng.random(n)
-    cos_t = np.sqrt(1.0 - xi1)  # same distribution as sqrt(xi1), but never exactly 0 at xi1=0
-    sin_t = np.sqrt(xi1)
-    phi = 2 * np.pi * xi2
     t1, t2 = tangent_frames(normals) if frames is None else frames
-    d = (sin_t * np.cos(phi))[:, None] * t1
-    d += (sin_t * np.sin(phi))[:, None] * t2
-    d += cos_t[:, None] * normals
-    return d
+    return cosine_about_faces(normals, (t1, t2), np.arange(n), np.zeros(n, bool), rng)
+
+
+def cosine_about_faces(
+    normals: np.ndarray,
+    tangents: tuple[np.ndarray, np.ndarray],
+    face: np.ndarray,
+    side: np.ndarray,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """Cosine-distributed unit directions about the side normal of ``face[k]``, one per k.
+
+    The same numbers as ``cosine_hemisphere(side_normals(normals[face], side), rng,
+    (t1[face], t2[face]))``, from a compiled kernel that reads each face's frame once per
+    ray instead of gathering it into (r, 3) arrays.
+
+    Parameters
+    ----------
+    normals : (m, 3) float64 array
+        Unit normals of side 0 of the faces.
+    tangents : tuple of two (m, 3) float64 arrays
+        The faces' tangents (:func:`tangent_frames` of ``normals``).
+    face : (r,) int array
+        Face of each direction.
+    side : (r,) int or bool array
+        Side of each direction (1: about the negated normal).
+    rng : numpy.random.Generator
+        The random generator.
+
+    Returns
+    -------
+    (r, 3) float64 array
+        Unit directions on the chosen side of each face.
+
+    Examples
+    --------
+    >>> nrm = np.array([[0.0, 0.0, 1.0]])
+    >>> d = cosine_about_faces(nrm, tangent_frames(nrm), np.zeros(3, int), np.ones(3, int), np.random.default_rng(0))
+    >>> bool((d[:, 2] < 0).all())
+    True
+    """
+    xi1, xi2 = rng.random(len(face)), rng.random(len(face))
+    flip = np.asarray(side) != 0
+    return _kernels.cosine_directions(normals, tangents[0], tangents[1], np.asarray(face), flip, xi1, xi2)
+
+
+def pushed_points_in_faces(
+    triangles: np.ndarray,
+    normals: np.ndarray,
+    face: np.ndarray,
+    side: np.ndarray,
+    offset: float,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """A uniform random point on each ``face[k]``, pushed by ``offset`` off its side ``side[k]``.
+
+    The same numbers as ``uniform_in_triangles(triangles[face], rng) + offset *
+    side_normal``, from a compiled kernel (no (r, 3, 3) gather of the corners).
+
+    Parameters
+    ----------
+    triangles : (m, 3, 3) float64 array
+        Corner coordinates.
+    normals : (m, 3) float64 array
+        Unit normals of side 0.
+    face, side : (r,) int arrays
+        Face and side of each point.
+    offset : float
+        Push along the side normal (model units).
+    rng : numpy.random.Generator
+        The random generator.
+
+    Returns
+    -------
+    (r, 3) float64 array
+        The pushed points.
+
+    Examples
+    --------
+    >>> tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
+    >>> p = pushed_points_in_faces(tri, np.array([[0.0, 0, 1]]), np.zeros(2, int), np.array([0, 1]), 0.1, np.random.default_rng(0))
+    >>> p[:, 2].tolist()
+    [0.1, -0.1]
+    """
+    ru, rv = rng.random(len(face)), rng.random(len(face))
+    flip = np.asarray(side) != 0
+    return _kernels.pushed_points(triangles, normals, np.asarray(face), flip, ru, rv, float(offset))
 
 
 def tangent_frames(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
