@@ -59,3 +59,43 @@ def pushed_points(triangles, normals, face, flip, ru, rv, offset):  # pragma: no
             p = wa * triangles[f, 0, c] + wb * triangles[f, 1, c] + wc * triangles[f, 2, c]
             out[k, c] = p + offset * (normals[f, c] * sgn)
     return out
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+def segment_query(k, o, t, center, scale, offset, o32, d32, dist, ok):  # pragma: no cover - compiled
+    """Row k of :func:`segment_queries` for the segment from point ``o`` to point ``t`` (3 scalars each)."""
+    s0, s1, s2 = t[0] - o[0], t[1] - o[1], t[2] - o[2]
+    length = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+    ok[k] = length > 0
+    if length > 0:
+        d32[k, 0], d32[k, 1], d32[k, 2] = s0 / length, s1 / length, s2 / length
+    else:
+        d32[k, 0], d32[k, 1], d32[k, 2] = 0.0, 0.0, 1.0
+    dist[k] = max(length * scale - offset, 0.0)
+    for c in range(3):
+        o32[k, c] = (o[c] - center[c]) * scale
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def query_buffers(n):  # pragma: no cover - compiled
+    """Empty outputs of :func:`segment_queries` for n segments."""
+    return (
+        np.empty((n, 3), np.float32),
+        np.empty((n, 3), np.float32),
+        np.empty(n, np.float32),
+        np.empty(n, np.bool_),
+    )
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def segment_queries(origins, targets, center, scale, offset):  # pragma: no cover - compiled
+    """Embree inputs of the segments ``origins[k] -> targets[k]`` (:meth:`RayCaster.occluded`).
+
+    Returns the float32 origins in scene coordinates, the float32 unit directions, the
+    float32 lengths in scene units shortened by ``offset`` (never below 0), and whether
+    each segment has a length.  A zero-length segment gets the direction +z.
+    """
+    o32, d32, dist, ok = query_buffers(len(origins))
+    for k in numba.prange(len(origins)):
+        segment_query(k, origins[k], targets[k], center, scale, offset, o32, d32, dist, ok)
+    return o32, d32, dist, ok

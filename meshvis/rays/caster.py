@@ -33,6 +33,7 @@ import numpy as np
 from meshvis import _validate
 from meshvis.geometry.adjacency import VertexGroups, group_vertices
 from meshvis.io import as_soup
+from meshvis.rays import _kernels
 
 #: default push of an origin off its surface, as a fraction of the bounding-box diagonal
 DEFAULT_OFFSET = 1e-5
@@ -274,15 +275,23 @@ class RayCaster:
         not occlude itself; push origins off their own surface first (:meth:`push_off`).
         """
         origins, targets = _validate.ray_arrays(origins, targets, "targets")
-        seg = targets - origins
-        length = np.linalg.norm(seg, axis=1)
-        ok = length > 0
-        d = np.zeros_like(seg)
-        d[ok] = seg[ok] / length[ok, None]
-        d[~ok] = (0.0, 0.0, 1.0)
-        dist = np.maximum(length * self.scale - self.offset, 0.0).astype(np.float32)
-        r = self._run(self.to_unit(origins), d.astype(np.float32), "OCCLUDED", dist)
-        return (r != -1) & ok
+        o32, d32, dist, ok = _kernels.segment_queries(
+            np.ascontiguousarray(origins, np.float64),
+            np.ascontiguousarray(targets, np.float64),
+            np.asarray(self.center, np.float64),
+            float(self.scale),
+            float(self.offset),
+        )
+        return self.occluded_queries(o32, d32, dist) & ok
+
+    def occluded_queries(self, o32: np.ndarray, d32: np.ndarray, dist: np.ndarray) -> np.ndarray:
+        """True where a ray already in scene coordinates meets geometry within ``dist``.
+
+        For compiled ray generators that write Embree's inputs directly: float32 origins
+        in the normalised coordinates of :meth:`to_unit`, float32 unit directions and
+        float32 lengths in those units (:func:`meshvis.rays._kernels.segment_queries`).
+        """
+        return self._run(o32, d32, "OCCLUDED", dist) != -1
 
     def push_off(self, points: np.ndarray, face: np.ndarray, side: np.ndarray) -> np.ndarray:
         """Move points lying on ``face`` off its surface, towards ``side`` (0 front, 1 back)."""

@@ -34,7 +34,7 @@ from __future__ import annotations
 import numpy as np
 
 from meshvis.rays.caster import RayCaster
-from meshvis.rays.samples import uniform_in_triangles, uniform_sphere
+from meshvis.repair import _kernels
 from meshvis.soup import Soup
 
 #: rays per face and side in the first round
@@ -88,25 +88,32 @@ def escapes(
     out = np.zeros((len(faces), 2), np.int64)
     per_batch = max(1, BATCH_RAYS // max(rays, 1))
     reach = ESCAPE_REACH * caster.diagonal
+    through_all = np.full(len(faces), -1, np.int64) if through is None else np.asarray(through, np.int64)
+    push = caster.offset * caster.diagonal  # origins off the surface
+    center = np.asarray(caster.center, np.float64)
     for lo in range(0, len(faces), per_batch):
         local = np.arange(lo, min(len(faces), lo + per_batch))
         k = len(local)
-        # per-face geometry broadcast over the face's rays (no per-ray gathers)
-        normal = caster.normals[faces[local]]
-        points = uniform_in_triangles(soup.triangles[faces[local]], rng, per=rays)
-        directions = uniform_sphere(k * rays, rng).reshape(k, rays, 3)
-        along = np.einsum("krj,kj->kr", directions, normal)
-        if through is not None:  # mirror the directions onto the asked hemisphere
-            wrong = (along < 0) != (np.asarray(through)[local, None] == 1)
-            directions[wrong] *= -1.0
-            along[wrong] *= -1.0
-        back = along < 0
-        push = np.where(back, -1.0, 1.0) * caster.offset * caster.diagonal  # off the surface
-        origins = (points + normal[:, None, :] * push[..., None]).reshape(-1, 3)
+        # the draws of uniform_in_triangles(per=rays) and uniform_sphere, in their order
+        ru, rv = rng.random((k, rays)), rng.random((k, rays))
+        gauss = rng.normal(size=(k * rays, 3))
+        o32, d32, dist, ok, back = _kernels.escape_queries(
+            soup.triangles[faces[local]],
+            np.ascontiguousarray(caster.normals[faces[local]]),
+            ru,
+            rv,
+            gauss,
+            through_all[local],
+            push,
+            reach,
+            center,
+            float(caster.scale),
+            float(caster.offset),
+        )
         # a ray escapes when nothing lies on it within the model's reach: an any-hit
         # query, cheaper than finding the first hit
-        blocked = caster.occluded(origins, origins + directions.reshape(-1, 3) * reach)
-        free = ~blocked.reshape(k, rays)
+        free = (~(caster.occluded_queries(o32, d32, dist) & ok)).reshape(k, rays)
+        back = back.reshape(k, rays)
         out[local, 0] = (free & ~back).sum(axis=1)
         out[local, 1] = (free & back).sum(axis=1)
     return out

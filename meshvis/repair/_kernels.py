@@ -1,0 +1,72 @@
+"""Numba kernel of the escape rays of :func:`meshvis.repair.evidence.escapes`.
+
+The numpy version built each batch's points, directions, pushed origins and segment ends
+as (faces, rays, 3) float64 arrays, then :meth:`RayCaster.occluded` read them again: most
+of the evidence stage was that memory traffic, not Embree.  This kernel takes the random
+numbers from the caller (drawn in the same order as before) and writes the Embree inputs
+directly, evaluating the same expressions in the same order, so that the counts are bit
+for bit those of the numpy version.
+"""
+
+from __future__ import annotations
+
+import math
+
+import numba
+import numpy as np
+
+from meshvis.rays._kernels import query_buffers, segment_query
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def escape_queries(
+    triangles, normal, ru, rv, gauss, through, push, reach, center, scale, offset
+):  # pragma: no cover - compiled
+    """Segments of ``rays`` uniform random rays from uniform points of each of k faces.
+
+    Parameters
+    ----------
+    triangles : (k, 3, 3) corners; normal : (k, 3) unit normals
+    ru, rv : (k, rays) uniforms of the square-root warp of ``uniform_in_triangles``
+    gauss : (k * rays, 3) standard normal draws (``uniform_sphere``'s directions)
+    through : (k,) int, -1 for both sides, else the side every ray leaves through
+        (a direction on the other side is mirrored)
+    push : push of the origins off the face (model units); reach : segment length
+    center, scale, offset : the scene transform and end push of :meth:`RayCaster.occluded`
+
+    Returns
+    -------
+    o32, d32, dist, ok : as :func:`meshvis.rays._kernels.segment_queries`
+    back : (k * rays,) bool, the ray leaves through the back
+    """
+    k, rays = ru.shape
+    o32, d32, dist, ok = query_buffers(k * rays)
+    back = np.empty(k * rays, np.bool_)
+    for f in numba.prange(k):
+        a, b, c = triangles[f, 0], triangles[f, 1], triangles[f, 2]
+        n = normal[f]
+        o = np.empty(3)
+        t = np.empty(3)
+        d = np.empty(3)
+        for r in range(rays):
+            row = f * rays + r
+            g = gauss[row]
+            length = math.sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2])
+            for j in range(3):
+                d[j] = g[j] / length
+            along = d[0] * n[0] + d[1] * n[1] + d[2] * n[2]
+            if through[f] >= 0 and (along < 0) != (through[f] == 1):
+                for j in range(3):
+                    d[j] *= -1.0
+                along *= -1.0
+            bk = along < 0
+            back[row] = bk
+            shift = -push if bk else push
+            u = math.sqrt(ru[f, r])
+            v = rv[f, r]
+            wa, wb, wc = 1 - u, u * (1 - v), u * v
+            for j in range(3):
+                o[j] = (wa * a[j] + wb * b[j] + wc * c[j]) + n[j] * shift
+                t[j] = o[j] + d[j] * reach
+            segment_query(row, o, t, center, scale, offset, o32, d32, dist, ok)
+    return o32, d32, dist, ok, back
