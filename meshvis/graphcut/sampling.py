@@ -13,6 +13,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
+from meshvis.graphcut import _kernels
 from meshvis.graphcut.nodes import NodeSet, node_rays
 from meshvis.rays.caster import RayCaster
 
@@ -53,21 +54,14 @@ def snap_to_points(nodes: NodeSet, face: np.ndarray, bary: np.ndarray) -> np.nda
     coordinates need to be gathered.
     """
     q = nodes.flagged_index[face]
-    g = nodes.flagged_metric[q]  # (n, 3): e1·e1, e1·e2, e2·e2
-    g0, g1, g2 = g[:, 0], g[:, 1], g[:, 2]
-    u, v = bary[:, 0], bary[:, 1]
-    best = np.zeros(len(face), np.int64)
-    best_d2 = None
-    # one pass per sample (K is small) keeps the temporaries at n values each
-    for k, (_, bu, bv) in enumerate(nodes.sample_bary):
-        du, dv = u - bu, v - bv
-        d2 = g0 * du * du + 2 * g1 * du * dv + g2 * dv * dv
-        if best_d2 is None:
-            best_d2 = d2
-        else:
-            closer = d2 < best_d2  # strict: ties keep the first sample, like argmin
-            best[closer] = k
-            best_d2 = np.where(closer, d2, best_d2)
+    bu, bv = nodes.sample_bary[:, 1], nodes.sample_bary[:, 2]
+    best = _kernels.nearest_sample(
+        nodes.flagged_metric[q],
+        np.ascontiguousarray(bary[:, 0]),
+        np.ascontiguousarray(bary[:, 1]),
+        bu.copy(),
+        bv.copy(),
+    )
     return q * nodes.samples + best
 
 
