@@ -222,14 +222,46 @@ def seen_counts(
         rays += MORE_RAYS * len(again)
     other, own = escaped[k, 1 - shown], escaped[k, shown]
     last = np.flatnonzero((other > 0) & (DOMINANCE * other > own) & ~decisive(escaped))
-    cap = int(LAST_SHARE * 2 * FIRST_RAYS * len(faces)) // LAST_RAYS
-    if len(last) > cap:  # the largest faces first: the error is measured in area
-        by_area = np.argsort(-soup.areas[faces[last]], kind="stable")
-        last = np.sort(last[by_area[:cap]])
-    if len(last):
-        escaped[last] += escapes(soup, caster, faces[last], LAST_RAYS, rng)
-        rays += LAST_RAYS * len(last)
+    rays += more_rays(soup, caster, faces, escaped, last, LAST_RAYS, LAST_SHARE, rng)
     return escaped, rays
+
+
+def more_rays(
+    soup: Soup,
+    caster: RayCaster,
+    faces: np.ndarray,
+    escaped: np.ndarray,
+    which: np.ndarray,
+    rays: int,
+    share: float,
+    rng: np.random.Generator,
+) -> int:
+    """Cast ``rays`` more rays from each face ``faces[which]``, adding to ``escaped`` in place.
+
+    At most ``share`` times the rays of the first round (``2 * FIRST_RAYS`` per face of
+    ``faces``) are cast, on the largest of the faces first: the error is measured in area.
+
+    Parameters
+    ----------
+    soup, caster : the model and its RayCaster
+    faces : (k,) int64, the faces tested
+    escaped : (k, 2) int64, escaping rays per face and side so far (updated)
+    which : (j,) int, positions in ``faces`` that get more rays
+    rays : int, rays per face; share : float, the cap; rng : numpy Generator
+
+    Returns
+    -------
+    int
+        Rays cast.
+    """
+    which = np.asarray(which, np.int64)
+    cap = int(share * 2 * FIRST_RAYS * len(faces)) // rays
+    if len(which) > cap:
+        by_area = np.argsort(-soup.areas[faces[which]], kind="stable")
+        which = np.sort(which[by_area[:cap]])
+    if len(which):
+        escaped[which] += escapes(soup, caster, faces[which], rays, rng)
+    return rays * len(which)
 
 
 def seen_side(
