@@ -22,6 +22,10 @@ Rays are cast in rounds, each for the faces the rounds before leave open:
    leave it to chance whether it reaches :data:`MIN_ESCAPES`, or which side wins); at
    most :data:`LAST_SHARE` times the rays of the first round, largest faces first.
 
+:func:`more_rays` casts further rounds for faces a caller picks: :func:`meshvis.repair.orient`
+gives flagged faces whose rays barely escaped, and those whose sign test leans to the side
+they do not show without passing, more rays before it decides.
+
 Most faces cost 64 rays.  A face's evidence is *decisive* when at least
 :data:`MIN_ESCAPES` rays escape and one side escapes at least ``dominance`` (default
 :data:`DOMINANCE`) times as often as the other: a face seen only through a thin gap
