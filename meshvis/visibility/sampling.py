@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshvis.rays.caster import Hits, RayCaster
-from meshvis.rays.samples import uniform_in_triangles
+from meshvis.visibility import _kernels
 from meshvis.visibility.regions import Region
 
 #: half-width of the band around a face, as a fraction of the diagonal (viewers at
@@ -106,14 +106,30 @@ def random_seeds(
     rays : int
         Seeds traced.
     """
-    points = uniform_in_triangles(caster.soup.triangles[faces], rng)
+    # the two draws of uniform_in_triangles(caster.soup.triangles[faces], rng), without the gather
+    ru, rv = rng.random(len(faces)), rng.random(len(faces))
+    faces = np.asarray(faces, np.int64)
+    points = _kernels.points_in_faces(caster.soup.triangles, faces, ru, rv)
     origin, direction = region.seed_viewers(points, rng)
-    side = (np.einsum("ij,ij->i", direction, caster.normals[faces]) >= 0).astype(np.int8)
+    origin = np.ascontiguousarray(np.broadcast_to(origin, points.shape), np.float64)
+    direction = np.ascontiguousarray(direction, np.float64)
+    side = _kernels.facing_sides(direction, caster.normals, faces)
     if want is not None:
         keep = (want < 0) | (want == side)
         faces, side, points, origin, direction = (x[keep] for x in (faces, side, points, origin, direction))
-    blocked = caster.occluded(caster.push_off(points, faces, side), origin)
-    free = ~blocked
+    # caster.occluded(caster.push_off(points, faces, side), origin), prepared in one pass
+    o32, d32, dist, ok = _kernels.seed_segments(
+        points,
+        caster.normals,
+        faces,
+        side,
+        origin,
+        np.asarray(caster.center, np.float64),
+        float(caster.scale),
+        float(caster.offset),
+        float(caster.diagonal),
+    )
+    free = ~(caster.occluded_queries(o32, d32, dist) & ok)
     return Sightings(faces[free], side[free], origin[free], direction[free], points[free]), len(faces)
 
 
