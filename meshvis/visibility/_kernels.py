@@ -116,3 +116,110 @@ def seed_segments(points, normals, face, side, viewers, center, scale, offset, d
             pushed[k, c] = points[k, c] + normals[f, c] * s
         segment_query(k, pushed[k], viewers[k], center, scale, offset, o32, d32, dist, ok)
     return o32, d32, dist, ok
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _dot3(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
+    """``np.einsum("ij,ij->i", a, b)`` of one row (numpy adds the middle product last)."""
+    return (a0 * b0 + a2 * b2) + a1 * b1
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _guard(n):  # pragma: no cover - compiled
+    """The divisor of ``_unit``: ``np.where(n > 0, n, 1.0)``."""
+    return n if n > 0 else 1.0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def reverse_jumps(
+    band_face, parent_face, normals, triangles, origin, direction, point, threshold
+):  # pragma: no cover
+    """Band rays stopped more than ``threshold`` before the plane of their parent's face.
+
+    Returns their indices (ascending) and the distance ``t_pred`` to that plane along each,
+    as the numpy code of :func:`meshvis.visibility.sampling.reverse_sampling` computes them.
+    """
+    n = len(band_face)
+    idx = np.empty(n, np.int64)
+    t_out = np.empty(n)
+    m = 0
+    for i in range(n):
+        f = parent_face[i]
+        if band_face[i] == f:
+            continue
+        n0, n1, n2 = normals[f, 0], normals[f, 1], normals[f, 2]
+        o0, o1, o2 = origin[i, 0], origin[i, 1], origin[i, 2]
+        d0, d1, d2 = direction[i, 0], direction[i, 1], direction[i, 2]
+        denom = _dot3(d0, d1, d2, n0, n1, n2)
+        t_pred = -np.inf
+        if abs(denom) > 1e-6:
+            w0, w1, w2 = triangles[f, 0, 0] - o0, triangles[f, 0, 1] - o1, triangles[f, 0, 2] - o2
+            t_pred = _dot3(w0, w1, w2, n0, n1, n2) / denom
+        t_hit = _dot3(point[i, 0] - o0, point[i, 1] - o1, point[i, 2] - o2, d0, d1, d2)
+        if t_pred - t_hit > threshold:
+            idx[m] = i
+            t_out[m] = t_pred
+            m += 1
+    return idx[:m].copy(), t_out[:m].copy()
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def reverse_rays(
+    idx, t_pred, band_face, triangles, origin, direction, point, parent_point, at_infinity, pass_by
+):  # pragma: no cover
+    """The mutated rays of reverse sampling, in the order of the numpy code's ``[cross]`` masks.
+
+    For each jump ``idx[j]``: the plane through the viewer ray and the parent's point cuts
+    the occluder's edges where their ends' signed distances change sign; a point
+    ``pass_by`` beyond each cut, away from the hit point, gets a unit direction towards the
+    predicted point.  Returns ``(beside, direction, ok_dir)``: (c, 3), (c, 3), (c,) bool.
+    """
+    k = len(idx)
+    beside = np.empty((3 * k, 3))
+    out_dir = np.empty((3 * k, 3))
+    ok_dir = np.empty(3 * k, np.bool_)
+    s = np.empty(3)
+    m = 0
+    for j in range(k):
+        i = idx[j]
+        h0, h1, h2 = point[i, 0], point[i, 1], point[i, 2]
+        o0, o1, o2 = origin[i, 0], origin[i, 1], origin[i, 2]
+        d0, d1, d2 = direction[i, 0], direction[i, 1], direction[i, 2]
+        t = t_pred[j]
+        q0, q1, q2 = o0 + d0 * t, o1 + d1 * t, o2 + d2 * t  # the predicted point
+        if at_infinity:
+            a0, a1, a2 = d0, d1, d2
+            b0, b1, b2 = parent_point[i, 0] - h0, parent_point[i, 1] - h1, parent_point[i, 2] - h2
+        else:
+            a0, a1, a2 = h0 - o0, h1 - o1, h2 - o2
+            b0, b1, b2 = parent_point[i, 0] - o0, parent_point[i, 1] - o1, parent_point[i, 2] - o2
+        # np.cross, then _unit
+        p0, p1, p2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+        g = _guard(_norm3(p0, p1, p2))
+        p0, p1, p2 = p0 / g, p1 / g, p2 / g
+        if not _norm3(p0, p1, p2) > 0:
+            continue
+        f = band_face[i]
+        for e in range(3):
+            s[e] = _dot3(
+                triangles[f, e, 0] - h0, triangles[f, e, 1] - h1, triangles[f, e, 2] - h2, p0, p1, p2
+            )
+        for e in range(3):
+            en = (e + 1) % 3
+            if not s[e] * s[en] < 0:
+                continue
+            frac = s[e] / (s[e] - s[en])
+            x0 = triangles[f, e, 0] + (triangles[f, en, 0] - triangles[f, e, 0]) * frac
+            x1 = triangles[f, e, 1] + (triangles[f, en, 1] - triangles[f, e, 1]) * frac
+            x2 = triangles[f, e, 2] + (triangles[f, en, 2] - triangles[f, e, 2]) * frac
+            u0, u1, u2 = x0 - h0, x1 - h1, x2 - h2
+            g = _guard(_norm3(u0, u1, u2))
+            y0, y1, y2 = x0 + u0 / g * pass_by, x1 + u1 / g * pass_by, x2 + u2 / g * pass_by
+            beside[m, 0], beside[m, 1], beside[m, 2] = y0, y1, y2
+            v0, v1, v2 = q0 - y0, q1 - y1, q2 - y2
+            g = _guard(_norm3(v0, v1, v2))
+            v0, v1, v2 = v0 / g, v1 / g, v2 / g
+            out_dir[m, 0], out_dir[m, 1], out_dir[m, 2] = v0, v1, v2
+            ok_dir[m] = _norm3(v0, v1, v2) > 0
+            m += 1
+    return beside[:m].copy(), out_dir[:m].copy(), ok_dir[:m].copy()

@@ -133,6 +133,14 @@ def random_seeds(
     return Sightings(faces[free], side[free], origin[free], direction[free], points[free]), len(faces)
 
 
+def _int64(*arrays: np.ndarray) -> list[np.ndarray]:
+    return [np.ascontiguousarray(a, np.int64) for a in arrays]
+
+
+def _float64(*arrays: np.ndarray) -> list[np.ndarray]:
+    return [np.ascontiguousarray(a, np.float64) for a in arrays]
+
+
 def border_band(caster: RayCaster, region: Region, seen: Sightings) -> np.ndarray:
     """(k, 9, 3) points of the band around each seen face, in order around it.
 
@@ -240,41 +248,36 @@ def reverse_sampling(
     refused : int
         Mutated rays dropped because no viewer of the region lies on their line.
     """
-    soup = caster.soup
-    # only rays that ended on another face can have met an occluder
-    idx = np.flatnonzero(band.face != parent.face)
-    n_t = caster.normals[parent.face[idx]]
-    v0 = soup.triangles[parent.face[idx], 0]
-    o, d = band.origin[idx], band.direction[idx]
-    denom = np.einsum("ij,ij->i", d, n_t)
-    steep = np.abs(denom) > 1e-6
-    t_pred = np.full(len(idx), -np.inf)
-    t_pred[steep] = np.einsum("ij,ij->i", v0[steep] - o[steep], n_t[steep]) / denom[steep]
-    t_hit = np.einsum("ij,ij->i", band.point[idx] - o, d)
-    jump = t_pred - t_hit > DISCONTINUITY * caster.diagonal
-    if not jump.any():
+    # only rays that ended on another face can have met an occluder; of those, the ones
+    # stopped well before their parent face's plane (one compiled pass, numpy's arithmetic)
+    triangles = caster.soup.triangles
+    band_face, parent_face = _int64(band.face, parent.face)
+    b_origin, b_direction, b_point, p_point = _float64(band.origin, band.direction, band.point, parent.point)
+    idx, t_pred = _kernels.reverse_jumps(
+        band_face,
+        parent_face,
+        caster.normals,
+        triangles,
+        b_origin,
+        b_direction,
+        b_point,
+        DISCONTINUITY * caster.diagonal,
+    )
+    if len(idx) == 0:
         return Sightings.empty(), 0, 0
-    t_pred, idx = t_pred[jump], idx[jump]
-    hx, old, o, d = band.point[idx], parent.point[idx], band.origin[idx], band.direction[idx]
-    predicted = o + d * t_pred[:, None]
-    if region.at_infinity:
-        plane = np.cross(d, old - hx)
-    else:
-        plane = np.cross(hx - o, old - o)
-    plane = _unit(plane)
-    usable = np.linalg.norm(plane, axis=1) > 0
-    tri = soup.triangles[band.face[idx]]  # the occluder
-    s = np.einsum("kij,kj->ki", tri - hx[:, None, :], plane)
-    s_next = np.roll(s, -1, axis=1)
-    cross = (s * s_next < 0) & usable[:, None]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        frac = np.where(cross, s / (s - s_next), 0.0)
-    edge_point = tri + (np.roll(tri, -1, axis=1) - tri) * frac[:, :, None]  # (k, 3, 3)
-    step = _unit(edge_point - hx[:, None, :]) * (PASS_BY * caster.diagonal)
-    beside = (edge_point + step)[cross]
-    target = np.repeat(predicted, 3, axis=0).reshape(-1, 3, 3)[cross]
-    direction = _unit(target - beside)
-    ok_dir = np.linalg.norm(direction, axis=1) > 0
+    # just beyond each end of the occluder's cut by the plane of viewer ray and certificate
+    beside, direction, ok_dir = _kernels.reverse_rays(
+        idx,
+        t_pred,
+        band_face,
+        triangles,
+        b_origin,
+        b_direction,
+        b_point,
+        p_point,
+        bool(region.at_infinity),
+        PASS_BY * caster.diagonal,
+    )
     origin, ok = region.origin_on_line(beside, direction)
     ok &= ok_dir
     if not ok.any():
