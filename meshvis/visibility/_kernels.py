@@ -223,3 +223,70 @@ def reverse_rays(
             ok_dir[m] = _norm3(v0, v1, v2) > 0
             m += 1
     return beside[:m].copy(), out_dir[:m].copy(), ok_dir[:m].copy()
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def hit_rows(origin, direction, face, side, distance):  # pragma: no cover - compiled
+    """The rows of the rays that hit (``face >= 0``): face, side, origin, direction, point.
+
+    ``point = origin + direction * distance``, as :func:`meshvis.visibility.sampling.trace`
+    computes it.
+    """
+    n = 0
+    for i in range(len(face)):
+        if face[i] >= 0:
+            n += 1
+    out_face = np.empty(n, np.int64)
+    out_side = np.empty(n, np.int8)
+    out_o = np.empty((n, 3))
+    out_d = np.empty((n, 3))
+    out_p = np.empty((n, 3))
+    m = 0
+    for i in range(len(face)):
+        if face[i] < 0:
+            continue
+        out_face[m] = face[i]
+        out_side[m] = side[i]
+        t = distance[i]
+        for c in range(3):
+            out_o[m, c] = origin[i, c]
+            out_d[m, c] = direction[i, c]
+            out_p[m, c] = origin[i, c] + direction[i, c] * t
+        m += 1
+    return out_face, out_side, out_o, out_d, out_p
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def split_segments(owner, a_pt, b_pt, a_f, b_f, min_len):  # pragma: no cover - compiled
+    """The band edges to halve and their midpoints (one step of border sampling).
+
+    An edge is halved when its ends saw different faces and it is longer than ``min_len``
+    (``np.linalg.norm``); returns the kept rows of ``owner, a_pt, b_pt, a_f, b_f`` and the
+    midpoints ``0.5 * (a + b)``.
+    """
+    n = len(owner)
+    keep = np.empty(n, np.bool_)
+    m = 0
+    for i in range(n):
+        keep[i] = (a_f[i] != b_f[i]) and (
+            _norm3(b_pt[i, 0] - a_pt[i, 0], b_pt[i, 1] - a_pt[i, 1], b_pt[i, 2] - a_pt[i, 2]) > min_len
+        )
+        if keep[i]:
+            m += 1
+    o_owner = np.empty(m, owner.dtype)
+    o_af = np.empty(m, a_f.dtype)
+    o_bf = np.empty(m, b_f.dtype)
+    o_a = np.empty((m, 3))
+    o_b = np.empty((m, 3))
+    mid = np.empty((m, 3))
+    j = 0
+    for i in range(n):
+        if not keep[i]:
+            continue
+        o_owner[j], o_af[j], o_bf[j] = owner[i], a_f[i], b_f[i]
+        for c in range(3):
+            o_a[j, c] = a_pt[i, c]
+            o_b[j, c] = b_pt[i, c]
+            mid[j, c] = 0.5 * (a_pt[i, c] + b_pt[i, c])
+        j += 1
+    return o_owner, o_a, o_b, o_af, o_bf, mid

@@ -79,9 +79,15 @@ class Sightings:
 def trace(caster: RayCaster, origin: np.ndarray, direction: np.ndarray) -> tuple[Sightings, Hits]:
     """Trace viewer rays; the sightings of the rays that hit, and all the hits."""
     hits = caster.intersect(origin, direction)
-    hit = hits.hit
-    point = origin[hit] + direction[hit] * hits.distance[hit, None]
-    return Sightings(hits.face[hit], hits.side[hit], origin[hit], direction[hit], point), hits
+    # the hit rows and points ``origin + direction * distance`` in one pass
+    face, side, o, d, point = _kernels.hit_rows(
+        np.ascontiguousarray(origin, np.float64),
+        np.ascontiguousarray(direction, np.float64),
+        hits.face,
+        hits.side,
+        hits.distance,
+    )
+    return Sightings(face, side, o, d, point), hits
 
 
 def random_seeds(
@@ -204,13 +210,15 @@ def border_sampling(caster: RayCaster, region: Region, seen: Sightings) -> tuple
     a_f, b_f = ends, np.roll(ends, -1, axis=1)
     seg_owner = np.repeat(np.arange(k), 9)
     a_pt, b_pt, a_f, b_f = (x.reshape(len(seg_owner), *x.shape[2:]) for x in (a_pt, b_pt, a_f, b_f))
+    a_pt, b_pt = _float64(a_pt, b_pt)
+    a_f, b_f = _int64(a_f, b_f)
     min_len = MIN_SEGMENT * caster.diagonal
     for _ in range(MAX_DEPTH):
-        split = (a_f != b_f) & (np.linalg.norm(b_pt - a_pt, axis=1) > min_len)
-        if not split.any():
+        seg_owner, a_pt, b_pt, a_f, b_f, mid = _kernels.split_segments(
+            seg_owner, a_pt, b_pt, a_f, b_f, min_len
+        )
+        if len(seg_owner) == 0:
             break
-        seg_owner, a_pt, b_pt, a_f, b_f = (x[split] for x in (seg_owner, a_pt, b_pt, a_f, b_f))
-        mid = 0.5 * (a_pt + b_pt)
         m_f, found, n = _cast_targets(caster, region, seen, seg_owner, mid)
         collected.append(found)
         rays += n
@@ -229,7 +237,8 @@ def _cast_targets(caster, region, seen: Sightings, owner: np.ndarray, targets: n
     ray count.
     """
     origin, direction = region.border_origins(seen.origin[owner], seen.direction[owner], targets)
-    origin = np.broadcast_to(origin, targets.shape).copy()
+    if origin.shape != targets.shape:
+        origin = np.broadcast_to(origin, targets.shape).copy()
     found, hits = trace(caster, origin, direction)
     return hits.face, (found, owner[hits.hit]), len(targets)
 
