@@ -32,7 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from meshvis.errors import ParameterError
-from meshvis.rays.samples import uniform_sphere
+from meshvis.visibility import _kernels
 
 #: viewers at infinity start this many bounding-sphere radii beyond the sphere (any positive
 #: margin works; a small one keeps float32 round-off of the Embree scene small)
@@ -67,8 +67,12 @@ class Region:
 
     def far_origins(self, targets: np.ndarray, directions: np.ndarray) -> np.ndarray:
         """Origins beyond the bounding sphere on the lines ``targets - s * directions``, s > 0."""
-        reach = np.linalg.norm(targets - self.center, axis=1) + (1 + FAR_MARGIN) * self.radius
-        return targets - directions * reach[:, None]
+        return _kernels.far_origins(
+            np.ascontiguousarray(targets, np.float64),
+            np.ascontiguousarray(directions, np.float64),
+            np.asarray(self.center, np.float64),
+            (1 + FAR_MARGIN) * self.radius,
+        )
 
     # --------------------------------------------------------------- interface
     def seed_viewers(self, points: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
@@ -78,14 +82,15 @@ class Region:
 
     def _view_directions(self, n: int, rng: np.random.Generator) -> np.ndarray:
         """Unit directions from the model towards viewers at infinity."""
-        return uniform_sphere(n, rng)
+        return _uniform_sphere(n, rng)
 
     def border_origins(self, origin: np.ndarray, direction: np.ndarray, targets: np.ndarray):
         """Rays from the viewers of ``(origin, direction)`` towards ``targets``."""
         if self.at_infinity:
             return self.far_origins(targets, direction), direction
-        d = targets - origin
-        return origin, d / np.linalg.norm(d, axis=1, keepdims=True)
+        return origin, _kernels.aimed_from(
+            np.ascontiguousarray(origin, np.float64), np.ascontiguousarray(targets, np.float64)
+        )
 
     def origin_on_line(self, through: np.ndarray, direction: np.ndarray):
         """A viewer on each line ``through - s * direction`` (s > 0); ``(origins, ok)``."""
@@ -130,7 +135,7 @@ class UpperHemisphere(Region):
         self.up = up / norm
 
     def _view_directions(self, n, rng):
-        d = uniform_sphere(n, rng)
+        d = _uniform_sphere(n, rng)
         flip = d @ self.up < 0
         d[flip] -= 2 * np.outer(d[flip] @ self.up, self.up)
         return d
@@ -258,6 +263,11 @@ class CameraPath(Points):
             return np.repeat(self.points[:1], n, axis=0)
         which = rng.choice(len(seg), size=n, p=length / length.sum())
         return self.points[which] + rng.random(n)[:, None] * seg[which]
+
+
+def _uniform_sphere(n: int, rng: np.random.Generator) -> np.ndarray:
+    """:func:`meshvis.rays.samples.uniform_sphere` (the same draw and numbers), normalised in one pass."""
+    return _kernels.unit_rows(rng.normal(size=(n, 3)))
 
 
 def _aimed(origins: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

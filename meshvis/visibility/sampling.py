@@ -24,7 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshvis.rays.caster import Hits, RayCaster
-from meshvis.rays.samples import uniform_in_triangles
+from meshvis.visibility import _kernels
 from meshvis.visibility.regions import Region
 
 #: half-width of the band around a face, as a fraction of the diagonal (viewers at
@@ -79,9 +79,15 @@ class Sightings:
 def trace(caster: RayCaster, origin: np.ndarray, direction: np.ndarray) -> tuple[Sightings, Hits]:
     """Trace viewer rays; the sightings of the rays that hit, and all the hits."""
     hits = caster.intersect(origin, direction)
-    hit = hits.hit
-    point = origin[hit] + direction[hit] * hits.distance[hit, None]
-    return Sightings(hits.face[hit], hits.side[hit], origin[hit], direction[hit], point), hits
+    # the hit rows and points ``origin + direction * distance`` in one pass
+    face, side, o, d, point = _kernels.hit_rows(
+        np.ascontiguousarray(origin, np.float64),
+        np.ascontiguousarray(direction, np.float64),
+        hits.face,
+        hits.side,
+        hits.distance,
+    )
+    return Sightings(face, side, o, d, point), hits
 
 
 def random_seeds(
@@ -106,15 +112,39 @@ def random_seeds(
     rays : int
         Seeds traced.
     """
-    points = uniform_in_triangles(caster.soup.triangles[faces], rng)
+    # the two draws of uniform_in_triangles(caster.soup.triangles[faces], rng), without the gather
+    ru, rv = rng.random(len(faces)), rng.random(len(faces))
+    faces = np.asarray(faces, np.int64)
+    points = _kernels.points_in_faces(caster.soup.triangles, faces, ru, rv)
     origin, direction = region.seed_viewers(points, rng)
-    side = (np.einsum("ij,ij->i", direction, caster.normals[faces]) >= 0).astype(np.int8)
+    origin = np.ascontiguousarray(np.broadcast_to(origin, points.shape), np.float64)
+    direction = np.ascontiguousarray(direction, np.float64)
+    side = _kernels.facing_sides(direction, caster.normals, faces)
     if want is not None:
         keep = (want < 0) | (want == side)
         faces, side, points, origin, direction = (x[keep] for x in (faces, side, points, origin, direction))
-    blocked = caster.occluded(caster.push_off(points, faces, side), origin)
-    free = ~blocked
+    # caster.occluded(caster.push_off(points, faces, side), origin), prepared in one pass
+    o32, d32, dist, ok = _kernels.seed_segments(
+        points,
+        caster.normals,
+        faces,
+        side,
+        origin,
+        np.asarray(caster.center, np.float64),
+        float(caster.scale),
+        float(caster.offset),
+        float(caster.diagonal),
+    )
+    free = ~(caster.occluded_queries(o32, d32, dist) & ok)
     return Sightings(faces[free], side[free], origin[free], direction[free], points[free]), len(faces)
+
+
+def _int64(*arrays: np.ndarray) -> list[np.ndarray]:
+    return [np.ascontiguousarray(a, np.int64) for a in arrays]
+
+
+def _float64(*arrays: np.ndarray) -> list[np.ndarray]:
+    return [np.ascontiguousarray(a, np.float64) for a in arrays]
 
 
 def border_band(caster: RayCaster, region: Region, seen: Sightings) -> np.ndarray:
@@ -180,13 +210,15 @@ def border_sampling(caster: RayCaster, region: Region, seen: Sightings) -> tuple
     a_f, b_f = ends, np.roll(ends, -1, axis=1)
     seg_owner = np.repeat(np.arange(k), 9)
     a_pt, b_pt, a_f, b_f = (x.reshape(len(seg_owner), *x.shape[2:]) for x in (a_pt, b_pt, a_f, b_f))
+    a_pt, b_pt = _float64(a_pt, b_pt)
+    a_f, b_f = _int64(a_f, b_f)
     min_len = MIN_SEGMENT * caster.diagonal
     for _ in range(MAX_DEPTH):
-        split = (a_f != b_f) & (np.linalg.norm(b_pt - a_pt, axis=1) > min_len)
-        if not split.any():
+        seg_owner, a_pt, b_pt, a_f, b_f, mid = _kernels.split_segments(
+            seg_owner, a_pt, b_pt, a_f, b_f, min_len
+        )
+        if len(seg_owner) == 0:
             break
-        seg_owner, a_pt, b_pt, a_f, b_f = (x[split] for x in (seg_owner, a_pt, b_pt, a_f, b_f))
-        mid = 0.5 * (a_pt + b_pt)
         m_f, found, n = _cast_targets(caster, region, seen, seg_owner, mid)
         collected.append(found)
         rays += n
@@ -205,7 +237,8 @@ def _cast_targets(caster, region, seen: Sightings, owner: np.ndarray, targets: n
     ray count.
     """
     origin, direction = region.border_origins(seen.origin[owner], seen.direction[owner], targets)
-    origin = np.broadcast_to(origin, targets.shape).copy()
+    if origin.shape != targets.shape:
+        origin = np.broadcast_to(origin, targets.shape).copy()
     found, hits = trace(caster, origin, direction)
     return hits.face, (found, owner[hits.hit]), len(targets)
 
@@ -224,41 +257,36 @@ def reverse_sampling(
     refused : int
         Mutated rays dropped because no viewer of the region lies on their line.
     """
-    soup = caster.soup
-    # only rays that ended on another face can have met an occluder
-    idx = np.flatnonzero(band.face != parent.face)
-    n_t = caster.normals[parent.face[idx]]
-    v0 = soup.triangles[parent.face[idx], 0]
-    o, d = band.origin[idx], band.direction[idx]
-    denom = np.einsum("ij,ij->i", d, n_t)
-    steep = np.abs(denom) > 1e-6
-    t_pred = np.full(len(idx), -np.inf)
-    t_pred[steep] = np.einsum("ij,ij->i", v0[steep] - o[steep], n_t[steep]) / denom[steep]
-    t_hit = np.einsum("ij,ij->i", band.point[idx] - o, d)
-    jump = t_pred - t_hit > DISCONTINUITY * caster.diagonal
-    if not jump.any():
+    # only rays that ended on another face can have met an occluder; of those, the ones
+    # stopped well before their parent face's plane (one compiled pass, numpy's arithmetic)
+    triangles = caster.soup.triangles
+    band_face, parent_face = _int64(band.face, parent.face)
+    b_origin, b_direction, b_point, p_point = _float64(band.origin, band.direction, band.point, parent.point)
+    idx, t_pred = _kernels.reverse_jumps(
+        band_face,
+        parent_face,
+        caster.normals,
+        triangles,
+        b_origin,
+        b_direction,
+        b_point,
+        DISCONTINUITY * caster.diagonal,
+    )
+    if len(idx) == 0:
         return Sightings.empty(), 0, 0
-    t_pred, idx = t_pred[jump], idx[jump]
-    hx, old, o, d = band.point[idx], parent.point[idx], band.origin[idx], band.direction[idx]
-    predicted = o + d * t_pred[:, None]
-    if region.at_infinity:
-        plane = np.cross(d, old - hx)
-    else:
-        plane = np.cross(hx - o, old - o)
-    plane = _unit(plane)
-    usable = np.linalg.norm(plane, axis=1) > 0
-    tri = soup.triangles[band.face[idx]]  # the occluder
-    s = np.einsum("kij,kj->ki", tri - hx[:, None, :], plane)
-    s_next = np.roll(s, -1, axis=1)
-    cross = (s * s_next < 0) & usable[:, None]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        frac = np.where(cross, s / (s - s_next), 0.0)
-    edge_point = tri + (np.roll(tri, -1, axis=1) - tri) * frac[:, :, None]  # (k, 3, 3)
-    step = _unit(edge_point - hx[:, None, :]) * (PASS_BY * caster.diagonal)
-    beside = (edge_point + step)[cross]
-    target = np.repeat(predicted, 3, axis=0).reshape(-1, 3, 3)[cross]
-    direction = _unit(target - beside)
-    ok_dir = np.linalg.norm(direction, axis=1) > 0
+    # just beyond each end of the occluder's cut by the plane of viewer ray and certificate
+    beside, direction, ok_dir = _kernels.reverse_rays(
+        idx,
+        t_pred,
+        band_face,
+        triangles,
+        b_origin,
+        b_direction,
+        b_point,
+        p_point,
+        bool(region.at_infinity),
+        PASS_BY * caster.diagonal,
+    )
     origin, ok = region.origin_on_line(beside, direction)
     ok &= ok_dir
     if not ok.any():
