@@ -5,7 +5,8 @@ as (faces, rays, 3) float64 arrays, then :meth:`RayCaster.occluded` read them ag
 of the evidence stage was that memory traffic, not Embree.  This kernel takes the random
 numbers from the caller (drawn in the same order as before) and writes the Embree inputs
 directly, evaluating the same expressions in the same order, so that the counts are bit
-for bit those of the numpy version.
+for bit those of the numpy version (numpy's ``einsum`` over three columns adds the middle
+product last: ``(a0*b0 + a2*b2) + a1*b1``, see :mod:`meshvis.visibility._kernels`).
 """
 
 from __future__ import annotations
@@ -54,7 +55,8 @@ def escape_queries(
             length = math.sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2])
             for j in range(3):
                 d[j] = g[j] / length
-            along = d[0] * n[0] + d[1] * n[1] + d[2] * n[2]
+            # np.einsum("krj,kj->kr") adds the middle product last
+            along = (d[0] * n[0] + d[2] * n[2]) + d[1] * n[1]
             if through[f] >= 0 and (along < 0) != (through[f] == 1):
                 for j in range(3):
                     d[j] *= -1.0
