@@ -99,3 +99,51 @@ def segment_queries(origins, targets, center, scale, offset):  # pragma: no cove
     for k in numba.prange(len(origins)):
         segment_query(k, origins[k], targets[k], center, scale, offset, o32, d32, dist, ok)
     return o32, d32, dist, ok
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def ray_queries(origins, directions, center, scale):  # pragma: no cover - compiled
+    """Embree inputs of the rays ``origins + t * directions`` (:meth:`RayCaster.intersect`).
+
+    Returns the float64 unit directions ``d / sqrt(einsum("ij,ij->i", d, d))`` (numpy's
+    einsum adds the middle square last; a zero direction gives NaN, which the caller
+    refuses), their float32 copy and the float32 origins in scene coordinates.
+    """
+    n = len(origins)
+    unit = np.empty((n, 3))
+    o32 = np.empty((n, 3), np.float32)
+    d32 = np.empty((n, 3), np.float32)
+    for k in numba.prange(n):
+        d0, d1, d2 = directions[k, 0], directions[k, 1], directions[k, 2]
+        length = math.sqrt((d0 * d0 + d2 * d2) + d1 * d1)
+        unit[k, 0], unit[k, 1], unit[k, 2] = d0 / length, d1 / length, d2 / length
+        for c in range(3):
+            d32[k, c] = unit[k, c]
+            o32[k, c] = (origins[k, c] - center[c]) * scale
+    return unit, o32, d32
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def hit_results(prim, tfar, ng, unit, scale):  # pragma: no cover - compiled
+    """Face (int64, -1 for a miss), distance (input units, inf for a miss) and side of each hit.
+
+    ``side`` is 0 where ``einsum("ij,ij->i", unit, Ng) < 0`` (the ray met the front), 1
+    where it is not, -1 for a miss.
+    """
+    n = len(prim)
+    face = np.empty(n, np.int64)
+    distance = np.empty(n)
+    side = np.empty(n, np.int8)
+    for k in numba.prange(n):
+        f = prim[k]
+        face[k] = f
+        if f >= 0:
+            distance[k] = np.float64(tfar[k]) / scale
+            dot = (unit[k, 0] * np.float64(ng[k, 0]) + unit[k, 2] * np.float64(ng[k, 2])) + unit[
+                k, 1
+            ] * np.float64(ng[k, 1])
+            side[k] = 1 if dot >= 0 else 0
+        else:
+            distance[k] = np.inf
+            side[k] = -1
+    return face, distance, side

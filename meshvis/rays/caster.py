@@ -165,12 +165,6 @@ class RayCaster:
         """Input coordinates -> normalised float32 coordinates of the Embree scene."""
         return ((np.asarray(points, np.float64) - self.center) * self.scale).astype(np.float32)
 
-    @staticmethod
-    def _unit_dirs(directions: np.ndarray) -> np.ndarray:
-        d = np.asarray(directions, np.float64)
-        with np.errstate(invalid="ignore", divide="ignore"):  # a zero direction: NaN, refused by the caller
-            return d / np.sqrt(np.einsum("ij,ij->i", d, d))[:, None]
-
     # ------------------------------------------------------------------ raw calls
     def _run(self, o32: np.ndarray, d32: np.ndarray, query: str, dists: np.ndarray | None = None) -> Any:
         """One Embree query over a batch, split over threads when it is large."""
@@ -242,21 +236,29 @@ class RayCaster:
             ``side`` is 0 where ``dot(direction, normal) < 0`` (the ray met the front).
         """
         origins, directions = _validate.ray_arrays(origins, directions)
-        d = _validate.unit_directions(self._unit_dirs(directions))
+        d, o32, d32 = _kernels.ray_queries(
+            np.ascontiguousarray(origins, np.float64),
+            np.ascontiguousarray(directions, np.float64),
+            np.asarray(self.center, np.float64),
+            float(self.scale),
+        )
+        d = _validate.unit_directions(d)
         dists = None
         if max_distance is not None:
             max_distance = _validate.max_distance(max_distance, len(origins))
             dists = np.broadcast_to(
                 np.asarray(max_distance, np.float64) * self.scale, (len(origins),)
             ).astype(np.float32)
-        r = self._run(self.to_unit(origins), d.astype(np.float32), "INTERSECT", dists)
-        face = r["primID"].astype(np.int64)
-        hit = face >= 0
-        distance = np.full(len(face), np.inf)
-        distance[hit] = r["tfar"][hit].astype(np.float64) / self.scale
+        r = self._run(o32, d32, "INTERSECT", dists)
         # side from Embree's geometric normal, which points like ours (counter-clockwise)
-        dots = np.einsum("ij,ij->i", d, r["Ng"])
-        side = np.where(hit, dots >= 0, -1).astype(np.int8)
+        face, distance, side = _kernels.hit_results(
+            np.ascontiguousarray(r["primID"]),
+            np.ascontiguousarray(r["tfar"]),
+            np.ascontiguousarray(r["Ng"]),
+            d,
+            float(self.scale),
+        )
+        hit = face >= 0
         if exact_distance and hit.any():
             # Refine in float64 on the hit triangle's plane (not for grazing hits).
             idx = np.flatnonzero(hit)
