@@ -7,6 +7,15 @@ each face's data once per ray and write the result directly.  They take the rand
 numbers from the caller (drawn from the same generator, in the same order as before) and
 evaluate the same expressions in the same order, without fused multiply-adds, so their
 output is bit for bit that of the numpy expressions they replace.
+
+The inline helpers below are shared by every kernel module of the package (rays, repair,
+visibility), so that each numpy summation order is written once:
+
+* ``np.linalg.norm(x, axis=1)`` sums the squares left to right (:func:`norm3`);
+* ``np.einsum("ij,ij->i", a, b)`` over 3 columns adds the middle product last,
+  ``(a0*b0 + a2*b2) + a1*b1`` (:func:`einsum_dot3`; numpy's baseline loop, the same with
+  AVX, AVX2 and AVX-512 switched off);
+* the square-root warp of ``uniform_in_triangles`` (:func:`warp_weights`).
 """
 
 from __future__ import annotations
@@ -15,6 +24,52 @@ import math
 
 import numba
 import numpy as np
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def norm3(x0, x1, x2):  # pragma: no cover - compiled
+    """``np.linalg.norm`` of one 3-vector."""
+    return math.sqrt((x0 * x0 + x1 * x1) + x2 * x2)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def einsum_dot3(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
+    """``np.einsum("ij,ij->i", a, b)`` of one row (numpy adds the middle product last)."""
+    return (a0 * b0 + a2 * b2) + a1 * b1
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def warp_weights(ru, rv):  # pragma: no cover - compiled
+    """Corner weights ``(1-√u, √u (1-v), √u v)`` of the square-root warp from its two uniforms.
+
+    A point is then ``wa * a + wb * b + wc * c`` (left to right, as numpy evaluates it).
+    """
+    u = math.sqrt(ru)
+    return 1 - u, u * (1 - rv), u * rv
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def unit_rows(d):  # pragma: no cover - compiled
+    """(n, 3) ``d / np.linalg.norm(d, axis=1, keepdims=True)``."""
+    out = np.empty_like(d)
+    for k in numba.prange(len(d)):
+        n = norm3(d[k, 0], d[k, 1], d[k, 2])
+        for c in range(3):
+            out[k, c] = d[k, c] / n
+    return out
+
+
+@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
+def points_in_faces(triangles, face, ru, rv):  # pragma: no cover - compiled
+    """(n, 3) ``uniform_in_triangles(triangles[face], rng)`` from its two draws ``ru, rv``."""
+    out = np.empty((len(face), 3))
+    for k in numba.prange(len(face)):
+        f = face[k]
+        wa, wb, wc = warp_weights(ru[k], rv[k])
+        for c in range(3):
+            out[k, c] = wa * triangles[f, 0, c] + wb * triangles[f, 1, c] + wc * triangles[f, 2, c]
+    return out
+
 
 #: 2π as the numpy expression ``2 * np.pi * xi`` evaluates it (the product first)
 TWO_PI = 2 * math.pi
@@ -52,9 +107,7 @@ def pushed_points(triangles, normals, face, flip, ru, rv, offset):  # pragma: no
     for k in numba.prange(len(face)):
         f = face[k]
         sgn = -1.0 if flip[k] else 1.0
-        u = math.sqrt(ru[k])
-        v = rv[k]
-        wa, wb, wc = 1 - u, u * (1 - v), u * v
+        wa, wb, wc = warp_weights(ru[k], rv[k])
         for c in range(3):
             p = wa * triangles[f, 0, c] + wb * triangles[f, 1, c] + wc * triangles[f, 2, c]
             out[k, c] = p + offset * (normals[f, c] * sgn)
@@ -65,7 +118,7 @@ def pushed_points(triangles, normals, face, flip, ru, rv, offset):  # pragma: no
 def segment_query(k, o, t, center, scale, offset, o32, d32, dist, ok):  # pragma: no cover - compiled
     """Row k of :func:`segment_queries` for the segment from point ``o`` to point ``t`` (3 scalars each)."""
     s0, s1, s2 = t[0] - o[0], t[1] - o[1], t[2] - o[2]
-    length = math.sqrt(s0 * s0 + s1 * s1 + s2 * s2)
+    length = norm3(s0, s1, s2)
     ok[k] = length > 0
     if length > 0:
         d32[k, 0], d32[k, 1], d32[k, 2] = s0 / length, s1 / length, s2 / length
@@ -115,7 +168,7 @@ def ray_queries(origins, directions, center, scale):  # pragma: no cover - compi
     d32 = np.empty((n, 3), np.float32)
     for k in numba.prange(n):
         d0, d1, d2 = directions[k, 0], directions[k, 1], directions[k, 2]
-        length = math.sqrt((d0 * d0 + d2 * d2) + d1 * d1)
+        length = math.sqrt(einsum_dot3(d0, d1, d2, d0, d1, d2))
         unit[k, 0], unit[k, 1], unit[k, 2] = d0 / length, d1 / length, d2 / length
         for c in range(3):
             d32[k, c] = unit[k, c]
@@ -139,9 +192,8 @@ def hit_results(prim, tfar, ng, unit, scale):  # pragma: no cover - compiled
         face[k] = f
         if f >= 0:
             distance[k] = np.float64(tfar[k]) / scale
-            dot = (unit[k, 0] * np.float64(ng[k, 0]) + unit[k, 2] * np.float64(ng[k, 2])) + unit[
-                k, 1
-            ] * np.float64(ng[k, 1])
+            g0, g1, g2 = np.float64(ng[k, 0]), np.float64(ng[k, 1]), np.float64(ng[k, 2])
+            dot = einsum_dot3(unit[k, 0], unit[k, 1], unit[k, 2], g0, g1, g2)
             side[k] = 1 if dot >= 0 else 0
         else:
             distance[k] = np.inf

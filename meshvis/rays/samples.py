@@ -175,8 +175,7 @@ def tangent_frames(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def uniform_sphere(n: int, rng: np.random.Generator) -> np.ndarray:
     """``n`` uniform unit directions."""
-    d = rng.normal(size=(n, 3))
-    return d / np.linalg.norm(d, axis=1, keepdims=True)
+    return _kernels.unit_rows(rng.normal(size=(n, 3)))
 
 
 def sample_scheme_barycentric(

@@ -5,18 +5,16 @@ as (faces, rays, 3) float64 arrays, then :meth:`RayCaster.occluded` read them ag
 of the evidence stage was that memory traffic, not Embree.  This kernel takes the random
 numbers from the caller (drawn in the same order as before) and writes the Embree inputs
 directly, evaluating the same expressions in the same order, so that the counts are bit
-for bit those of the numpy version (numpy's ``einsum`` over three columns adds the middle
-product last: ``(a0*b0 + a2*b2) + a1*b1``, see :mod:`meshvis.visibility._kernels`).
+for bit those of the numpy version (the summation orders are the helpers of
+:mod:`meshvis.rays._kernels`).
 """
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 
-from meshvis.rays._kernels import query_buffers, segment_query
+from meshvis.rays._kernels import einsum_dot3, norm3, query_buffers, segment_query, warp_weights
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
@@ -52,11 +50,10 @@ def escape_queries(
         for r in range(rays):
             row = f * rays + r
             g = gauss[row]
-            length = math.sqrt(g[0] * g[0] + g[1] * g[1] + g[2] * g[2])
+            length = norm3(g[0], g[1], g[2])
             for j in range(3):
                 d[j] = g[j] / length
-            # np.einsum("krj,kj->kr") adds the middle product last
-            along = (d[0] * n[0] + d[2] * n[2]) + d[1] * n[1]
+            along = einsum_dot3(d[0], d[1], d[2], n[0], n[1], n[2])  # np.einsum("krj,kj->kr")
             if through[f] >= 0 and (along < 0) != (through[f] == 1):
                 for j in range(3):
                     d[j] *= -1.0
@@ -64,9 +61,7 @@ def escape_queries(
             bk = along < 0
             back[row] = bk
             shift = -push if bk else push
-            u = math.sqrt(ru[f, r])
-            v = rv[f, r]
-            wa, wb, wc = 1 - u, u * (1 - v), u * v
+            wa, wb, wc = warp_weights(ru[f, r], rv[f, r])
             for j in range(3):
                 o[j] = (wa * a[j] + wb * b[j] + wc * c[j]) + n[j] * shift
                 t[j] = o[j] + d[j] * reach

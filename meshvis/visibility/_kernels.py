@@ -13,52 +13,16 @@ thousands of times per search on batches of a few thousand rays, where starting 
 thread pool costs more than the loop: they are serial.  The seed kernels run once per
 chunk of up to a million rays and are parallel.
 
-Summation orders replicated:
-
-* ``np.linalg.norm(x, axis=1)`` sums the squares left to right: ``sqrt((x0*x0 + x1*x1) + x2*x2)``;
-* ``np.einsum("ij,ij->i", a, b)`` over 3 columns adds the middle product last:
-  ``(a0*b0 + a2*b2) + a1*b1`` (numpy's unrolled loop; checked on a million random rows).
+The summation orders of numpy's norm and einsum are the helpers of
+:mod:`meshvis.rays._kernels`.
 """
 
 from __future__ import annotations
 
-import math
-
 import numba
 import numpy as np
 
-from meshvis.rays._kernels import query_buffers, segment_query
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def _norm3(x0, x1, x2):  # pragma: no cover - compiled
-    """``np.linalg.norm`` of one 3-vector."""
-    return math.sqrt((x0 * x0 + x1 * x1) + x2 * x2)
-
-
-@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def points_in_faces(triangles, face, ru, rv):  # pragma: no cover - compiled
-    """(n, 3) ``uniform_in_triangles(triangles[face], rng)`` from its two draws ``ru, rv``."""
-    out = np.empty((len(face), 3))
-    for k in numba.prange(len(face)):
-        f = face[k]
-        u = math.sqrt(ru[k])
-        v = rv[k]
-        wa, wb, wc = 1 - u, u * (1 - v), u * v
-        for c in range(3):
-            out[k, c] = (wa * triangles[f, 0, c] + wb * triangles[f, 1, c]) + wc * triangles[f, 2, c]
-    return out
-
-
-@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def unit_rows(d):  # pragma: no cover - compiled
-    """(n, 3) ``d / np.linalg.norm(d, axis=1, keepdims=True)``."""
-    out = np.empty_like(d)
-    for k in numba.prange(len(d)):
-        n = _norm3(d[k, 0], d[k, 1], d[k, 2])
-        for c in range(3):
-            out[k, c] = d[k, c] / n
-    return out
+from meshvis.rays._kernels import einsum_dot3, norm3, query_buffers, segment_query
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -67,7 +31,7 @@ def far_origins(targets, directions, center, margin):  # pragma: no cover - comp
     out = np.empty_like(targets)
     for k in range(len(targets)):
         reach = (
-            _norm3(targets[k, 0] - center[0], targets[k, 1] - center[1], targets[k, 2] - center[2]) + margin
+            norm3(targets[k, 0] - center[0], targets[k, 1] - center[1], targets[k, 2] - center[2]) + margin
         )
         for c in range(3):
             out[k, c] = targets[k, c] - directions[k, c] * reach
@@ -82,7 +46,7 @@ def aimed_from(origins, targets):  # pragma: no cover - compiled
         d0 = targets[k, 0] - origins[k, 0]
         d1 = targets[k, 1] - origins[k, 1]
         d2 = targets[k, 2] - origins[k, 2]
-        n = _norm3(d0, d1, d2)
+        n = norm3(d0, d1, d2)
         out[k, 0], out[k, 1], out[k, 2] = d0 / n, d1 / n, d2 / n
     return out
 
@@ -93,9 +57,9 @@ def facing_sides(directions, normals, face):  # pragma: no cover - compiled
     out = np.empty(len(face), np.int8)
     for k in numba.prange(len(face)):
         f = face[k]
-        dot = (directions[k, 0] * normals[f, 0] + directions[k, 2] * normals[f, 2]) + directions[
-            k, 1
-        ] * normals[f, 1]
+        dot = einsum_dot3(
+            directions[k, 0], directions[k, 1], directions[k, 2], normals[f, 0], normals[f, 1], normals[f, 2]
+        )
         out[k] = 1 if dot >= 0 else 0
     return out
 
@@ -116,12 +80,6 @@ def seed_segments(points, normals, face, side, viewers, center, scale, offset, d
             pushed[k, c] = points[k, c] + normals[f, c] * s
         segment_query(k, pushed[k], viewers[k], center, scale, offset, o32, d32, dist, ok)
     return o32, d32, dist, ok
-
-
-@numba.njit(cache=True, nogil=True, inline="always")
-def _dot3(a0, a1, a2, b0, b1, b2):  # pragma: no cover - compiled
-    """``np.einsum("ij,ij->i", a, b)`` of one row (numpy adds the middle product last)."""
-    return (a0 * b0 + a2 * b2) + a1 * b1
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
@@ -150,12 +108,12 @@ def reverse_jumps(
         n0, n1, n2 = normals[f, 0], normals[f, 1], normals[f, 2]
         o0, o1, o2 = origin[i, 0], origin[i, 1], origin[i, 2]
         d0, d1, d2 = direction[i, 0], direction[i, 1], direction[i, 2]
-        denom = _dot3(d0, d1, d2, n0, n1, n2)
+        denom = einsum_dot3(d0, d1, d2, n0, n1, n2)
         t_pred = -np.inf
         if abs(denom) > 1e-6:
             w0, w1, w2 = triangles[f, 0, 0] - o0, triangles[f, 0, 1] - o1, triangles[f, 0, 2] - o2
-            t_pred = _dot3(w0, w1, w2, n0, n1, n2) / denom
-        t_hit = _dot3(point[i, 0] - o0, point[i, 1] - o1, point[i, 2] - o2, d0, d1, d2)
+            t_pred = einsum_dot3(w0, w1, w2, n0, n1, n2) / denom
+        t_hit = einsum_dot3(point[i, 0] - o0, point[i, 1] - o1, point[i, 2] - o2, d0, d1, d2)
         if t_pred - t_hit > threshold:
             idx[m] = i
             t_out[m] = t_pred
@@ -195,13 +153,13 @@ def reverse_rays(
             b0, b1, b2 = parent_point[i, 0] - o0, parent_point[i, 1] - o1, parent_point[i, 2] - o2
         # np.cross, then _unit
         p0, p1, p2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-        g = _guard(_norm3(p0, p1, p2))
+        g = _guard(norm3(p0, p1, p2))
         p0, p1, p2 = p0 / g, p1 / g, p2 / g
-        if not _norm3(p0, p1, p2) > 0:
+        if not norm3(p0, p1, p2) > 0:
             continue
         f = band_face[i]
         for e in range(3):
-            s[e] = _dot3(
+            s[e] = einsum_dot3(
                 triangles[f, e, 0] - h0, triangles[f, e, 1] - h1, triangles[f, e, 2] - h2, p0, p1, p2
             )
         for e in range(3):
@@ -213,14 +171,14 @@ def reverse_rays(
             x1 = triangles[f, e, 1] + (triangles[f, en, 1] - triangles[f, e, 1]) * frac
             x2 = triangles[f, e, 2] + (triangles[f, en, 2] - triangles[f, e, 2]) * frac
             u0, u1, u2 = x0 - h0, x1 - h1, x2 - h2
-            g = _guard(_norm3(u0, u1, u2))
+            g = _guard(norm3(u0, u1, u2))
             y0, y1, y2 = x0 + u0 / g * pass_by, x1 + u1 / g * pass_by, x2 + u2 / g * pass_by
             beside[m, 0], beside[m, 1], beside[m, 2] = y0, y1, y2
             v0, v1, v2 = q0 - y0, q1 - y1, q2 - y2
-            g = _guard(_norm3(v0, v1, v2))
+            g = _guard(norm3(v0, v1, v2))
             v0, v1, v2 = v0 / g, v1 / g, v2 / g
             out_dir[m, 0], out_dir[m, 1], out_dir[m, 2] = v0, v1, v2
-            ok_dir[m] = _norm3(v0, v1, v2) > 0
+            ok_dir[m] = norm3(v0, v1, v2) > 0
             m += 1
     return beside[:m].copy(), out_dir[:m].copy(), ok_dir[:m].copy()
 
@@ -269,7 +227,7 @@ def split_segments(owner, a_pt, b_pt, a_f, b_f, min_len):  # pragma: no cover - 
     m = 0
     for i in range(n):
         keep[i] = (a_f[i] != b_f[i]) and (
-            _norm3(b_pt[i, 0] - a_pt[i, 0], b_pt[i, 1] - a_pt[i, 1], b_pt[i, 2] - a_pt[i, 2]) > min_len
+            norm3(b_pt[i, 0] - a_pt[i, 0], b_pt[i, 1] - a_pt[i, 1], b_pt[i, 2] - a_pt[i, 2]) > min_len
         )
         if keep[i]:
             m += 1

@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from meshvis.errors import ParameterError
+from meshvis.rays.samples import uniform_sphere
 from meshvis.visibility import _kernels
 
 #: viewers at infinity start this many bounding-sphere radii beyond the sphere (any positive
@@ -82,7 +83,7 @@ class Region:
 
     def _view_directions(self, n: int, rng: np.random.Generator) -> np.ndarray:
         """Unit directions from the model towards viewers at infinity."""
-        return _uniform_sphere(n, rng)
+        return uniform_sphere(n, rng)
 
     def border_origins(self, origin: np.ndarray, direction: np.ndarray, targets: np.ndarray):
         """Rays from the viewers of ``(origin, direction)`` towards ``targets``."""
@@ -135,7 +136,7 @@ class UpperHemisphere(Region):
         self.up = up / norm
 
     def _view_directions(self, n, rng):
-        d = _uniform_sphere(n, rng)
+        d = uniform_sphere(n, rng)
         flip = d @ self.up < 0
         d[flip] -= 2 * np.outer(d[flip] @ self.up, self.up)
         return d
@@ -263,11 +264,6 @@ class CameraPath(Points):
             return np.repeat(self.points[:1], n, axis=0)
         which = rng.choice(len(seg), size=n, p=length / length.sum())
         return self.points[which] + rng.random(n)[:, None] * seg[which]
-
-
-def _uniform_sphere(n: int, rng: np.random.Generator) -> np.ndarray:
-    """:func:`meshvis.rays.samples.uniform_sphere` (the same draw and numbers), normalised in one pass."""
-    return _kernels.unit_rows(rng.normal(size=(n, 3)))
 
 
 def _aimed(origins: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

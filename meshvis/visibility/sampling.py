@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from meshvis.rays import _kernels as ray_kernels
 from meshvis.rays.caster import Hits, RayCaster
 from meshvis.visibility import _kernels
 from meshvis.visibility.regions import Region
@@ -115,7 +116,7 @@ def random_seeds(
     # the two draws of uniform_in_triangles(caster.soup.triangles[faces], rng), without the gather
     ru, rv = rng.random(len(faces)), rng.random(len(faces))
     faces = np.asarray(faces, np.int64)
-    points = _kernels.points_in_faces(caster.soup.triangles, faces, ru, rv)
+    points = ray_kernels.points_in_faces(caster.soup.triangles, faces, ru, rv)
     origin, direction = region.seed_viewers(points, rng)
     origin = np.ascontiguousarray(np.broadcast_to(origin, points.shape), np.float64)
     direction = np.ascontiguousarray(direction, np.float64)

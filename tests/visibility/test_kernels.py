@@ -33,13 +33,13 @@ def test_points_in_faces_are_uniform_in_triangles(data):
     expected = uniform_in_triangles(tri[face], np.random.default_rng(1))
     rng = np.random.default_rng(1)
     ru, rv = rng.random(len(face)), rng.random(len(face))
-    _bytes_equal(_kernels.points_in_faces(tri, face, ru, rv), expected)
+    _bytes_equal(ray_kernels.points_in_faces(tri, face, ru, rv), expected)
 
 
 def test_unit_rows_far_origins_and_aimed_directions(data):
     x, y, _, _ = data
     _bytes_equal(
-        _kernels.unit_rows(np.random.default_rng(2).normal(size=(ROWS, 3))),
+        ray_kernels.unit_rows(np.random.default_rng(2).normal(size=(ROWS, 3))),
         uniform_sphere(ROWS, np.random.default_rng(2)),
     )
     center, margin = np.array([0.3, -2.0, 5.0]), 1.05 * 17.0
