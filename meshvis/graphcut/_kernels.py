@@ -1,15 +1,24 @@
-"""Numba kernel of the hit snapping of :func:`meshvis.graphcut.sampling.snap_to_points`.
+"""Numba kernels of the graph cut's nodes and sampling.
 
-The numpy version made one pass over all hits per sample point, with (hits,) temporaries
-for each term of the distance; this kernel keeps the running best per hit in registers.
-It evaluates the same quadratic form in the same order, with the same tie rule (the first
-sample wins), so its choice is bit for bit that of the numpy version.
+* :func:`nearest_sample`, the hit snapping of :func:`meshvis.graphcut.sampling.snap_to_points`:
+  the numpy version made one pass over all hits per sample point, with (hits,) temporaries
+  for each term of the distance; this kernel keeps the running best per hit in registers.
+* :func:`pushed_origins`, the ray origins of sample points that lie on a partner triangle
+  (:func:`meshvis.graphcut.nodes.build_nodes`): the numpy version built (candidates, 3)
+  arrays for every (sample point, partner) candidate and sorted them.
+
+Both evaluate the same expressions in the same order as the numpy versions they replace,
+with the same tie rules, so their output is bit for bit the same.
 """
 
 from __future__ import annotations
 
+import math
+
 import numba
 import numpy as np
+
+from meshvis.rays._kernels import einsum_dot3
 
 
 @numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
@@ -32,3 +41,174 @@ def nearest_sample(metric, u, v, sample_u, sample_v):  # pragma: no cover - comp
                 best[k] = s
                 best_d2 = d2
     return best
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _sign(x):  # pragma: no cover - compiled
+    """``np.sign`` of one float (NaN stays NaN)."""
+    if x > 0:
+        return 1.0
+    if x < 0:
+        return -1.0
+    return x  # 0.0, -0.0 or NaN, as np.sign gives them
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _max_nan(a, b):  # pragma: no cover - compiled
+    """``np.maximum`` of two floats (a NaN wins)."""
+    if a != a or b != b:
+        return math.nan
+    return a if a >= b else b
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _at_least(move, best):  # pragma: no cover - compiled
+    """Whether ``move`` comes at or after ``best`` in numpy's sort order (NaN last)."""
+    if move != move:
+        return True
+    if best != best:
+        return False
+    return move >= best
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def pushed_origins(
+    pos, point_face, side, triangles, normals, flagged_index, f, g, samples, offset, proximity, square_cos
+):  # pragma: no cover - compiled  # noqa: E501
+    """(P, 3) origins of :func:`meshvis.graphcut.nodes._pushed_origins` on one side.
+
+    ``f, g`` are the (face, partner) candidates in the numpy version's order (the pairs,
+    then the pairs reversed, keeping those whose first face is flagged); every sample point
+    of ``f`` is tested against ``g``.  Among the partners a point lies on, the one with the
+    furthest move wins, the last one on ties (the numpy version's stable sort).
+    """
+    n_points = len(pos)
+    sgn = 1.0 if side == 0 else -1.0
+    origin = np.empty((n_points, 3))
+    ns = np.empty((n_points, 3))
+    for k in range(n_points):
+        for c in range(3):
+            ns[k, c] = normals[point_face[k], c] * sgn
+            origin[k, c] = pos[k, c] + offset * ns[k, c]
+    best_move = np.zeros(n_points)
+    best_orient = np.zeros(n_points)
+    best_g = np.full(n_points, -1, np.int64)
+    for e in range(len(f)):
+        gg = g[e]
+        n0, n1, n2 = normals[gg, 0], normals[gg, 1], normals[gg, 2]
+        a0, a1, a2 = triangles[gg, 0, 0], triangles[gg, 0, 1], triangles[gg, 0, 2]
+        v00, v01, v02 = triangles[gg, 1, 0] - a0, triangles[gg, 1, 1] - a1, triangles[gg, 1, 2] - a2
+        v10, v11, v12 = triangles[gg, 2, 0] - a0, triangles[gg, 2, 1] - a1, triangles[gg, 2, 2] - a2
+        d00 = einsum_dot3(v00, v01, v02, v00, v01, v02)
+        d01 = einsum_dot3(v00, v01, v02, v10, v11, v12)
+        d11 = einsum_dot3(v10, v11, v12, v10, v11, v12)
+        den = d00 * d11 - d01 * d01
+        ok = den > 0
+        if not ok:
+            den = 1.0
+        scale = math.sqrt(_max_nan(d00, d11))
+        t = proximity / (scale if scale > 0 else 1.0)
+        first = flagged_index[f[e]] * samples
+        for q in range(samples):
+            pt = first + q
+            p0, p1, p2 = pos[pt, 0], pos[pt, 1], pos[pt, 2]
+            d = einsum_dot3(n0, n1, n2, p0 - a0, p1 - a1, p2 - a2)
+            if not abs(d) < proximity:
+                continue
+            w0, w1, w2 = (p0 - d * n0) - a0, (p1 - d * n1) - a1, (p2 - d * n2) - a2
+            d20 = einsum_dot3(w0, w1, w2, v00, v01, v02)
+            d21 = einsum_dot3(w0, w1, w2, v10, v11, v12)
+            v = (d11 * d20 - d01 * d21) / den
+            w = (d00 * d21 - d01 * d20) / den
+            u = 1 - v - w
+            if not (ok and u >= -t and v >= -t and w >= -t):
+                continue
+            cos = einsum_dot3(n0, n1, n2, ns[pt, 0], ns[pt, 1], ns[pt, 2])
+            orient = _sign(d) if abs(cos) < square_cos else _sign(cos)
+            if orient == 0:
+                continue
+            move = offset - orient * d
+            if best_g[pt] < 0 or _at_least(move, best_move[pt]):
+                best_move[pt], best_orient[pt], best_g[pt] = move, orient, gg
+    for k in range(n_points):
+        gg = best_g[k]
+        if gg < 0:
+            continue
+        step = best_orient[k] * best_move[k]
+        for c in range(3):
+            origin[k, c] = (pos[k, c] + step * normals[gg, c]) + offset * ns[k, c]
+    return origin
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def merged_edge_weights(indptr, indices, data, counted, area, is_point):  # pragma: no cover - compiled
+    """Eq. 5 of :func:`meshvis.graphcut.weights.edge_weights` from a canonical CSR ``n_ij``.
+
+    Every off-diagonal entry gives ``T_ij = A_i n_ij / n_i`` (halved, or for a point node
+    towards a cluster node dropped, as there); ``(i, j)`` and ``(j, i)`` are merged into
+    one edge ``i < j`` by adding their two terms (one addition, so the order of the two
+    does not matter), and the edges come out sorted by ``(i, j)``, those of weight 0 left
+    out.  The lower entries are first moved to the rows of their columns (in increasing
+    row order, so each row's list stays sorted), then each row's two sorted lists are merged.
+    """
+    n = len(indptr) - 1
+    low_count = np.zeros(n + 1, np.int64)
+    for r in range(n):
+        for e in range(indptr[r], indptr[r + 1]):
+            if indices[e] < r:
+                low_count[indices[e] + 1] += 1
+    low_start = np.cumsum(low_count)
+    low_at = low_start[:-1].copy()
+    low_col = np.empty(low_start[-1], np.int64)
+    low_val = np.empty(low_start[-1])
+    out_i = np.empty(len(indices), np.int64)
+    out_j = np.empty(len(indices), np.int64)
+    out_w = np.empty(len(indices))
+
+    def term(r, c, n_rc):
+        if counted[r] <= 0:
+            return 0.0
+        t = area[r] * n_rc / max(counted[r], 1)
+        if is_point[r] != is_point[c]:
+            return t * (0.0 if is_point[r] else 1.0)
+        return t * 0.5
+
+    for r in range(n):
+        for e in range(indptr[r], indptr[r + 1]):
+            c = indices[e]
+            if c < r:
+                low_col[low_at[c]] = r
+                low_val[low_at[c]] = term(r, c, data[e])
+                low_at[c] += 1
+    k = 0
+    for r in range(n):
+        a, a_end = indptr[r], indptr[r + 1]
+        while a < a_end and indices[a] <= r:  # skip the lower part and the self-link
+            a += 1
+        b, b_end = low_start[r], low_start[r + 1]
+        while a < a_end or b < b_end:
+            if b >= b_end or (a < a_end and indices[a] < low_col[b]):
+                c, w = indices[a], term(r, indices[a], data[a])
+                a += 1
+            elif a >= a_end or low_col[b] < indices[a]:
+                c, w = low_col[b], low_val[b]
+                b += 1
+            else:
+                c, w = indices[a], term(r, indices[a], data[a]) + low_val[b]
+                a += 1
+                b += 1
+            if w > 0:
+                out_i[k], out_j[k], out_w[k] = r, c, w
+                k += 1
+    return out_i[:k], out_j[:k], out_w[:k]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def edge_maxima(w_max, i, j, w):  # pragma: no cover - compiled
+    """``np.maximum.at(w_max, i, w)`` then ``np.maximum.at(w_max, j, w)``, in place (NaN wins)."""
+    for ends in (i, j):
+        for e in range(len(w)):
+            x = w[e]
+            if x > w_max[ends[e]] or x != x:
+                w_max[ends[e]] = x
+    return w_max

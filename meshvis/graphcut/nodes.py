@@ -15,6 +15,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from meshvis.graphcut import _kernels
 from meshvis.graphcut.clusters import Clustering
 from meshvis.rays.samples import (
     cosine_about_faces,
@@ -251,66 +252,30 @@ def _pushed_origins(
     partner triangle (closer than ``proximity`` to its plane and inside it), it is moved
     along that partner's normal (oriented towards the same side) until it clears the
     partner by ``offset``; among several partners the one needing the furthest move wins.
+    A partner at right angles (a face against a wall at a T-junction, a sliver along it,
+    ``|cos| <`` :data:`PERPENDICULAR_COS`): the normals do not tell which side of the
+    partner the origin belongs to, and picking one at random can push it through the
+    partner (e.g. out of a room), so the point keeps the side of the partner it lies on,
+    and does not move when it lies on the partner's plane itself.  One pass of
+    :func:`meshvis.graphcut._kernels.pushed_origins` over the (point, partner) candidates.
     """
-    n_s = side_normals(normals[point_face], np.full(len(point_face), side))
-    origin = pos + offset * n_s
-    if len(pairs) == 0 or len(pos) == 0:
-        return origin
-    # (point, partner) candidates: every sample point of f against every partner g of f
-    both = np.concatenate([pairs, pairs[:, ::-1]])
+    # (face, partner) candidates: every pair both ways, for the flagged first faces
+    both = np.concatenate([pairs, pairs[:, ::-1]]) if len(pairs) else np.zeros((0, 2), np.int64)
     both = both[flagged_index[both[:, 0]] >= 0]
-    f, g = both[:, 0], both[:, 1]
-    pt = (flagged_index[f][:, None] * samples + np.arange(samples)).ravel()
-    g = np.repeat(g, samples)
-    p = pos[pt]
-    ng = normals[g]
-    d = np.einsum("ij,ij->i", ng, p - triangles[g, 0])
-    near = np.abs(d) < proximity
-    if not near.any():
-        return origin
-    pt, g, p, ng, d = pt[near], g[near], p[near], ng[near], d[near]
-    inside = _inside_triangle(p - d[:, None] * ng, triangles[g], tol=proximity)
-    pt, ng, d = pt[inside], ng[inside], d[inside]
-    if len(pt) == 0:
-        return origin
-    cos = np.einsum("ij,ij->i", ng, n_s[pt])
-    orient = np.sign(cos)
-    # A partner at right angles (a face against a wall at a T-junction, a sliver along
-    # it): the normals do not tell which side of the partner the origin belongs to, and
-    # picking one at random can push it through the partner (e.g. out of a room).  Keep
-    # the side the sample point lies on; on the partner's plane itself, do not move.
-    square = np.abs(cos) < PERPENDICULAR_COS
-    orient[square] = np.sign(d[square])
-    moved = orient != 0
-    pt, ng, d, orient = pt[moved], ng[moved], d[moved], orient[moved]
-    if len(pt) == 0:
-        return origin
-    move = offset - orient * d  # distance to travel along orient*ng to clear g by offset
-    order = np.lexsort((move, pt))
-    last = np.r_[pt[order][1:] != pt[order][:-1], True]
-    sel = order[last]
-    origin[pt[sel]] = pos[pt[sel]] + (orient[sel] * move[sel])[:, None] * ng[sel] + offset * n_s[pt[sel]]
-    return origin
-
-
-def _inside_triangle(p: np.ndarray, tri: np.ndarray, tol: float) -> np.ndarray:
-    """Whether points (already in the triangles' planes) lie inside them, with tolerance."""
-    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
-    v0, v1, v2 = b - a, c - a, p - a
-    d00 = np.einsum("ij,ij->i", v0, v0)
-    d01 = np.einsum("ij,ij->i", v0, v1)
-    d11 = np.einsum("ij,ij->i", v1, v1)
-    d20 = np.einsum("ij,ij->i", v2, v0)
-    d21 = np.einsum("ij,ij->i", v2, v1)
-    den = d00 * d11 - d01 * d01
-    ok = den > 0
-    den = np.where(ok, den, 1.0)
-    v = (d11 * d20 - d01 * d21) / den
-    w = (d00 * d21 - d01 * d20) / den
-    u = 1 - v - w
-    scale = np.sqrt(np.maximum(d00, d11))
-    t = tol / np.where(scale > 0, scale, 1.0)
-    return ok & (u >= -t) & (v >= -t) & (w >= -t)
+    return _kernels.pushed_origins(
+        np.ascontiguousarray(pos, np.float64),
+        np.ascontiguousarray(point_face, np.int64),
+        int(side),
+        np.ascontiguousarray(triangles, np.float64),
+        np.ascontiguousarray(normals, np.float64),
+        np.ascontiguousarray(flagged_index, np.int64),
+        np.ascontiguousarray(both[:, 0], np.int64),
+        np.ascontiguousarray(both[:, 1], np.int64),
+        int(samples),
+        float(offset),
+        float(proximity),
+        PERPENDICULAR_COS,
+    )
 
 
 def node_rays(

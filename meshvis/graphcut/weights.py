@@ -11,7 +11,7 @@ from dataclasses import dataclass
 import numpy as np
 import scipy.sparse as sp
 
-from meshvis.geometry.adjacency import stable_order
+from meshvis.graphcut import _kernels
 
 #: escape share above which a side counts as open to the outside (see :func:`inside_prior`).
 #: Measured: the holes in the bottom of the Stanford bunny let 2.1% of its inner side's
@@ -88,28 +88,15 @@ def edge_weights(
         Edge weight.
     """
     h = sp.csr_matrix(hits)
-    h.sum_duplicates()
-    n = len(area)
-    r = np.repeat(np.arange(n, dtype=np.int64), np.diff(h.indptr))
-    c, n_ij = h.indices.astype(np.int64), h.data
-    off = r != c
-    r, c, n_ij = r[off], c[off], n_ij[off]
-    t = area[r] * n_ij / np.maximum(counted[r], 1)
-    t[counted[r] <= 0] = 0.0
-    # a term from a point node towards a cluster node is dropped; the other one counts fully
-    mixed = is_point[r] != is_point[c]
-    t *= np.where(mixed, np.where(is_point[r], 0.0, 1.0), 0.5)
-    # merge (i, j) with (j, i): runs of equal undirected keys in one stable sort
-    key = np.minimum(r, c) * np.int64(n) + np.maximum(r, c)
-    order = stable_order(key, n * n)
-    key, t = key[order], t[order]
-    new = np.ones(len(key), bool)
-    new[1:] = key[1:] != key[:-1]
-    starts = np.flatnonzero(new)
-    w = np.add.reduceat(t, starts) if len(t) else t
-    key = key[starts]
-    keep = w > 0
-    return key[keep] // n, key[keep] % n, w[keep]
+    h.sum_duplicates()  # sorted, unique column indices per row
+    return _kernels.merged_edge_weights(
+        h.indptr.astype(np.int64),
+        h.indices.astype(np.int64),
+        np.asarray(h.data, np.float64),
+        np.asarray(counted),
+        np.asarray(area, np.float64),
+        np.asarray(is_point, bool),
+    )
 
 
 def outside_weights(escaped: np.ndarray, counted: np.ndarray, area: np.ndarray) -> np.ndarray:
@@ -219,9 +206,7 @@ def graph_weights(
     if not use_filter:
         return Weights(i, j, w, w_out, w_in, w.copy(), w.copy(), w_out.copy(), w_in.copy())
     w_max = np.maximum(w_out, w_in)
-    if len(w):
-        np.maximum.at(w_max, i, w)
-        np.maximum.at(w_max, j, w)
+    _kernels.edge_maxima(w_max, i, j, w)
     return Weights(
         i,
         j,

@@ -1,0 +1,171 @@
+"""The compiled kernels of the graph cut give the bits of the numpy code they replace."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import scipy.sparse as sp
+
+from meshvis.graphcut import _kernels
+from meshvis.graphcut.nodes import PERPENDICULAR_COS, _pushed_origins, side_normals
+from meshvis.graphcut.weights import edge_weights
+from meshvis.rays.samples import sample_scheme_barycentric
+
+
+def _numpy_pushed_origins(
+    pos, point_face, side, triangles, normals, flagged_index, pairs, samples, offset, proximity
+):
+    """The numpy expression that :func:`meshvis.graphcut._kernels.pushed_origins` replaced."""
+    n_s = side_normals(normals[point_face], np.full(len(point_face), side))
+    origin = pos + offset * n_s
+    both = np.concatenate([pairs, pairs[:, ::-1]])
+    both = both[flagged_index[both[:, 0]] >= 0]
+    f, g = both[:, 0], both[:, 1]
+    pt = (flagged_index[f][:, None] * samples + np.arange(samples)).ravel()
+    g = np.repeat(g, samples)
+    p = pos[pt]
+    ng = normals[g]
+    d = np.einsum("ij,ij->i", ng, p - triangles[g, 0])
+    near = np.abs(d) < proximity
+    pt, g, p, ng, d = pt[near], g[near], p[near], ng[near], d[near]
+    q, tri = p - d[:, None] * ng, triangles[g]
+    a, b, c = tri[:, 0], tri[:, 1], tri[:, 2]
+    v0, v1, v2 = b - a, c - a, q - a
+    d00, d01 = np.einsum("ij,ij->i", v0, v0), np.einsum("ij,ij->i", v0, v1)
+    d11, d20, d21 = (
+        np.einsum("ij,ij->i", v1, v1),
+        np.einsum("ij,ij->i", v2, v0),
+        np.einsum("ij,ij->i", v2, v1),
+    )
+    den = d00 * d11 - d01 * d01
+    ok = den > 0
+    den = np.where(ok, den, 1.0)
+    v = (d11 * d20 - d01 * d21) / den
+    w = (d00 * d21 - d01 * d20) / den
+    u = 1 - v - w
+    scale = np.sqrt(np.maximum(d00, d11))
+    t = proximity / np.where(scale > 0, scale, 1.0)
+    inside = ok & (u >= -t) & (v >= -t) & (w >= -t)
+    pt, ng, d = pt[inside], ng[inside], d[inside]
+    cos = np.einsum("ij,ij->i", ng, n_s[pt])
+    orient = np.sign(cos)
+    square = np.abs(cos) < PERPENDICULAR_COS
+    orient[square] = np.sign(d[square])
+    moved = orient != 0
+    pt, ng, d, orient = pt[moved], ng[moved], d[moved], orient[moved]
+    move = offset - orient * d
+    order = np.lexsort((move, pt))
+    last = np.r_[pt[order][1:] != pt[order][:-1], True]
+    sel = order[last]
+    origin[pt[sel]] = pos[pt[sel]] + (orient[sel] * move[sel])[:, None] * ng[sel] + offset * n_s[pt[sel]]
+    return origin
+
+
+@pytest.fixture
+def crossings():
+    """Flagged faces, each with partners through, along and across its sample points."""
+    rng = np.random.default_rng(3)
+    m, samples, proximity, offset = 600, 4, 1e-3, 1e-4
+    tri = rng.normal(size=(m, 3, 3)) * np.exp(rng.normal(size=(m, 1, 1)))
+    bary = sample_scheme_barycentric(samples, 2)
+    flagged = np.flatnonzero(rng.random(m) < 0.5)
+    pairs = []
+    for f in flagged[: len(flagged) // 2]:  # partners built on f's own sample points
+        pts = bary @ tri[f]
+        normal = np.cross(tri[f, 1] - tri[f, 0], tri[f, 2] - tri[f, 0])
+        normal /= np.linalg.norm(normal)
+        for kind in range(3):
+            g = rng.integers(0, m)
+            centre = pts[rng.integers(0, samples)]
+            if kind == 0:  # nearly coplanar, just off the plane
+                tri[g] = centre + (tri[f] - tri[f].mean(0)) * 2 + normal * rng.normal() * proximity * 0.5
+            elif kind == 1:  # at right angles, through the point
+                side = np.cross(normal, tri[f, 1] - tri[f, 0])
+                tri[g] = centre + np.array([side, -side, normal]) * rng.random()
+            pairs.append((f, g))
+    pairs += [tuple(rng.integers(0, m, 2)) for _ in range(300)]
+    pairs = np.array(pairs, np.int64)
+    normals = np.cross(tri[:, 1] - tri[:, 0], tri[:, 2] - tri[:, 0])
+    normals /= np.linalg.norm(normals, axis=1, keepdims=True)
+    flagged = np.union1d(flagged, np.unique(pairs))[::2]  # some partners are not flagged themselves
+    flagged_index = np.full(m, -1, np.int64)
+    flagged_index[flagged] = np.arange(len(flagged))
+    pos = np.einsum("kc,fcd->fkd", bary, tri[flagged]).reshape(-1, 3)
+    point_face = np.repeat(flagged, samples)
+    return pos, point_face, tri, normals, flagged_index, pairs, samples, offset, proximity
+
+
+@pytest.mark.parametrize("side", [0, 1])
+def test_pushed_origins_are_the_numpy_expression(crossings, side):
+    pos, point_face, tri, normals, flagged_index, pairs, samples, offset, proximity = crossings
+    args = (pos, point_face, side, tri, normals, flagged_index, pairs, samples, offset, proximity)
+    expected = _numpy_pushed_origins(*args)
+    got = _pushed_origins(*args)
+    moved = np.any(
+        expected != pos + offset * side_normals(normals[point_face], np.full(len(pos), side)), axis=1
+    )
+    assert moved.sum() > 50  # the fixture does exercise the partner moves
+    assert got.dtype == expected.dtype and got.tobytes() == expected.tobytes()
+
+
+def test_pushed_origins_without_partners(crossings):
+    pos, point_face, tri, normals, flagged_index, _, samples, offset, proximity = crossings
+    none = np.zeros((0, 2), np.int64)
+    got = _pushed_origins(pos, point_face, 1, tri, normals, flagged_index, none, samples, offset, proximity)
+    assert np.array_equal(got, pos - offset * normals[point_face])
+
+
+def _numpy_edge_weights(hits, counted, area, is_point):
+    """The numpy expression of Eq. 5 that :func:`meshvis.graphcut._kernels.merged_edge_weights` replaced."""
+    h = sp.csr_matrix(hits)
+    h.sum_duplicates()
+    n = len(area)
+    r = np.repeat(np.arange(n, dtype=np.int64), np.diff(h.indptr))
+    c, n_ij = h.indices.astype(np.int64), h.data
+    off = r != c
+    r, c, n_ij = r[off], c[off], n_ij[off]
+    t = area[r] * n_ij / np.maximum(counted[r], 1)
+    t[counted[r] <= 0] = 0.0
+    mixed = is_point[r] != is_point[c]
+    t *= np.where(mixed, np.where(is_point[r], 0.0, 1.0), 0.5)
+    key = np.minimum(r, c) * np.int64(n) + np.maximum(r, c)
+    order = np.argsort(key, kind="stable")
+    key, t = key[order], t[order]
+    new = np.ones(len(key), bool)
+    new[1:] = key[1:] != key[:-1]
+    starts = np.flatnonzero(new)
+    w = np.add.reduceat(t, starts) if len(t) else t
+    key = key[starts]
+    keep = w > 0
+    return key[keep] // n, key[keep] % n, w[keep]
+
+
+@pytest.mark.parametrize("n", [0, 1, 7, 3000])
+def test_edge_weights_are_the_numpy_expression(n):
+    rng = np.random.default_rng(n)
+    k = 12 * n
+    r, c = rng.integers(0, max(n, 1), k), rng.integers(0, max(n, 1), k)
+    r, c = np.concatenate([r, c[: k // 2]]), np.concatenate([c, r[: k // 2]])  # many (j, i) twins
+    hits = sp.coo_matrix((rng.integers(1, 9, len(r)).astype(float), (r, c)), shape=(n, n)).tocsr()
+    counted = rng.integers(-1, 40, n)  # some nodes with no counted rays
+    area = rng.random(n) * np.exp(rng.normal(size=n) * 4)
+    is_point = rng.random(n) < 0.6
+    expected = _numpy_edge_weights(hits, counted, area, is_point)
+    got = edge_weights(hits, counted, area, is_point)
+    if n > 100:
+        assert len(expected[0]) > n and np.sum(expected[2] > 0) > n  # the case has merged edges
+    for a, b in zip(got, expected):
+        assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def test_edge_maxima_are_maximum_at():
+    rng = np.random.default_rng(5)
+    n, k = 500, 4000
+    i, j, w = rng.integers(0, n, k), rng.integers(0, n, k), rng.random(k)
+    w[::97] = np.nan
+    start = rng.random(n) * 0.5
+    expected = start.copy()
+    np.maximum.at(expected, i, w)
+    np.maximum.at(expected, j, w)
+    got = _kernels.edge_maxima(start.copy(), i, j, w)
+    assert got.tobytes() == expected.tobytes()
