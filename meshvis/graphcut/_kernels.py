@@ -212,3 +212,71 @@ def edge_maxima(w_max, i, j, w):  # pragma: no cover - compiled
             if x > w_max[ends[e]] or x != x:
                 w_max[ends[e]] = x
     return w_max
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def ray_starts(
+    counts,
+    n_cluster,
+    node_start,
+    entry_cumarea,
+    area,
+    entry_face,
+    entry_side,
+    point_face,
+    point_origin,
+    draws,
+):  # pragma: no cover - compiled  # noqa: E501
+    """Source node, face and side of every ray of :func:`meshvis.graphcut.nodes.node_rays`.
+
+    Rays come node by node, ``counts[i]`` of them for node ``i``.  A cluster node's ray picks
+    its entry by area: the first entry of the node whose cumulative area exceeds
+    ``base + draw × area`` (``np.searchsorted(..., side="right")`` clipped to the node's
+    entries, one draw per cluster ray in order).  A point node's ray starts at the stored
+    pushed origin of its sample point (written into ``origins``; cluster rows are left for
+    the caller, whose points need more draws).
+
+    Returns
+    -------
+    source, face : (r,) int64 arrays; side : (r,) int8 array; origins : (r, 3) float64 array;
+    cluster_rows : (c,) int64 array, the rows of cluster rays
+    """
+    total = 0
+    for i in range(len(counts)):
+        total += counts[i]
+    source = np.empty(total, np.int64)
+    face = np.empty(total, np.int64)
+    side = np.empty(total, np.int8)
+    origins = np.empty((total, 3))
+    n_c = 0
+    for i in range(n_cluster):
+        n_c += counts[i]
+    cluster_rows = np.empty(n_c, np.int64)
+    row = 0
+    c = 0
+    for i in range(len(counts)):
+        if i < n_cluster:
+            start, end = node_start[i], node_start[i + 1]
+            base = entry_cumarea[start - 1] if start > 0 else 0.0
+            for _ in range(counts[i]):
+                target = base + draws[c] * area[i]
+                lo, hi = start, end  # first index in [start, end) with cumarea > target
+                while lo < hi:
+                    mid = (lo + hi) // 2
+                    if entry_cumarea[mid] <= target:
+                        lo = mid + 1
+                    else:
+                        hi = mid
+                k = min(lo, end - 1)
+                source[row], face[row], side[row] = i, entry_face[k], entry_side[k]
+                cluster_rows[c] = row
+                c += 1
+                row += 1
+        else:
+            p, s = (i - n_cluster) // 2, (i - n_cluster) % 2
+            for _ in range(counts[i]):
+                source[row], face[row], side[row] = i, point_face[p], s
+                for d in range(3):
+                    origins[row, d] = point_origin[p, s, d]
+                row += 1
+    return source, face, side, origins, cluster_rows

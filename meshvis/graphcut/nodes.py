@@ -317,30 +317,23 @@ def node_rays(
         Unit ray directions.
     """
     counts = np.asarray(counts, np.int64)
-    source = np.repeat(np.arange(nodes.n, dtype=np.int64), counts)
-    origins = np.empty((len(source), 3))
-    face = np.empty(len(source), np.int64)
-    side = np.empty(len(source), np.int8)
-
-    cl = source < nodes.n_cluster
-    rows_c = np.flatnonzero(cl)
-    if len(rows_c):
-        src_c = source[rows_c]
-        start = nodes.node_start[src_c]
-        base = np.where(start > 0, nodes.entry_cumarea[np.maximum(start - 1, 0)], 0.0)
-        target = base + rng.random(len(src_c)) * nodes.area[src_c]
-        idx = np.searchsorted(nodes.entry_cumarea, target, side="right")
-        idx = np.clip(idx, start, nodes.node_start[src_c + 1] - 1)
-        f, s = nodes.entry_face[idx], nodes.entry_side[idx]
-        origins[rows_c] = pushed_points_in_faces(triangles, normals, f, s, offset, rng)
-        face[rows_c], side[rows_c] = f, s
-
-    pn = ~cl
-    if pn.any():
-        k = source[pn] - nodes.n_cluster
-        p, s = k // 2, k % 2
-        origins[pn] = nodes.point_origin[p, s]
-        face[pn], side[pn] = nodes.point_face[p], s
+    n_c = int(counts[: nodes.n_cluster].sum())
+    # one area draw per cluster ray, then the points on the chosen faces, then the directions
+    draws = rng.random(n_c) if n_c else np.zeros(0)
+    source, face, side, origins, rows_c = _kernels.ray_starts(
+        counts,
+        nodes.n_cluster,
+        nodes.node_start,
+        nodes.entry_cumarea,
+        nodes.area,
+        nodes.entry_face,
+        nodes.entry_side,
+        nodes.point_face,
+        nodes.point_origin,
+        draws,
+    )
+    if n_c:
+        origins[rows_c] = pushed_points_in_faces(triangles, normals, face[rows_c], side[rows_c], offset, rng)
     # tangent frames depend on the face only (flipping the normal keeps them orthogonal)
     t1, t2 = nodes.tangents
     directions = cosine_about_faces(normals, (t1, t2), face, side, rng)

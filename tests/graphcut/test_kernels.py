@@ -2,14 +2,20 @@
 
 from __future__ import annotations
 
+from pathlib import Path
+
 import numpy as np
 import pytest
 import scipy.sparse as sp
 
 from meshvis.graphcut import _kernels
-from meshvis.graphcut.nodes import PERPENDICULAR_COS, _pushed_origins, side_normals
+from meshvis.graphcut.nodes import PERPENDICULAR_COS, _pushed_origins, build_nodes, node_rays, side_normals
+from meshvis.graphcut.preprocess import preprocess
 from meshvis.graphcut.weights import edge_weights
-from meshvis.rays.samples import sample_scheme_barycentric
+from meshvis.io import load
+from meshvis.rays.samples import cosine_about_faces, pushed_points_in_faces, sample_scheme_barycentric
+
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 
 def _numpy_pushed_origins(
@@ -165,7 +171,50 @@ def test_edge_maxima_are_maximum_at():
     w[::97] = np.nan
     start = rng.random(n) * 0.5
     expected = start.copy()
-    np.maximum.at(expected, i, w)
-    np.maximum.at(expected, j, w)
+    with np.errstate(invalid="ignore"):
+        np.maximum.at(expected, i, w)
+        np.maximum.at(expected, j, w)
     got = _kernels.edge_maxima(start.copy(), i, j, w)
     assert got.tobytes() == expected.tobytes()
+
+
+def _numpy_node_rays(nodes, normals, triangles, counts, rng, offset):
+    """The numpy layout of :func:`meshvis.graphcut.nodes.node_rays` before :func:`_kernels.ray_starts`."""
+    source = np.repeat(np.arange(nodes.n, dtype=np.int64), counts)
+    origins = np.empty((len(source), 3))
+    face = np.empty(len(source), np.int64)
+    side = np.empty(len(source), np.int8)
+    rows_c = np.flatnonzero(source < nodes.n_cluster)
+    if len(rows_c):
+        src_c = source[rows_c]
+        start = nodes.node_start[src_c]
+        base = np.where(start > 0, nodes.entry_cumarea[np.maximum(start - 1, 0)], 0.0)
+        target = base + rng.random(len(src_c)) * nodes.area[src_c]
+        idx = np.searchsorted(nodes.entry_cumarea, target, side="right")
+        idx = np.clip(idx, start, nodes.node_start[src_c + 1] - 1)
+        f, s = nodes.entry_face[idx], nodes.entry_side[idx]
+        origins[rows_c] = pushed_points_in_faces(triangles, normals, f, s, offset, rng)
+        face[rows_c], side[rows_c] = f, s
+    pn = source >= nodes.n_cluster
+    k = source[pn] - nodes.n_cluster
+    origins[pn] = nodes.point_origin[k // 2, k % 2]
+    face[pn], side[pn] = nodes.point_face[k // 2], k % 2
+    t1, t2 = nodes.tangents
+    return source, origins, cosine_about_faces(normals, (t1, t2), face, side, rng)
+
+
+@pytest.mark.parametrize("model", ["overlapping_solids.obj", "assembly.obj"])
+def test_node_rays_are_the_numpy_layout(model):
+    soup = load(MODELS / model)
+    pre = preprocess(soup)
+    offset = 1e-4 * soup.diagonal
+    nodes = build_nodes(
+        soup.triangles, soup.normals, soup.areas, pre.clustering, pre.flagged, pre.partner_pairs,
+        offset=offset, proximity=2 * offset,
+    )  # fmt: skip
+    assert nodes.n_points and nodes.n_cluster  # both kinds of node cast rays
+    counts = np.random.default_rng(1).integers(0, 6, nodes.n)
+    got = node_rays(nodes, soup.normals, soup.triangles, counts, np.random.default_rng(2), offset)
+    expected = _numpy_node_rays(nodes, soup.normals, soup.triangles, counts, np.random.default_rng(2), offset)
+    for a, b in zip(got, expected):
+        assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
