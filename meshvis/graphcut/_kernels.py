@@ -280,3 +280,68 @@ def ray_starts(
                     origins[row, d] = point_origin[p, s, d]
                 row += 1
     return source, face, side, origins, cluster_rows
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def split_hits(face, side, source, side_node, escaped):  # pragma: no cover - compiled
+    """First step of :func:`meshvis.graphcut.sampling.sample_round` on one batch of hits.
+
+    Adds the misses to ``escaped`` (per source node, in place) and returns, for the rays
+    that hit (in ray order): the face, side and source node, the node of the side hit
+    (-1 on a flagged face, which has no cluster node), and the positions among the hits
+    and among all rays of the hits on flagged faces.
+    """
+    n_hit = 0
+    for k in range(len(face)):
+        if face[k] >= 0:
+            n_hit += 1
+        else:
+            escaped[source[k]] += 1
+    f = np.empty(n_hit, np.int64)
+    s = np.empty(n_hit, np.int64)
+    sr = np.empty(n_hit, np.int64)
+    dst = np.empty(n_hit, np.int64)
+    flagged_at = np.empty(n_hit, np.int64)
+    ray_at = np.empty(n_hit, np.int64)
+    h = 0
+    q = 0
+    for k in range(len(face)):
+        if face[k] < 0:
+            continue
+        f[h], s[h], sr[h] = face[k], side[k], source[k]
+        dst[h] = side_node[face[k], side[k]]
+        if dst[h] < 0:
+            flagged_at[q], ray_at[q] = h, k
+            q += 1
+        h += 1
+    return f, s, sr, dst, flagged_at[:q], ray_at[:q]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def kept_hits(sr, s, dst, flagged_at, point, blocked, n_cluster, discarded):  # pragma: no cover - compiled
+    """Last step of :func:`meshvis.graphcut.sampling.sample_round` on one batch of hits.
+
+    A hit on a flagged face links to the point node of its sample ``point`` on the side hit
+    (``n_cluster + 2 p + s``); one whose reverse ray was
+    ``blocked`` is discarded (added to ``discarded`` per source node, in place).  Returns
+    the (source, destination) node of every kept hit, in hit order.
+    """
+    keep = np.ones(len(sr), np.bool_)
+    for q in range(len(flagged_at)):
+        h = flagged_at[q]
+        dst[h] = n_cluster + 2 * point[q] + s[h]
+        if blocked[q]:
+            keep[h] = False
+            discarded[sr[h]] += 1
+    n_keep = 0
+    for h in range(len(sr)):
+        if keep[h]:
+            n_keep += 1
+    rows = np.empty(n_keep, np.int64)
+    cols = np.empty(n_keep, np.int64)
+    k = 0
+    for h in range(len(sr)):
+        if keep[h]:
+            rows[k], cols[k] = sr[h], dst[h]
+            k += 1
+    return rows, cols

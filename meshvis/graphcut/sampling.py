@@ -100,25 +100,20 @@ def sample_round(
         h = caster.intersect(origins, dirs)
         counts.time_embree += time.perf_counter() - t0
         counts.rays += len(src)
-        hit = h.face >= 0
-        counts.escaped += np.bincount(src[~hit], minlength=nodes.n)
-        f, s, sr = h.face[hit], h.side[hit].astype(np.int64), src[hit]
-        dst = nodes.side_node[f, s]
-        keep = np.ones(len(f), bool)
-        idx = np.flatnonzero(dst < 0)  # hits on flagged faces: snap, then check the way back
-        if len(idx):
-            hit_idx = np.flatnonzero(hit)[idx]
+        f, s, sr, dst, flagged_at, ray_at = _kernels.split_hits(
+            h.face, h.side, src, nodes.side_node, counts.escaped
+        )
+        p, blocked = np.zeros(0, np.int64), np.zeros(0, bool)
+        if len(flagged_at):  # hits on flagged faces: snap to a sample point, check the way back
             assert h.bary is not None  # intersect always fills it
-            p = snap_to_points(nodes, f[idx], h.bary[hit_idx])
+            p = snap_to_points(nodes, f[flagged_at], h.bary[ray_at])
             t0 = time.perf_counter()
-            blocked = caster.occluded(nodes.point_origin[p, s[idx]], origins[hit_idx])
+            blocked = caster.occluded(nodes.point_origin[p, s[flagged_at]], origins[ray_at])
             counts.time_embree += time.perf_counter() - t0
-            counts.reverse_rays += len(idx)
-            dst[idx] = nodes.point_node(p, s[idx])
-            keep[idx[blocked]] = False
-        counts.discarded += np.bincount(sr[~keep], minlength=nodes.n)
-        rows.append(sr[keep])
-        cols.append(dst[keep])
+            counts.reverse_rays += len(flagged_at)
+        r, c = _kernels.kept_hits(sr, s, dst, flagged_at, p, blocked, nodes.n_cluster, counts.discarded)
+        rows.append(r)
+        cols.append(c)
         if progress is not None:
             progress(len(src))
     counts.cast += rays_per_node

@@ -218,3 +218,29 @@ def test_node_rays_are_the_numpy_layout(model):
     expected = _numpy_node_rays(nodes, soup.normals, soup.triangles, counts, np.random.default_rng(2), offset)
     for a, b in zip(got, expected):
         assert a.dtype == b.dtype and a.tobytes() == b.tobytes()
+
+
+def test_hit_split_and_keep_are_the_numpy_steps():
+    rng = np.random.default_rng(9)
+    n_faces, n_cluster, n, rays = 50, 30, 200, 5000
+    side_node = rng.integers(0, n_cluster, (n_faces, 2))
+    side_node[rng.random(n_faces) < 0.3] = -1  # flagged faces
+    face = np.where(rng.random(rays) < 0.2, -1, rng.integers(0, n_faces, rays))
+    side = np.where(face < 0, -1, rng.integers(0, 2, rays)).astype(np.int8)
+    src = rng.integers(0, n, rays)
+    escaped, discarded = np.zeros(n, np.int64), np.zeros(n, np.int64)
+    f, s, sr, dst, flagged_at, ray_at = _kernels.split_hits(face, side, src, side_node, escaped)
+    hit = face >= 0
+    assert np.array_equal(escaped, np.bincount(src[~hit], minlength=n))
+    assert np.array_equal(f, face[hit]) and np.array_equal(s, side[hit]) and np.array_equal(sr, src[hit])
+    expected_dst = side_node[face[hit], side[hit]]
+    idx = np.flatnonzero(expected_dst < 0)
+    assert np.array_equal(dst, expected_dst) and np.array_equal(flagged_at, idx)
+    assert np.array_equal(ray_at, np.flatnonzero(hit)[idx])
+    point, blocked = rng.integers(0, 40, len(idx)), rng.random(len(idx)) < 0.4
+    rows, cols = _kernels.kept_hits(sr, s, dst, flagged_at, point, blocked, n_cluster, discarded)
+    expected_dst[idx] = n_cluster + 2 * point + s[idx]
+    keep = np.ones(len(sr), bool)
+    keep[idx[blocked]] = False
+    assert np.array_equal(discarded, np.bincount(sr[~keep], minlength=n))
+    assert np.array_equal(rows, sr[keep]) and np.array_equal(cols, expected_dst[keep])
