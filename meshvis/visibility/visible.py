@@ -475,15 +475,44 @@ def _seed_chunk(state: _State, caster, region, rng, todo, per_face: int, guided,
         _propagate(state, caster, region, fresh)
 
 
+class _Queue:
+    """Sightings first in, first out: taking a batch copies the batch, not the rest."""
+
+    def __init__(self, first: Sightings):
+        self.parts: list[Sightings] = []
+        self.start = 0  # sightings of parts[0] already taken
+        self.push(first)
+
+    def __len__(self) -> int:
+        return sum(len(p.face) for p in self.parts) - self.start
+
+    def push(self, s: Sightings) -> None:
+        if len(s.face):
+            self.parts.append(s)
+
+    def take(self, k: int) -> Sightings:
+        """The next ``k`` sightings (fewer if the queue holds fewer)."""
+        out = []
+        while k > 0 and self.parts:
+            head = self.parts[0]
+            n = min(k, len(head.face) - self.start)
+            out.append(head.subset(slice(self.start, self.start + n)))
+            k -= n
+            self.start += n
+            if self.start == len(head.face):
+                self.parts.pop(0)
+                self.start = 0
+        return Sightings.concat(out)
+
+
 def _propagate(state: _State, caster, region, fresh: Sightings) -> None:
     """Border and reverse sampling from every new sighting, until nothing new turns up.
 
     Only sightings on ``state.spread`` are propagated (all faces, unless ``faces=`` asks about some).
     """
-    queue = fresh.subset(np.flatnonzero(state.spread[fresh.face]))
-    while len(queue.face) and state.left > 0:
-        batch = queue.subset(np.arange(min(len(queue.face), PROPAGATE_BATCH, max(1, state.left // 64))))
-        rest = queue.subset(np.arange(len(batch.face), len(queue.face)))
+    queue = _Queue(fresh.subset(np.flatnonzero(state.spread[fresh.face])))
+    while len(queue) and state.left > 0:
+        batch = queue.take(min(PROPAGATE_BATCH, max(1, state.left // 64)))
         band, parent, n_band = border_sampling(caster, region, batch)
         state.rays["border"] += n_band
         mutated, n_rev, refused = reverse_sampling(caster, region, band, parent)
@@ -491,4 +520,4 @@ def _propagate(state: _State, caster, region, fresh: Sightings) -> None:
         state.refused += refused
         new = state.record(Sightings.concat([band, mutated]))
         state.snapshot()
-        queue = Sightings.concat([rest, new.subset(np.flatnonzero(state.spread[new.face]))])
+        queue.push(new.subset(np.flatnonzero(state.spread[new.face])))
