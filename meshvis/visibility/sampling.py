@@ -72,8 +72,8 @@ class Sightings:
         parts = [p for p in parts if len(p.face)] or [cls.empty()]
         return cls(*(np.concatenate([getattr(p, k) for p in parts]) for k in cls.__dataclass_fields__))
 
-    def subset(self, index: np.ndarray) -> Sightings:
-        """The sightings at ``index``."""
+    def subset(self, index: np.ndarray | slice) -> Sightings:
+        """The sightings at ``index`` (an index array or mask copies; a slice gives views)."""
         return Sightings(*(getattr(self, k)[index] for k in self.__dataclass_fields__))
 
 
