@@ -143,9 +143,16 @@ def cosine_filter(w: np.ndarray, w_max: np.ndarray) -> np.ndarray:
     to 0), which would cut a weak link completely instead of damping it — a small part
     seen by a large cluster would then be unreachable from it.
     """
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(w_max > 0, w / w_max, 0.0)
-    return np.sin(0.5 * np.pi * np.clip(ratio, 0.0, 1.0)) ** 2 * w
+    # in place, one temporary: the same operations in the same order as
+    # ``sin(0.5 π clip(w / w_max, 0, 1))² · w``, so the same bits
+    ratio = np.zeros(np.shape(w), np.float64)
+    np.divide(w, w_max, out=ratio, where=w_max > 0)
+    np.clip(ratio, 0.0, 1.0, out=ratio)
+    ratio *= 0.5 * np.pi
+    np.sin(ratio, out=ratio)
+    np.square(ratio, out=ratio)
+    ratio *= w
+    return ratio
 
 
 def graph_weights(
