@@ -143,7 +143,7 @@ def cosine_filter(w: np.ndarray, w_max: np.ndarray) -> np.ndarray:
     to 0), which would cut a weak link completely instead of damping it — a small part
     seen by a large cluster would then be unreachable from it.
     """
-    # in place, one temporary: the same operations in the same order as
+    # in place on one float array (and the mask): the same operations in the same order as
     # ``sin(0.5 π clip(w / w_max, 0, 1))² · w``, so the same bits
     ratio = np.zeros(np.shape(w), np.float64)
     np.divide(w, w_max, out=ratio, where=w_max > 0)

@@ -244,20 +244,3 @@ def test_hit_split_and_keep_are_the_numpy_steps():
     keep[idx[blocked]] = False
     assert np.array_equal(discarded, np.bincount(sr[~keep], minlength=n))
     assert np.array_equal(rows, sr[keep]) and np.array_equal(cols, expected_dst[keep])
-
-
-def test_cosine_filter_in_place_gives_the_bits_of_the_literal_expression():
-    from meshvis.graphcut.weights import cosine_filter
-
-    rng = np.random.default_rng(3)
-    w = rng.random(5000) * rng.integers(0, 2, 5000)
-    w_max = np.maximum(w, rng.random(5000))
-    w_max[::7] = 0.0  # no link: filtered to 0
-    w[::11] = w_max[::11] * 2  # above the maximum: clipped to the full weight
-    w[5] = np.nan
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ratio = np.where(w_max > 0, w / w_max, 0.0)
-    expected = np.sin(0.5 * np.pi * np.clip(ratio, 0.0, 1.0)) ** 2 * w
-    got = cosine_filter(w, w_max)
-    assert got.dtype == np.float64
-    assert got.tobytes() == expected.tobytes()
