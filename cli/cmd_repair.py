@@ -105,7 +105,7 @@ def box(text: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
 def algorithm_options(p: argparse.ArgumentParser) -> None:
     """Add the graph-cut options that apply to any model (shared with ``meshvis batch``).
 
-    The options are ``--seed``, ``--rays-per-node``, ``--samples-per-face``, ``--no-filter``,
+    The options are ``--seed``, ``--rays-per-node``, ``--rays-per-point``, ``--samples-per-face``, ``--no-filter``,
     ``--no-progressive`` and ``--solver``, with the defaults of
     :data:`meshvis.repair.operation.CLASSIFY_DEFAULTS`; their ``dest`` names are the keywords
     of :func:`meshvis.classify`.
@@ -122,6 +122,13 @@ def algorithm_options(p: argparse.ArgumentParser) -> None:
         type=positive_int,
         default=d["rays_per_node"],
         help=f"ray budget per node (default {d['rays_per_node']})",
+    )
+    p.add_argument(
+        "--rays-per-point",
+        type=positive_int,
+        default=d["rays_per_point"],
+        help="ray budget per sample point of an intersecting/coplanar face (default: --rays-per-node; "
+        "8 is 25-45%% faster on models with many intersecting faces, at a small cost in accuracy)",
     )
     p.add_argument(
         "--samples-per-face",

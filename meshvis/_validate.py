@@ -123,10 +123,22 @@ def image_size(size: Any) -> tuple[int, int]:
 
 
 def classify_args(
-    rays_per_node, seed_value, samples_per_face, sampling_scheme, opening, tolerance, solver, offset, progress
+    rays_per_node,
+    seed_value,
+    samples_per_face,
+    sampling_scheme,
+    opening,
+    tolerance,
+    solver,
+    offset,
+    progress,
+    *,
+    rays_per_point=None,
 ) -> None:
     """The arguments of :func:`meshvis.classify` (see its docstring)."""
     integer("rays_per_node", rays_per_node, 1, limits.MAX_RAYS_PER_NODE, "MAX_RAYS_PER_NODE")
+    if rays_per_point is not None:
+        integer("rays_per_point", rays_per_point, 1, limits.MAX_RAYS_PER_NODE, "MAX_RAYS_PER_NODE")
     seed(seed_value)
     integer("samples_per_face", samples_per_face, 1, limits.MAX_SAMPLES_PER_FACE, "MAX_SAMPLES_PER_FACE")
     choice("sampling_scheme", sampling_scheme, (1, 2))
@@ -235,11 +247,13 @@ def names(name: str, value: Any) -> list[str]:
 
 def operation_options(options: Mapping[str, Any]) -> None:
     """The classification options of a repair operation (``seed``, ``rays_per_node``,
-    ``samples_per_face``), checked once before a batch starts."""
+    ``rays_per_point``, ``samples_per_face``), checked once before a batch starts."""
     seed(options.get("seed", 0))
     integer(
         "rays_per_node", options.get("rays_per_node", 32), 1, limits.MAX_RAYS_PER_NODE, "MAX_RAYS_PER_NODE"
     )
+    if options.get("rays_per_point") is not None:
+        integer("rays_per_point", options["rays_per_point"], 1, limits.MAX_RAYS_PER_NODE, "MAX_RAYS_PER_NODE")
     integer(
         "samples_per_face",
         options.get("samples_per_face", 4),

@@ -26,6 +26,7 @@ CLASSIFY_DEFAULTS: dict[str, Any] = {
     "seed": 0,
     "rays_per_node": 32,
     "samples_per_face": 4,
+    "rays_per_point": None,  # None: rays_per_node
     "use_filter": True,
     "progressive": True,
     "solver": "pymaxflow",
@@ -107,6 +108,7 @@ def classify_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
         rays_per_node=int(o["rays_per_node"]),
         seed=int(o["seed"]),
         samples_per_face=int(o["samples_per_face"]),
+        rays_per_point=None if o["rays_per_point"] is None else int(o["rays_per_point"]),
         use_filter=bool(o["use_filter"]),
         progressive=bool(o["progressive"]),
         solver=o["solver"],

@@ -166,9 +166,29 @@ def test_cosine_filter_in_place_gives_the_bits_of_the_literal_expression():
     assert got.tobytes() == expected.tobytes()
 
 
+def test_rays_per_point_caps_the_sample_points_only():
+    a, b = trimesh.creation.icosphere(3), trimesh.creation.icosphere(3)
+    b.vertices += [0.8, 0, 0]
+    v, f = stack(a, b)
+    full = classify((v, f), seed=3)
+    same = classify((v, f), seed=3, rays_per_point=32)  # the default budget, spelled out
+    assert np.array_equal(full.side_outside, same.side_outside) and full.counts.rays == same.counts.rays
+    few = classify((v, f), seed=3, rays_per_point=8)
+    k = few.nodes.n_cluster
+    assert few.nodes.n > k  # the spheres intersect: there are sample points
+    assert few.counts.cast[k:].max() <= 8 < full.counts.cast[k:].max()
+    assert np.array_equal(few.counts.cast[:k] > 0, full.counts.cast[:k] > 0)
+    assert few.counts.rays < full.counts.rays
+    assert few.report(per_face=False)["params"]["rays_per_point"] == 8
+    one_round = classify((v, f), seed=3, rays_per_point=2, progressive=False)
+    assert one_round.counts.cast[k:].max() == 2
+
+
 def test_bad_parameters():
     with pytest.raises(ParameterError):
         classify(trimesh.creation.box(), rays_per_node=0)
+    with pytest.raises(ParameterError, match="rays_per_point must be at least 1"):
+        classify(trimesh.creation.box(), rays_per_point=0)
     with pytest.raises(ParameterError):
         classify(trimesh.creation.box(), solver="nope")
 

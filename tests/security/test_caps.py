@@ -211,6 +211,10 @@ def test_obj_vertex_line_with_too_many_numbers_is_refused(tmp_path):
     [
         (["--rays-per-node", "1000000000"], "rays_per_node must be at most 65536 (the cap MAX_RAYS_PER_NODE"),
         (["--samples-per-face", "1000000"], "samples_per_face must be at most 1024"),
+        (
+            ["--rays-per-point", "1000000000"],
+            "rays_per_point must be at most 65536 (the cap MAX_RAYS_PER_NODE",
+        ),
         (["--seed", "-1"], "seed must be at least 0, got -1"),
     ],
 )
