@@ -422,6 +422,25 @@ _BARE = re.compile(r"(?<!\S)(-?\d+)(?=\s|$)")
 _THIRD = re.compile(r"(/[^\s/]*)/[^\s/]*")
 
 
+def _mixed_to_uv(body: str, n_corner: int, slashes: int) -> str:
+    """Face records of mixed corner layouts rewritten to ``v/vt`` everywhere.
+
+    Corners ``v/vt/vn`` lose their normal and bare corners ``v`` get the UV 0.  The common
+    mix, ``v/vt`` records beside records of bare corners only (edges or faces without UVs
+    in CAD exports), rewrites just the bare records; anything else goes through two
+    regular-expression passes over all records.  Both give the same text.
+    """
+    if _TWO_SLASHES.search(body) is None:
+        lines = body.split("\n")
+        bare = [i for i, line in enumerate(lines) if "/" not in line]
+        bare_corners = sum(len(lines[i].split()) - 1 for i in bare)
+        if slashes == n_corner - bare_corners:  # every other corner is v/vt
+            for i in bare:
+                lines[i] = _BARE.sub(r"\1/0", lines[i])
+            return "\n".join(lines)
+    return _BARE.sub(r"\1/0", _THIRD.sub(r"\1", body))
+
+
 def _parse_faces(f_lines: list[str], label: str) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Corner counts and (v, vt) index per corner of the face records.
 
@@ -446,7 +465,7 @@ def _parse_faces(f_lines: list[str], label: str) -> tuple[np.ndarray, np.ndarray
     elif slashes == n_corner and _TWO_SLASHES.search(body) is None:
         stride = 2
     else:  # mixed layouts: drop normals, give bare corners an empty UV
-        body = _BARE.sub(r"\1/0", _THIRD.sub(r"\1", body))
+        body = _mixed_to_uv(body, n_corner, slashes)
         stride = 2
     body = body.replace("f", f" {_RECORD} ").replace("/", " ")
     values = _numbers(body, np.int64, "faces", label)

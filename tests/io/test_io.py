@@ -319,6 +319,39 @@ def test_obj_corner_layouts_colours_groups(tmp_path):
     assert np.array_equal(soup.uv[2], np.zeros((3, 2)))  # v//vn has no UV
 
 
+def test_obj_mixed_layout_rewrite_matches_the_two_regular_expression_passes():
+    """The targeted rewrite of mixed corner layouts gives the text of the general one."""
+    import random
+
+    from meshvis.io import obj
+
+    forms = {
+        "v": lambda v, r: v,
+        "vt": lambda v, r: f"{v}/{r.randint(1, 9)}",
+        "vtn": lambda v, r: f"{v}/{r.randint(1, 9)}/{r.randint(1, 9)}",
+        "vn": lambda v, r: f"{v}/0/{r.randint(1, 9)}",  # '//' is rewritten before
+    }
+    rng, mixed = random.Random(0), 0
+    for _ in range(2000):
+        records = []
+        for _ in range(rng.randint(1, 8)):
+            layout = rng.choice([*forms, "any"])
+            corners = [
+                forms[layout if layout != "any" else rng.choice(list(forms))](str(rng.randint(-9, 99)), rng)
+                for _ in range(rng.randint(2, 5))
+            ]
+            sep = rng.choice([" ", "  ", "\t"])
+            records.append("f" + sep + sep.join(corners) + rng.choice(["", " "]))
+        body = "\n".join(records)
+        n_corner, slashes = len(body.split()) - len(records), body.count("/")
+        if slashes in (0, 2 * n_corner) or (slashes == n_corner and obj._TWO_SLASHES.search(body) is None):
+            continue  # one layout: not rewritten
+        mixed += 1
+        expected = obj._BARE.sub(r"\1/0", obj._THIRD.sub(r"\1", body))
+        assert obj._mixed_to_uv(body, n_corner, slashes) == expected, body
+    assert mixed > 1000
+
+
 def test_obj_mtl_and_texture_are_written_back(tmp_path):
     from PIL import Image
 
