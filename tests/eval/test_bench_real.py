@@ -42,3 +42,18 @@ def test_bench_real_judges_every_method_on_a_small_model(tmp_path, capsys):
         assert len(shares) == 3 and all(0 <= x <= 1 for x in shares)
     assert curve.stat().st_size > 1000 and (tmp_path / "nested.seed0.npz").is_file()
     assert "nested" in capsys.readouterr().out
+    assert r["rays_per_point"] == 32  # the default: rays_per_node
+
+
+@pytest.mark.skipif(not (REAL / "pins.glb").is_file(), reason="shared real models not present")
+def test_bench_real_passes_the_sample_points_budget_to_the_cut(tmp_path):
+    out = tmp_path / "r.json"
+    argv = ["bench", "real", "--only", str(REAL / "pins.glb"), "--cache", str(tmp_path), "--searches", "1"]
+    argv += ["--views", "8", "--size", "32", "--json", str(out)]
+    assert main(argv) == 0
+    assert main(argv[:-1] + [str(tmp_path / "r8.json"), "--rays-per-point", "2"]) == 0
+    full = json.loads(out.read_text())["results"][0]
+    few = json.loads((tmp_path / "r8.json").read_text())["results"][0]
+    assert (full["rays_per_point"], few["rays_per_point"]) == (32, 2)
+    rays = {r["method"]: r["rays"] for r in full["rows"]}, {r["method"]: r["rays"] for r in few["rows"]}
+    assert rays[1]["object (graph cut)"] < rays[0]["object (graph cut)"]

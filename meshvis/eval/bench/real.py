@@ -113,6 +113,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         "--worst", metavar="FOLDER", help="pictures of the worst views of object and both per model"
     )
     p.add_argument("--json", metavar="FILE", help="also write every number as JSON")
+    p.add_argument(
+        "--rays-per-point",
+        type=int,
+        default=None,
+        metavar="R",
+        help="ray budget per sample point of the graph cut (object and both; default: rays_per_node)",
+    )
 
 
 def main(args: argparse.Namespace) -> int:
@@ -144,6 +151,7 @@ def main(args: argparse.Namespace) -> int:
             worst=args.worst,
             views=args.views,
             size=args.size,
+            rays_per_point=args.rays_per_point,
         )
         print(format_model(r), flush=True)
         results.append(r)
@@ -191,6 +199,7 @@ def run_model(
     worst: str | None = None,
     views: int = VIEWS,
     size: int = SIZE,
+    rays_per_point: int | None = None,
 ) -> dict:
     """Every method on one model; one dict of rows and curves.
 
@@ -214,6 +223,8 @@ def run_model(
         Viewpoints of the false pixels.
     size : int
         Image size of the false pixels.
+    rays_per_point : int, optional
+        Ray budget per sample point of the graph cut (:func:`meshvis.classify`).
 
     Returns
     -------
@@ -229,7 +240,7 @@ def run_model(
     rows = {"reference (dense random)": (ref.seen, int(ref.rays.sum()), ref.seconds)}
 
     t = time.perf_counter()
-    c = classify(soup, seed=seed)
+    c = classify(soup, seed=seed, rays_per_point=rays_per_point)
     obj = remove_interior(soup, classification=c, visibility="object")
     t_obj = time.perf_counter() - t
     rows["object (graph cut)"] = (obj.keep, int(c.report(per_face=False)["rays"]), t_obj)
@@ -291,6 +302,7 @@ def run_model(
     result = {
         "model": stem,
         "faces": soup.n_faces,
+        "rays_per_point": c.params["rays_per_point"],
         "ground": ground,
         "up": list(up),
         "reference_hidden_area": float(soup.areas[ref_hidden].sum() / soup.total_area),
