@@ -195,7 +195,7 @@ def face_labels(nodes: NodeSet, node_outside: np.ndarray, m: int, degenerate: np
     return out
 
 
-def ray_allocation(nodes: NodeSet, rays: int, point_rays: int | None = None) -> np.ndarray:
+def ray_allocation(nodes: NodeSet, rays: int, point_rays: int) -> np.ndarray:
     """Rays per node: ``rays`` times a factor √(faces in node), capped; ``point_rays`` per sample point.
 
     A cluster node of many triangles gets more rays than a single sample point, so that
@@ -205,9 +205,9 @@ def ray_allocation(nodes: NodeSet, rays: int, point_rays: int | None = None) -> 
     ----------
     nodes : NodeSet
     rays : int
-        Rays of a one-face node.
-    point_rays : int, optional
-        Rays of each sample-point node (default ``rays``).
+        Rays of a one-face cluster node.
+    point_rays : int
+        Rays of each sample-point node (``rays`` gives every one-face node the same).
 
     Returns
     -------
@@ -216,8 +216,7 @@ def ray_allocation(nodes: NodeSet, rays: int, point_rays: int | None = None) -> 
     """
     factor = np.clip(np.ceil(np.sqrt(nodes.n_faces)), 1, CLUSTER_RAY_FACTOR_MAX).astype(np.int64)
     alloc = rays * factor
-    if point_rays is not None:
-        alloc[nodes.n_cluster :] = point_rays
+    alloc[nodes.n_cluster :] = point_rays
     alloc[nodes.area <= 0] = 0
     return alloc
 
@@ -356,6 +355,8 @@ def classify(
     loop = _Sampling(
         caster, nodes, soup, pre.degenerate, rng, hint_out, hint_in, use_filter, opening, solver, report
     )
+    if rays_per_point is None:
+        rays_per_point = rays_per_node
     loop.run(rays_per_node, rays_per_point, progressive, tolerance)
     stages += loop.stages(use_filter)
     report("done", 1.0)
@@ -363,7 +364,7 @@ def classify(
         "rays_per_node": rays_per_node,
         "seed": seed,
         "samples_per_face": samples_per_face,
-        "rays_per_point": rays_per_node if rays_per_point is None else rays_per_point,
+        "rays_per_point": rays_per_point,
         "sampling_scheme": sampling_scheme,
         "use_filter": use_filter,
         "opening": opening,
@@ -488,17 +489,16 @@ class _Sampling:
         self.stop_reason = "single round"
         self.graph = self.cut = self.labels = None
 
-    def run(
-        self, rays_per_node: int, rays_per_point: int | None, progressive: bool, tolerance: float
-    ) -> None:
+    def run(self, rays_per_node: int, rays_per_point: int, progressive: bool, tolerance: float) -> None:
         """Cast rounds of rays and cut after each until the labels settle (module notes)."""
         nodes = self.nodes
         budget = ray_allocation(nodes, rays_per_node, rays_per_point)
         _validate.ray_budget(int(budget.sum()), nodes.n, rays_per_node)
         cast = np.zeros(nodes.n, np.int64)
         if progressive:
-            first_point = None if rays_per_point is None else min(FIRST_ROUND_RAYS, rays_per_point)
-            give = ray_allocation(nodes, min(FIRST_ROUND_RAYS, rays_per_node), first_point)
+            give = ray_allocation(
+                nodes, min(FIRST_ROUND_RAYS, rays_per_node), min(FIRST_ROUND_RAYS, rays_per_point)
+            )
         else:
             give = budget.copy()
         prev = prev_nodes = None
