@@ -420,6 +420,8 @@ _RECORD = np.iinfo(np.int64).min + 1  # stands for the "f" keyword while parsing
 _TWO_SLASHES = re.compile(r"/[^\s/]+/")
 _BARE = re.compile(r"(?<!\S)(-?\d+)(?=\s|$)")
 _THIRD = re.compile(r"(/[^\s/]*)/[^\s/]*")
+#: a face record without a slash: bare corners only
+_BARE_RECORD = re.compile(r"^[^/\n]*$", re.MULTILINE)
 
 
 def _mixed_to_uv(body: str, n_corner: int, slashes: int) -> str:
@@ -431,13 +433,13 @@ def _mixed_to_uv(body: str, n_corner: int, slashes: int) -> str:
     regular-expression passes over all records.  Both give the same text.
     """
     if _TWO_SLASHES.search(body) is None:
-        lines = body.split("\n")
-        bare = [i for i, line in enumerate(lines) if "/" not in line]
-        bare_corners = sum(len(lines[i].split()) - 1 for i in bare)
-        if slashes == n_corner - bare_corners:  # every other corner is v/vt
-            for i in bare:
-                lines[i] = _BARE.sub(r"\1/0", lines[i])
-            return "\n".join(lines)
+        bare = list(_BARE_RECORD.finditer(body))
+        if slashes == n_corner - sum(len(r.group().split()) - 1 for r in bare):  # the rest is v/vt
+            pieces, end = [], 0
+            for r in bare:
+                pieces += [body[end : r.start()], _BARE.sub(r"\1/0", r.group())]
+                end = r.end()
+            return "".join(pieces) + body[end:]
     return _BARE.sub(r"\1/0", _THIRD.sub(r"\1", body))
 
 
