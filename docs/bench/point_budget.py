@@ -27,7 +27,8 @@ from pathlib import Path
 import numpy as np
 
 from meshvis.eval.bench.orientation import soup_of
-from meshvis.eval.false_pixels import face_pixels, false_pixels
+from meshvis.eval.bench.real import _judge as judge
+from meshvis.eval.false_pixels import face_pixels
 from meshvis.eval.reference import reference
 from meshvis.geometry.adjacency import weld
 from meshvis.geometry.duplicates import opposite_copies
@@ -86,15 +87,15 @@ def remove_rows(model, stem):
     for (spf, rpn, rpp), seed in itertools.product(settings, ints(args.seeds)):
         t = time.perf_counter()
         c = classify(model, seed=seed, rays_per_node=rpn, samples_per_face=spf, rays_per_point=rpp)
-        removed = ~remove_interior(model, classification=c, visibility=args.visibility, seed=seed).keep
+        keep = remove_interior(model, classification=c, visibility=args.visibility, seed=seed).keep
         seconds = time.perf_counter() - t
-        fp = false_pixels(table, removed)
-        points.setdefault((spf, rpn, rpp), []).append((seconds, fp["mean"]))
+        # judged by `meshvis bench real`'s own function (the "unseen" column is not printed)
+        row = judge(args.visibility, area, keep, hidden, hidden, table, None, c.n_rays, seconds)
+        points.setdefault((spf, rpn, rpp), []).append((seconds, row["false_pixels_mean"]))
         print(
             f"| {spf} | {rpn} | {rpp} | {seed} | {seconds:.2f} s | {c.n_rays / 1e6:.2f} M | {len(c.rounds)} "
-            f"| {100 * area[removed].sum() / total:.2f} % "
-            f"| {100 * area[removed & hidden].sum() / max(area[hidden].sum(), 1e-300):.1f} % "
-            f"| {fp['mean']:.0f} | {fp['worst']:.0f} |",
+            f"| {100 * row['removed_area']:.2f} % | {100 * row['reference_hidden_removed']:.1f} % "
+            f"| {row['false_pixels_mean']:.0f} | {row['false_pixels_worst']:.0f} |",
             flush=True,
         )
     return points
