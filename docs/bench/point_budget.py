@@ -4,7 +4,7 @@
 
 Usage (from the repository root):
     python docs/bench/point_budget.py remove [MODEL ...] [--points 32,16,8] [--samples 4] [--seeds 0,1,2]
-    python docs/bench/point_budget.py orient [MODEL ...] [--points 32,8] [--seeds 0,1]
+    python docs/bench/point_budget.py orient [MODEL ...] [--points 32,8] [--seeds 0,1] [--libigl]
 
 ``remove``: `remove_interior(visibility="object")` (or ``--visibility both``) judged as `meshvis bench real` judges it
 (DESIGN.md §10): false pixels per million over 128 views (mean and worst view), the share of
@@ -26,7 +26,7 @@ from pathlib import Path
 
 import numpy as np
 
-from meshvis.eval.bench.orientation import soup_of
+from meshvis.eval.bench.orientation import BASELINES, soup_of
 from meshvis.eval.bench.real import _judge as judge
 from meshvis.eval.false_pixels import face_pixels
 from meshvis.eval.reference import reference
@@ -38,6 +38,7 @@ from meshvis.repair.orient import orient
 from meshvis.repair.remove import remove_interior
 
 warnings.simplefilter("ignore")
+LIBIGL = BASELINES["libigl_reorient"]
 parser = argparse.ArgumentParser()
 parser.add_argument("task", choices=("remove", "orient"))
 parser.add_argument("models", nargs="*", default=["../shared/models/real/pybullet__samurai_monastry.obj"])
@@ -52,6 +53,7 @@ parser.add_argument(
     "--replot", metavar="TXT", help="remove: only draw --curve from the saved output of a run"
 )
 parser.add_argument("--seeds", default="0,1")
+parser.add_argument("--libigl", action="store_true", help="orient: also time libigl's default")
 parser.add_argument(
     "--visibility", default="object", choices=("object", "both"), help="remove: the mode judged"
 )
@@ -137,6 +139,10 @@ def orient_rows(model, stem):
     print("| input | rays_per_point | seed | orient | error |")
     print("|---|---:|---:|---:|---:|")
     for kind, (s, turned) in [("as is", (model, np.zeros(m, bool))), ("soup", soup_of(model, 0))]:
+        if args.libigl:  # libigl's default on the same input, before the meshvis runs
+            for seed in ints(args.seeds):
+                res = LIBIGL.run(s, **LIBIGL.fixed)
+                print(f"| {kind} | libigl_reorient | {seed} | {res.seconds:.2f} s | |", flush=True)
         for rpp in ints(args.points):
             for seed in ints(args.seeds):
                 t = time.perf_counter()
