@@ -7,6 +7,7 @@ import os
 import time
 
 from meshvis.errors import ParameterError
+from meshvis.graphcut.solvers import SOLVERS
 from meshvis.io.report import write_report
 from meshvis.repair.operation import CLASSIFY_DEFAULTS, OPERATION_DEFAULTS
 from meshvis.repair.remove_modes import LEVELS, VISIBILITY_MODES
@@ -149,7 +150,7 @@ def algorithm_options(p: argparse.ArgumentParser) -> None:
         action="store_false",
         help="cast the whole ray budget in one round",
     )
-    p.add_argument("--solver", choices=("pymaxflow", "scipy"), default=d["solver"])
+    p.add_argument("--solver", choices=SOLVERS, default=d["solver"])
 
 
 def region_option(p: argparse.ArgumentParser, default: str | None, what: str) -> None:

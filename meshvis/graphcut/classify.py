@@ -32,7 +32,7 @@ from meshvis._version import __version__
 from meshvis.errors import ModelError, ParameterError
 from meshvis.geometry.adjacency import VertexGroups, group_vertices
 from meshvis.graphcut.hints import Hints, hint_weights
-from meshvis.graphcut.mincut import SOLVERS, Cut, VisibilityGraph
+from meshvis.graphcut.mincut import DEFAULT_SOLVER, SOLVERS, Cut, VisibilityGraph
 from meshvis.graphcut.nodes import NodeSet, build_nodes
 from meshvis.graphcut.preprocess import Preprocessed, preprocess
 from meshvis.graphcut.sampling import VisibilityCounts, sample_round
@@ -269,7 +269,7 @@ def classify(
     opening: float | None = DEFAULT_OPENING,
     progressive: bool = True,
     tolerance: float = 1e-3,
-    solver: str = "pymaxflow",
+    solver: str = DEFAULT_SOLVER,
     offset: float | None = None,
     caster: RayCaster | None = None,
     progress: Callable[[str, float], None] | None = None,
@@ -296,7 +296,8 @@ def classify(
         :func:`meshvis.graphcut.weights.inside_prior`); None follows the paper exactly
     progressive : sample in rounds and stop when labels settle (else one full round)
     tolerance : stop when a round changes less than this fraction of the total side area
-    solver : "pymaxflow" or "scipy"
+    solver : "bk" (compiled Boykov–Kolmogorov), "pymaxflow" (the same through PyMaxflow,
+        the same labels) or "scipy" (integer capacities)
     offset : push of ray origins off surfaces, relative to the bounding-box diagonal
     caster : reuse a prebuilt :class:`~meshvis.rays.caster.RayCaster` of the same model
     progress : callback ``progress(stage, fraction)``

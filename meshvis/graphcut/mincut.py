@@ -1,9 +1,12 @@
 """s-t minimum cut of the visibility graph (appendix H §4, Eq. 10–11).
 
-Source = OUTSIDE, sink = INSIDE; a node left on the source side is outside.  Two solvers
+Source = OUTSIDE, sink = INSIDE; a node left on the source side is outside.  Three solvers
 sit behind one function:
 
-* ``"pymaxflow"`` (default): Boykov–Kolmogorov on float capacities;
+* ``"bk"`` (default): Boykov–Kolmogorov on float capacities, compiled here
+  (:mod:`meshvis.graphcut.boykov_kolmogorov`);
+* ``"pymaxflow"``: the same algorithm through PyMaxflow (the same labels; kept to check
+  the kernel against);
 * ``"scipy"``: ``scipy.sparse.csgraph.maximum_flow``, which needs integer capacities.
   Capacities are scaled so that the largest one maps to ``2**30`` and rounded to the
   nearest integer; capacities below ``0.5 / scale`` (relative 2**-31 of the largest)
@@ -19,9 +22,10 @@ import numpy as np
 import scipy.sparse as sp
 
 from meshvis.errors import ParameterError
+from meshvis.graphcut.boykov_kolmogorov import min_cut_bk
+from meshvis.graphcut.solvers import DEFAULT_SOLVER, SOLVERS
 from meshvis.graphcut.weights import Weights
 
-SOLVERS = ("pymaxflow", "scipy")
 #: largest integer capacity used by the scipy solver (int32 sums must not overflow: the
 #: flow out of the source is bounded by the sum of its capacities, which we keep < 2**31)
 INT_MAX_CAP = 2**30
@@ -45,7 +49,7 @@ def min_cut(
     cap_ji: np.ndarray,
     cap_source: np.ndarray,
     cap_sink: np.ndarray,
-    solver: str = "pymaxflow",
+    solver: str = DEFAULT_SOLVER,
 ) -> Cut:
     """Minimum s-t cut of a graph with directed capacities.
 
@@ -53,12 +57,15 @@ def min_cut(
     ----------
     n : number of nodes; i, j : (k,) edge ends; cap_ij, cap_ji : (k,) capacities i→j and j→i
     cap_source : (n,) capacity source→node; cap_sink : (n,) capacity node→sink
-    solver : "pymaxflow" or "scipy"
+    solver : "bk", "pymaxflow" or "scipy"
 
     Returns
     -------
     Cut, with ``outside[v]`` True where v stays connected to the source.
     """
+    if solver == "bk":
+        outside, value = min_cut_bk(n, i, j, cap_ij, cap_ji, cap_source, cap_sink)
+        return Cut(outside, value, "bk")
     if solver == "pymaxflow":
         return _cut_pymaxflow(n, i, j, cap_ij, cap_ji, cap_source, cap_sink)
     if solver == "scipy":
@@ -157,7 +164,7 @@ class VisibilityGraph:
         """Number of node-node edges of the graph."""
         return len(self.weights.edges_i)
 
-    def cut(self, solver: str = "pymaxflow", tie_to_source: np.ndarray | None = None) -> Cut:
+    def cut(self, solver: str = DEFAULT_SOLVER, tie_to_source: np.ndarray | None = None) -> Cut:
         """Min cut; nodes in ``tie_to_source`` (bool mask) are forced outside (layer peeling)."""
         w = self.weights
         cap_out = w.cap_out

@@ -15,6 +15,7 @@ from typing import Any
 import numpy as np
 
 from meshvis.errors import ParameterError
+from meshvis.graphcut.solvers import DEFAULT_SOLVER
 from meshvis.repair.remove_modes import DEFAULT_VISIBILITY
 
 #: operations that classify a model and write a result
@@ -29,7 +30,7 @@ CLASSIFY_DEFAULTS: dict[str, Any] = {
     "rays_per_point": None,  # None: rays_per_node
     "use_filter": True,
     "progressive": True,
-    "solver": "pymaxflow",
+    "solver": DEFAULT_SOLVER,
     "inside_points": [],
     "outside_points": [],
     "inside_boxes": [],

@@ -137,6 +137,25 @@ def test_solvers_agree_within_the_rounding_bound_on_weights_spanning_12_orders()
     assert r["difference"] <= r["bound"]
     assert r["capacities_rounded_to_zero"] > 0  # the integer solver does lose the tiny ones
     assert r["agreement"] >= cases.AGREEMENT and r["area_differing"] < 1e-8
+    # the compiled solver finds the same maximum flow, and its labels are a cut of that value
+    assert r["value_bk"] == pytest.approx(r["value_pymaxflow"], rel=1e-9)
+    assert r["bk_labels_cut"] == pytest.approx(r["value_pymaxflow"], rel=1e-9)
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_compiled_solver_equals_pymaxflow_on_capacities_spanning_12_orders(seed):
+    rng = np.random.default_rng(seed)
+    n, k = 200, 1000
+    i, j = rng.integers(0, n, k), rng.integers(0, n, k)
+    keep = i != j  # repeated pairs stay: parallel edges add up
+    i, j = i[keep], j[keep]
+    caps = [10.0 ** rng.uniform(-12, 0, size) for size in (len(i), len(i), n, n)]
+    for c in caps[2:]:
+        c[rng.random(n) < 0.5] = 0.0
+    pm = min_cut(n, i, j, *caps, solver="pymaxflow")
+    bk = min_cut(n, i, j, *caps, solver="bk")
+    assert np.array_equal(bk.outside, pm.outside)
+    assert bk.value == pytest.approx(pm.value, rel=1e-12)
 
 
 @pytest.mark.parametrize("seed", [0, 1, 2])

@@ -19,7 +19,7 @@ import numpy as np
 from meshvis.errors import ModelError
 from meshvis.eval import generators
 from meshvis.graphcut.classify import Classification, classify
-from meshvis.graphcut.mincut import Cut, rounding_bound
+from meshvis.graphcut.mincut import Cut, cut_value, rounding_bound
 from meshvis.graphcut.weights import DEFAULT_OPENING
 from meshvis.rays.caster import DEFAULT_OFFSET
 from meshvis.soup import Soup
@@ -713,8 +713,12 @@ def _cut_edges(outside: np.ndarray, w) -> int:
 
 
 def compare_solvers(c: Classification) -> dict:
-    """Cut the final graph of ``c`` with both solvers and compare.
+    """Cut the final graph of ``c`` with the three solvers and compare.
 
+    The compiled Boykov–Kolmogorov solver (``bk``, the default) and PyMaxflow run the same
+    algorithm on the same float capacities: their values agree to the summation order and
+    their labels are the same (the source side of a maximum flow's residual graph is
+    unique) up to exact ties between minimum cuts, which float rounding breaks either way.
     The scipy solver cuts integer capacities ``rint(cap × scale)``.  Each rounded capacity
     is off by at most ``0.5 / scale``; comparing each solver's cut under both capacity
     sets gives ``|value_scipy − value_pymaxflow| ≤ 0.5 k / scale`` with *k* the larger
@@ -729,7 +733,8 @@ def compare_solvers(c: Classification) -> dict:
     Returns
     -------
     dict
-        Both values, their difference, the bound, the weight span (orders of magnitude of
+        The three values, the scipy difference and its bound, the nodes the ``bk`` labels
+        differ on from PyMaxflow's and the cut value of the ``bk`` labels, the weight span (orders of magnitude of
         the positive edge weights and of all positive capacities), the capacities rounded
         to zero (count, share of their sum in the exact cut value), the nodes and faces
         labelled differently and the area agreement.
@@ -737,6 +742,7 @@ def compare_solvers(c: Classification) -> dict:
     w = c.graph.weights
     pm: Cut = c.graph.cut("pymaxflow")
     sc: Cut = c.graph.cut("scipy")
+    bk: Cut = c.graph.cut("bk")
     k = max(_cut_edges(pm.outside, w), _cut_edges(sc.outside, w))
     bound = rounding_bound(k, sc.scale)
     caps = np.concatenate([w.cap_ij, w.cap_ji, w.cap_out, w.cap_in])
@@ -749,6 +755,9 @@ def compare_solvers(c: Classification) -> dict:
     return {
         "value_pymaxflow": pm.value,
         "value_scipy": sc.value,
+        "value_bk": bk.value,
+        "bk_nodes_differing": int(np.sum(bk.outside != pm.outside)),
+        "bk_labels_cut": cut_value(bk.outside, w.edges_i, w.edges_j, w.cap_ij, w.cap_ji, w.cap_out, w.cap_in),
         "difference": abs(sc.value - pm.value),
         "bound": bound,
         "cut_edges": k,
@@ -801,15 +810,19 @@ def weight_cases(
             bad = nonfinite(c)
             slack = 1e-9 * max(r["value_pymaxflow"], 1e-300)  # float summation order
             ok_value = r["difference"] <= r["bound"] + slack
+            # the compiled solver: the same maximum flow, and its labels a cut of that value
+            ok_bk = abs(r["value_bk"] - r["value_pymaxflow"]) <= slack
+            ok_bk &= abs(r["bk_labels_cut"] - r["value_pymaxflow"]) <= slack
             ok_span = name not in require_span or r["edge_weight_orders"] >= WEIGHT_ORDERS
-            ok = ok_value and ok_span and r["agreement"] >= AGREEMENT and not bad
+            ok = ok_value and ok_bk and ok_span and r["agreement"] >= AGREEMENT and not bad
             fig = (
                 f"edge weights span {r['edge_weight_orders']:.1f} orders; cut {r['value_pymaxflow']:.6g} vs "
                 f"{r['value_scipy']:.6g}, |diff| {r['difference']:.2e} <= bound {r['bound']:.2e}: "
                 f"{'yes' if ok_value else 'NO'}; labels agree on {100 * r['agreement']:.4f}% of area; "
                 f"rounding lost {r['capacities_rounded_to_zero']} of {r['capacities']} capacities "
                 f"({r['lost_share_of_cut']:.1e} of the cut), {r['faces_differing']} faces "
-                f"({r['area_differing']:.1e} of area) labelled differently"
+                f"({r['area_differing']:.1e} of area) labelled differently; bk: cut {r['value_bk']:.6g}, "
+                f"labels differ from pymaxflow on {r['bk_nodes_differing']} nodes{'' if ok_bk else ', VALUE DIFFERS'}"
             )
             if not ok_span:
                 fig += f"; SPAN BELOW {WEIGHT_ORDERS} ORDERS"

@@ -1,0 +1,343 @@
+"""Boykov–Kolmogorov maximum flow, compiled (the default solver of :mod:`~meshvis.graphcut.mincut`).
+
+The algorithm of Boykov and Kolmogorov ("An experimental comparison of min-cut/max-flow
+algorithms for energy minimization in vision", PAMI 2004), which PyMaxflow wraps in C++,
+written here as one numba kernel over flat arrays:
+
+* a *search tree* grows from the source (OUTSIDE) and one from the sink (INSIDE) through
+  arcs with residual capacity; where they touch, the path is *augmented* by its bottleneck;
+* arcs saturated by the augmentation cut nodes off their tree (*orphans*); each orphan
+  looks for a new parent in its own tree that still leads to the terminal, preferring the
+  shortest such path (the distance and time-stamp marks of the paper), or becomes free;
+* the loop ends when neither tree can grow.  The source tree is then exactly the set of
+  nodes reachable from the source in the residual graph: a node in it is reached along its
+  tree path, and a node outside it would have been adopted by the growth stage.
+
+That set is the same for every maximum flow (the smallest source side among the minimum
+cuts), so the labels do not depend on which maximum flow the search happens to find: this
+kernel and PyMaxflow give the same labels (``tests/graphcut/test_boykov_kolmogorov.py``
+checks it on random graphs with ties and on the real scenes' graphs).  A node linked to
+neither terminal and reachable from neither is free and counts as INSIDE, as the
+object-based definition wants (DESIGN.md §4).
+
+Why not PyMaxflow: its graph is built edge by edge through Python wrappers and kept as C++
+structures; on the monastery's 1.4 M edges building it took a third of each cut, and the
+kernel here is also faster on the search itself (docs/performance.md, "Max-flow kernel").
+
+Arc layout: the arcs leaving node ``v`` are ``first[v] .. first[v + 1] - 1``; arc ``a``
+goes to ``head[a]`` with residual capacity ``rcap[a]``, and ``sister[a]`` is its reverse.
+``excess[v]`` is the residual terminal capacity: positive from the source, negative to the
+sink (the two links of a node are netted first, as in the paper's code).
+"""
+
+from __future__ import annotations
+
+import numba
+import numpy as np
+
+#: parent marks: a free node, a tree root linked to its terminal, a node cut off its tree
+FREE, TERMINAL, ORPHAN = -1, -2, -3
+#: distance of a node whose path to the terminal is broken
+_NO_PATH = 1 << 62
+
+
+def min_cut_bk(
+    n: int,
+    i: np.ndarray,
+    j: np.ndarray,
+    cap_ij: np.ndarray,
+    cap_ji: np.ndarray,
+    cap_source: np.ndarray,
+    cap_sink: np.ndarray,
+) -> tuple[np.ndarray, float]:
+    """Minimum s-t cut by Boykov–Kolmogorov; source = OUTSIDE.
+
+    Parameters
+    ----------
+    n : int
+        Number of nodes.
+    i, j : (k,) int arrays
+        Edge ends (each unordered pair at most once).
+    cap_ij, cap_ji : (k,) float64 arrays
+        Capacities ``i → j`` and ``j → i`` (non-negative).
+    cap_source, cap_sink : (n,) float64 arrays
+        Capacities source → node and node → sink (non-negative).
+
+    Returns
+    -------
+    outside : (n,) bool array
+        Nodes reachable from the source in the residual graph of a maximum flow.
+    value : float
+        The maximum flow (= the minimum cut's capacity).
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> out, value = min_cut_bk(2, np.array([0]), np.array([1]), np.array([1.0]),
+    ...                         np.array([0.0]), np.array([5.0, 0.0]), np.array([0.0, 3.0]))
+    >>> out.tolist(), value
+    ([True, False], 1.0)
+    """
+    cap_source = np.asarray(cap_source, np.float64)
+    cap_sink = np.asarray(cap_sink, np.float64)
+    if n == 0:
+        return np.zeros(0, bool), 0.0
+    first, head, sister, arc_ij, arc_ji = arcs_by_tail(n, np.asarray(i, np.int64), np.asarray(j, np.int64))
+    rcap = np.empty(len(head), np.float64)
+    rcap[arc_ij] = cap_ij
+    rcap[arc_ji] = cap_ji
+    excess = cap_source - cap_sink
+    outside, flow = _max_flow(first, head, sister, rcap, excess)
+    # the netted part of each node's two terminal links flows straight through the node
+    return outside, float(flow + np.minimum(cap_source, cap_sink).sum())
+
+
+@numba.njit(cache=True, nogil=True)
+def arcs_by_tail(n, i, j):  # pragma: no cover - compiled
+    """Both arcs of every edge, grouped by tail node (a counting sort).
+
+    Returns ``first`` (n + 1,), ``head`` and ``sister`` (2k,), and the positions of each
+    edge's ``i → j`` and ``j → i`` arcs (k,).
+    """
+    k = len(i)
+    first = np.zeros(n + 1, np.int64)
+    for e in range(k):
+        first[i[e] + 1] += 1
+        first[j[e] + 1] += 1
+    for v in range(n):
+        first[v + 1] += first[v]
+    fill = first[:-1].copy()
+    head = np.empty(2 * k, np.int64)
+    sister = np.empty(2 * k, np.int64)
+    arc_ij = np.empty(k, np.int64)
+    arc_ji = np.empty(k, np.int64)
+    for e in range(k):
+        a = fill[i[e]]
+        fill[i[e]] += 1
+        b = fill[j[e]]
+        fill[j[e]] += 1
+        head[a], head[b] = j[e], i[e]
+        sister[a], sister[b] = b, a
+        arc_ij[e], arc_ji[e] = a, b
+    return first, head, sister, arc_ij, arc_ji
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _enqueue(queue, ends, v):  # pragma: no cover - compiled
+    """Append ``v`` to a ring buffer whose ``ends`` are (first, one past last)."""
+    queue[ends[1]] = v
+    ends[1] = (ends[1] + 1) % len(queue)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _push_front(queue, ends, v):  # pragma: no cover - compiled
+    ends[0] = (ends[0] - 1) % len(queue)
+    queue[ends[0]] = v
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _dequeue(queue, ends):  # pragma: no cover - compiled
+    v = queue[ends[0]]
+    ends[0] = (ends[0] + 1) % len(queue)
+    return v
+
+
+@numba.njit(cache=True, nogil=True)
+def _max_flow(first, head, sister, rcap, excess):  # pragma: no cover - compiled
+    """Boykov–Kolmogorov on the arc layout (module notes); ``rcap`` and ``excess`` in place.
+
+    Returns (source-tree membership, flow pushed through the edges).
+    """
+    n = len(excess)
+    parent = np.full(n, FREE, np.int64)  # arc from the node to its parent, or a mark
+    in_sink_tree = np.zeros(n, np.bool_)
+    stamp = np.zeros(n, np.int64)  # when `dist` was last known to be right
+    dist = np.zeros(n, np.int64)  # tree distance to the terminal
+    active = np.empty(n + 1, np.int64)  # ring buffer; each node at most once
+    active_ends = np.zeros(2, np.int64)
+    queued = np.zeros(n, np.bool_)
+    orphans = np.empty(n + 1, np.int64)  # ring buffer; a node is an orphan at most once
+    orphan_ends = np.zeros(2, np.int64)
+    scan_from = first[:-1].copy()  # where the growth of each node goes on
+    arcs = (first, head, sister, rcap)
+    tree = (parent, in_sink_tree, stamp, dist)
+    queues = (active, active_ends, queued, scan_from, orphans, orphan_ends)
+    for v in range(n):
+        if excess[v] != 0:
+            parent[v] = TERMINAL
+            in_sink_tree[v] = excess[v] < 0
+            dist[v] = 1
+            queued[v] = True
+            _enqueue(active, active_ends, v)
+    time = 0
+    flow = 0.0
+    current = -1  # the node whose growth found a path keeps growing next
+    while True:
+        v = -1
+        if current >= 0:
+            queued[current] = False
+            if parent[current] != FREE:
+                v = current
+            current = -1
+        while v < 0 and active_ends[0] != active_ends[1]:
+            u = _dequeue(active, active_ends)
+            queued[u] = False
+            if parent[u] != FREE:
+                v = u
+        if v < 0:
+            break
+        # growth: adopt free neighbours, stop at the first arc into the other tree.  A node
+        # that found a path grows on from that arc: the arcs before it led into its own
+        # tree, and one that could lead elsewhere again (a neighbour freed by the adoption)
+        # sends the scan back to the start (`scan_from` reset in `_adopt`)
+        bridge = -1  # arc from the source tree to the sink tree
+        sink_side = in_sink_tree[v]
+        for a in range(scan_from[v], first[v + 1]):
+            if (rcap[sister[a]] if sink_side else rcap[a]) > 0:
+                u = head[a]
+                if parent[u] == FREE:
+                    in_sink_tree[u] = sink_side
+                    parent[u] = sister[a]
+                    stamp[u] = stamp[v]
+                    dist[u] = dist[v] + 1
+                    scan_from[u] = first[u]
+                    if not queued[u]:
+                        queued[u] = True
+                        _enqueue(active, active_ends, u)
+                elif in_sink_tree[u] != sink_side:
+                    bridge = sister[a] if sink_side else a
+                    scan_from[v] = a
+                    break
+                elif stamp[u] <= stamp[v] and dist[u] > dist[v]:
+                    # a shorter way to the terminal for u
+                    parent[u] = sister[a]
+                    stamp[u] = stamp[v]
+                    dist[u] = dist[v] + 1
+        time += 1
+        if bridge < 0:
+            scan_from[v] = first[v]
+            continue
+        current = v
+        queued[v] = True
+        flow += _augment(bridge, head, sister, rcap, excess, parent, orphans, orphan_ends)
+        _adopt(time, arcs, tree, queues)
+    outside = np.zeros(n, np.bool_)
+    for v in range(n):
+        outside[v] = parent[v] != FREE and not in_sink_tree[v]
+    return outside, flow
+
+
+@numba.njit(cache=True, nogil=True)
+def _augment(bridge, head, sister, rcap, excess, parent, orphans, orphan_ends):  # pragma: no cover - compiled
+    """Push the bottleneck along source root → bridge → sink root; orphan saturated nodes."""
+    # bottleneck: the bridge, the source-tree arcs (parent → child), the sink-tree arcs
+    # (child → parent) and the two terminal links
+    b = rcap[bridge]
+    v = head[sister[bridge]]
+    while parent[v] != TERMINAL:
+        b = min(b, rcap[sister[parent[v]]])
+        v = head[parent[v]]
+    b = min(b, excess[v])
+    v = head[bridge]
+    while parent[v] != TERMINAL:
+        b = min(b, rcap[parent[v]])
+        v = head[parent[v]]
+    b = min(b, -excess[v])
+    # b equals one of the residuals exactly, so that one becomes exactly 0
+    rcap[sister[bridge]] += b
+    rcap[bridge] -= b
+    v = head[sister[bridge]]
+    while True:
+        p = parent[v]
+        if p == TERMINAL:
+            excess[v] -= b
+            if excess[v] == 0:
+                parent[v] = ORPHAN
+                _push_front(orphans, orphan_ends, v)
+            break
+        rcap[p] += b
+        rcap[sister[p]] -= b
+        if rcap[sister[p]] == 0:
+            parent[v] = ORPHAN
+            _push_front(orphans, orphan_ends, v)
+        v = head[p]
+    v = head[bridge]
+    while True:
+        p = parent[v]
+        if p == TERMINAL:
+            excess[v] += b
+            if excess[v] == 0:
+                parent[v] = ORPHAN
+                _push_front(orphans, orphan_ends, v)
+            break
+        rcap[sister[p]] += b
+        rcap[p] -= b
+        if rcap[p] == 0:
+            parent[v] = ORPHAN
+            _push_front(orphans, orphan_ends, v)
+        v = head[p]
+    return b
+
+
+@numba.njit(cache=True, nogil=True)
+def _adopt(time, arcs, tree, queues):  # pragma: no cover - compiled
+    """Give every orphan a parent of its own tree that still reaches the terminal, or free it."""
+    first, head, sister, rcap = arcs
+    parent, in_sink_tree, stamp, dist = tree
+    active, active_ends, queued, scan_from, orphans, orphan_ends = queues
+    while orphan_ends[0] != orphan_ends[1]:
+        v = _dequeue(orphans, orphan_ends)
+        sink_side = in_sink_tree[v]
+        best, best_d = -1, _NO_PATH
+        for a in range(first[v], first[v + 1]):
+            # flow must be able to go parent → v in the source tree, v → parent in the sink tree
+            if (rcap[a] if sink_side else rcap[sister[a]]) <= 0:
+                continue
+            u = head[a]
+            if in_sink_tree[u] != sink_side or parent[u] == FREE:
+                continue
+            # walk up from u until a terminal, a node stamped this time, or an orphan
+            d, w = 0, u
+            while True:
+                if stamp[w] == time:
+                    d += dist[w]
+                    break
+                p = parent[w]
+                d += 1
+                if p == TERMINAL:
+                    stamp[w], dist[w] = time, 1
+                    break
+                if p == ORPHAN:
+                    d = _NO_PATH
+                    break
+                w = head[p]
+            if d == _NO_PATH:
+                continue
+            if d < best_d:
+                best, best_d = a, d
+            # stamp the path so later walks stop early
+            w = u
+            while stamp[w] != time:
+                stamp[w], dist[w] = time, d
+                d -= 1
+                w = head[parent[w]]
+        if best >= 0:
+            parent[v], stamp[v], dist[v] = best, time, best_d + 1
+            continue
+        parent[v] = FREE
+        scan_from[v] = first[v]
+        for a in range(first[v], first[v + 1]):
+            u = head[a]
+            p = parent[u]
+            if in_sink_tree[u] != sink_side or p == FREE:
+                continue
+            # a neighbour that could feed v may adopt it again (from the start of its arcs,
+            # also when it is the node growing now); v's children are orphans now
+            if (rcap[a] if sink_side else rcap[sister[a]]) > 0:
+                scan_from[u] = first[u]
+                if not queued[u]:
+                    queued[u] = True
+                    _enqueue(active, active_ends, u)
+            if p != TERMINAL and p != ORPHAN and head[p] == v:
+                parent[u] = ORPHAN
+                _enqueue(orphans, orphan_ends, u)
