@@ -129,7 +129,7 @@ def algorithm_options(p: argparse.ArgumentParser) -> None:
         type=positive_int,
         default=d["rays_per_point"],
         help="ray budget per sample point of an intersecting/coplanar face (default: --rays-per-node; "
-        "8 takes 0.37-0.9 of the time on the real scenes measured, at a cost in accuracy: docs/performance.md)",
+        "in remove-interior --visibility both, --rays-per-node divided by --samples-per-face: docs/performance.md)",
     )
     p.add_argument(
         "--samples-per-face",

@@ -43,6 +43,7 @@ def test_bench_real_judges_every_method_on_a_small_model(tmp_path, capsys):
     assert curve.stat().st_size > 1000 and (tmp_path / "nested.seed0.npz").is_file()
     assert "nested" in capsys.readouterr().out
     assert r["rays_per_point"] == 32  # the default: rays_per_node
+    assert r["rays_per_point_both"] == 8  # both's default: rays_per_node // samples_per_face
 
 
 @pytest.mark.skipif(not (REAL / "pins.glb").is_file(), reason="shared real models not present")
@@ -55,5 +56,6 @@ def test_bench_real_passes_the_sample_points_budget_to_the_cut(tmp_path):
     full = json.loads(out.read_text())["results"][0]
     few = json.loads((tmp_path / "r8.json").read_text())["results"][0]
     assert (full["rays_per_point"], few["rays_per_point"]) == (32, 2)
+    assert (full["rays_per_point_both"], few["rays_per_point_both"]) == (8, 2)
     rays = {r["method"]: r["rays"] for r in full["rows"]}, {r["method"]: r["rays"] for r in few["rows"]}
     assert rays[1]["object (graph cut)"] < rays[0]["object (graph cut)"]

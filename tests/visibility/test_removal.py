@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -11,6 +12,8 @@ from meshvis.cli.main import main
 from meshvis.errors import ParameterError
 from meshvis.io import load, save
 from meshvis.repair.remove import REASONS, remove_interior
+
+MODELS = Path(__file__).resolve().parents[2] / "models"
 
 
 def test_view_removes_exactly_the_sealed_pocket(scenes):
@@ -122,3 +125,24 @@ def test_both_searches_only_around_the_faces_the_cut_calls_hidden(scenes):
     cube, _ = scenes.unit_cube()
     whole = remove_interior(cube, visibility="both", seed=0)
     assert whole.keep.all() and whole.visibility.rays["total"] == 0
+
+
+def test_both_gives_the_cuts_sample_points_the_budget_of_a_one_face_side(scenes):
+    soup, _ = scenes.pierced_box()  # the triangle crosses the box: flagged faces, sample points
+    budget = {
+        mode: remove_interior(soup, visibility=mode, seed=0, **kw).classification.params["rays_per_point"]
+        for mode, kw in [("both", {}), ("object", {})]
+    }
+    assert budget == {"both": 8, "object": 32}  # 32 // 4 sample points; object keeps rays_per_node
+    # a budget the caller sets wins, and the default follows rays_per_node and the samples
+    given = remove_interior(soup, seed=0, rays_per_point=32).classification
+    fewer = remove_interior(soup, seed=0, rays_per_node=16, samples_per_face=2).classification
+    assert given.params["rays_per_point"] == 32 and fewer.params["rays_per_point"] == 8
+
+
+def test_both_casts_fewer_cut_rays_where_sample_points_need_refining():
+    soup = load(MODELS / "assembly.obj")  # interpenetrating parts: many flagged faces
+    default = remove_interior(soup, seed=0).classification
+    full = remove_interior(soup, seed=0, rays_per_point=32).classification
+    assert default.counts.rays < full.counts.rays
+    assert default.params["rays_per_point"] == 8 and full.params["rays_per_point"] == 32

@@ -118,7 +118,8 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         type=int,
         default=None,
         metavar="R",
-        help="ray budget per sample point of the graph cut (object and both; default: rays_per_node)",
+        help="ray budget per sample point of the graph cut (object and both; default: each mode's own, "
+        "rays_per_node for object and rays_per_node // samples_per_face for both)",
     )
 
 
@@ -224,7 +225,9 @@ def run_model(
     size : int
         Image size of the false pixels.
     rays_per_point : int, optional
-        Ray budget per sample point of the graph cut (:func:`meshvis.classify`).
+        Ray budget per sample point of the graph cut (:func:`meshvis.classify`) of the
+        object mode and of both; by default each mode's own (``rays_per_node``, and for
+        both :func:`meshvis.repair.remove.both_point_budget`).
 
     Returns
     -------
@@ -250,13 +253,19 @@ def run_model(
     view = remove_interior(soup, visibility="view", region="outside", seed=seed)
     rows["view (guided, outside)"] = (view.keep, view.visibility.rays["total"], time.perf_counter() - t)
 
+    # both as the command runs it: its own cut, whose sample points get less unless a
+    # budget is given (then the object mode's cut is the same and is reused)
     t = time.perf_counter()
-    both = remove_interior(soup, classification=c, visibility="both", seed=seed)
-    rows["both"] = (
-        both.keep,
-        both.visibility.rays["total"] + rows["object (graph cut)"][1],
-        t_obj + time.perf_counter() - t,
-    )
+    if rays_per_point is None:
+        both = remove_interior(soup, visibility="both", seed=seed)
+        t_both = time.perf_counter() - t
+    else:
+        both = remove_interior(soup, classification=c, visibility="both", seed=seed)
+        t_both = t_obj + time.perf_counter() - t
+    c_both = both.classification
+    assert c_both is not None  # "both" always cuts
+    rays_both = both.visibility.rays["total"] + int(c_both.report(per_face=False)["rays"])
+    rows["both"] = (both.keep, rays_both, t_both)
 
     convs, conv_seconds = [], []
     for k in range(1, max(int(searches), 1) + 1):
@@ -303,6 +312,7 @@ def run_model(
         "model": stem,
         "faces": soup.n_faces,
         "rays_per_point": c.params["rays_per_point"],
+        "rays_per_point_both": c_both.params["rays_per_point"],
         "ground": ground,
         "up": list(up),
         "reference_hidden_area": float(soup.areas[ref_hidden].sum() / soup.total_area),
