@@ -16,7 +16,7 @@ import numpy as np
 
 from meshvis.errors import ParameterError
 from meshvis.graphcut.solvers import DEFAULT_SOLVER
-from meshvis.repair.remove_modes import DEFAULT_VISIBILITY
+from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, cut_rays_per_point
 
 #: operations that classify a model and write a result
 OPERATIONS = ("classify", "orient", "remove-interior", "layers")
@@ -312,7 +312,12 @@ def run_operation(
         op == "orient" and o["from_region"]
     )
     if not by_sight:  # sight alone needs no cut
-        c = classify(soup, progress=progress, **classify_kwargs(o))
+        kw = classify_kwargs(o)
+        if op == "remove-interior":  # both gives the sample points less (remove_modes)
+            kw["rays_per_point"] = cut_rays_per_point(
+                o["visibility"], kw["rays_per_node"], kw["samples_per_face"], kw["rays_per_point"]
+            )
+        c = classify(soup, progress=progress, **kw)
         tell(c.summary())
     report = _OUTPUTS[op](soup, c, o, tell, up)
     report["operation"] = op

@@ -13,7 +13,8 @@
 In ``both`` the cut only proposes the faces that the search then tries to see, so its
 sample points get less: unless ``rays_per_point`` is given, each sample point of an
 intersecting face gets ``rays_per_node // samples_per_face`` rays, which gives a flagged
-face's side the budget of an unflagged face's (:func:`both_point_budget`).  Measured on
+face's side the budget of an unflagged face's
+(:func:`~meshvis.repair.remove_modes.cut_rays_per_point`).  Measured on
 the real scenes (docs/performance.md, "Rays per sample point"): ``both`` keeps its false
 pixels at 0-3 per million and removes as much of the hidden area or more, in about two
 thirds of the time.
@@ -37,7 +38,7 @@ from meshvis.geometry.adjacency import components, edges, face_adjacency, weld
 from meshvis.geometry.duplicates import hidden_copies, opposite_copies
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.io import as_soup
-from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, LEVELS, VISIBILITY_MODES
+from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, LEVELS, VISIBILITY_MODES, cut_rays_per_point
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, visible_from
 
@@ -208,8 +209,9 @@ def both_point_budget(classify_kw: dict[str, Any]) -> dict[str, Any]:
     """``classify_kw`` with the sample points' ray budget of ``visibility="both"``.
 
     A ``rays_per_point`` given (not None) is kept; otherwise it becomes
-    ``max(1, rays_per_node // samples_per_face)`` with :func:`meshvis.classify`'s defaults
-    for what is not given (32 // 4 = 8).
+    ``max(1, rays_per_node // samples_per_face)``
+    (:func:`~meshvis.repair.remove_modes.cut_rays_per_point`), with
+    :func:`meshvis.classify`'s defaults for what is not given (32 // 4 = 8).
 
     Examples
     --------
@@ -218,12 +220,11 @@ def both_point_budget(classify_kw: dict[str, Any]) -> dict[str, Any]:
     >>> both_point_budget({"rays_per_node": 64, "rays_per_point": 32})["rays_per_point"]
     32
     """
-    if classify_kw.get("rays_per_point") is not None:
-        return dict(classify_kw)
     defaults = inspect.signature(classify).parameters
     rays = classify_kw.get("rays_per_node", defaults["rays_per_node"].default)
     samples = classify_kw.get("samples_per_face", defaults["samples_per_face"].default)
-    return {**classify_kw, "rays_per_point": max(1, int(rays) // int(samples))}
+    budget = cut_rays_per_point("both", rays, samples, classify_kw.get("rays_per_point"))
+    return {**classify_kw, "rays_per_point": budget}
 
 
 def _kept_by_cut(c: Classification) -> np.ndarray:

@@ -146,3 +146,16 @@ def test_both_casts_fewer_cut_rays_where_sample_points_need_refining():
     full = remove_interior(soup, seed=0, rays_per_point=32).classification
     assert default.counts.rays < full.counts.rays
     assert default.params["rays_per_point"] == 8 and full.params["rays_per_point"] == 32
+
+
+def test_the_command_gives_both_the_same_sample_point_budget(tmp_path):
+    def budget(*flags):
+        out, report = tmp_path / "out.obj", tmp_path / "r.json"
+        argv = ["remove-interior", str(MODELS / "assembly.obj"), "-o", str(out), "--report", str(report)]
+        assert main([*argv, "--force", "--quiet", *flags]) == 0
+        return json.loads(report.read_text())["classification"]["params"]["rays_per_point"]
+
+    assert budget() == 8  # both, the default
+    assert budget("--visibility", "object") == 32
+    assert budget("--rays-per-point", "16") == 16
+    assert budget("--rays-per-node", "64") == 16
