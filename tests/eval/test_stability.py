@@ -142,16 +142,23 @@ def test_solvers_agree_within_the_rounding_bound_on_weights_spanning_12_orders()
     assert r["bk_labels_cut"] == pytest.approx(r["value_pymaxflow"], rel=1e-9)
 
 
-@pytest.mark.parametrize("seed", [0, 1, 2])
-def test_compiled_solver_equals_pymaxflow_on_capacities_spanning_12_orders(seed):
+def _stiff_graph(seed: int, n: int, k: int):
+    """Random edges (repeated pairs stay: parallel edges add up) with capacities spanning
+    12 orders of magnitude; half the terminal links are 0."""
     rng = np.random.default_rng(seed)
-    n, k = 200, 1000
     i, j = rng.integers(0, n, k), rng.integers(0, n, k)
-    keep = i != j  # repeated pairs stay: parallel edges add up
+    keep = i != j
     i, j = i[keep], j[keep]
     caps = [10.0 ** rng.uniform(-12, 0, size) for size in (len(i), len(i), n, n)]
     for c in caps[2:]:
         c[rng.random(n) < 0.5] = 0.0
+    return i, j, caps
+
+
+@pytest.mark.parametrize("seed", [0, 1, 2])
+def test_compiled_solver_equals_pymaxflow_on_capacities_spanning_12_orders(seed):
+    n = 200
+    i, j, caps = _stiff_graph(seed, n, 1000)
     pm = min_cut(n, i, j, *caps, solver="pymaxflow")
     bk = min_cut(n, i, j, *caps, solver="bk")
     assert np.array_equal(bk.outside, pm.outside)
@@ -160,14 +167,8 @@ def test_compiled_solver_equals_pymaxflow_on_capacities_spanning_12_orders(seed)
 
 @pytest.mark.parametrize("seed", [0, 1, 2])
 def test_rounding_bound_holds_on_random_graphs_with_extreme_capacities(seed):
-    rng = np.random.default_rng(seed)
-    n, k = 60, 300
-    i, j = rng.integers(0, n, k), rng.integers(0, n, k)
-    keep = i != j
-    i, j = i[keep], j[keep]
-    caps = [10.0 ** rng.uniform(-12, 0, size) for size in (len(i), len(i), n, n)]
-    for c in caps[2:]:
-        c[rng.random(n) < 0.5] = 0.0
+    n = 60
+    i, j, caps = _stiff_graph(seed, n, 300)
     pm = min_cut(n, i, j, *caps, solver="pymaxflow")
     sc = min_cut(n, i, j, *caps, solver="scipy")
     crossing = max(int(np.sum(o[i] != o[j])) + n for o in (pm.outside, sc.outside))
