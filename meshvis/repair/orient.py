@@ -24,7 +24,8 @@
    (:mod:`meshvis.repair.evidence`) and turned where that evidence is decisive and shows
    its other side; a face whose own sides the cut did not settle (two-sided, or flagged
    with sample points that disagree) is seen from both sides and, where the input does
-   not wind its patch consistently, takes the side seen more often; a flagged face (it
+   not wind its patch consistently or the patch is the face alone, takes the side seen
+   more often; a flagged face (it
    crosses another surface, across which its patch does not speak for it) also turns
    where a sign test says its other side is seen more often.  Faces of closed patches follow their patch: a closed patch bounds a volume,
    and a face of it whose back pokes out through the surface is a self-intersection, not
@@ -451,7 +452,14 @@ def _clearly_one_sided(c: Classification, outer: np.ndarray) -> np.ndarray:
 
 
 def _consistently_wound(p: Patches) -> np.ndarray:
-    """(m,) bool: the face's patch has all its fronts on one side as the input winds them."""
+    """(m,) bool: the face's patch has several faces, all fronts on one side as the input winds them.
+
+    A patch of one face has no winding of its own to keep: nothing joins it to a surface
+    whose side could speak for it (a lone triangle of a level or a soup), so its own
+    evidence decides it as it decides a face of an inconsistently wound patch.  On the
+    pandora level, 580 such faces seen from both sides but about five times as often from
+    one had kept the input's inward winding (0.79 % of the decisive area).
+    """
     patch = p.clustering.cluster
     front = p.clustering.side_node[:, 0]
     ok = patch >= 0
@@ -460,7 +468,9 @@ def _consistently_wound(p: Patches) -> np.ndarray:
     hi = np.full(n, -1)
     np.minimum.at(lo, patch[ok], front[ok])
     np.maximum.at(hi, patch[ok], front[ok])
-    return ok & (lo[np.maximum(patch, 0)] == hi[np.maximum(patch, 0)])
+    size = np.bincount(patch[ok], minlength=n)
+    at = np.maximum(patch, 0)
+    return ok & (lo[at] == hi[at]) & (size[at] > 1)
 
 
 def _visible_sides(
@@ -473,7 +483,8 @@ def _visible_sides(
     own rays already show their side clearly, and turned where its evidence is decisive
     and shows the other side.  A face whose own sides the cut did not settle (two-sided,
     or a flagged face whose sample points disagree) is seen from both sides: where the
-    input does not wind its patch consistently it takes the side seen more often
+    input does not wind its patch consistently, or the patch is the face alone, it takes
+    the side seen more often
     (:data:`BOTH_SEEN_DOMINANCE`).  A flagged face also turns where the side it does not
     show is seen significantly more often (:data:`CROSSING_LEVEL`); flagged faces whose rays
     barely escaped, and those whose test leans to the other side without passing, get more

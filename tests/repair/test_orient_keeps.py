@@ -15,7 +15,7 @@ import pytest
 
 from meshvis.io import load
 from meshvis.repair import evidence
-from meshvis.repair.orient import orient
+from meshvis.repair.orient import STATUS_NAMES, orient
 from meshvis.soup import Soup
 
 REAL = Path(__file__).resolve().parents[3] / "shared" / "models" / "real"
@@ -88,6 +88,18 @@ def test_seen_side_under_a_roof_takes_the_side_seen_more_often_only_when_asked()
     assert sure[0] and side[0] == 1
     side, sure, _ = evidence.seen_side(soup, caster, face, shown, np.random.default_rng(0))
     assert not sure[0]
+
+
+def test_a_lone_face_takes_the_side_seen_more_often():
+    """A patch of one face has no winding to keep: the small triangle under a roof (its
+    back, open below, seen about 1.4x as often as its front) turns, where the two-face
+    sheet under the same roof keeps its winding (the test below)."""
+    t = 0.01
+    tri = [[-t, -t, 0.0], [t, -t, 0.0], [0.0, t, 0.0]]  # counter-clockwise seen from +z: front up
+    roof = [[-1.0, -1.0, 1.0], [1.0, -1.0, 1.0], [1.0, 1.0, 1.0], [-1.0, 1.0, 1.0]]
+    r = orient(Soup(np.array(tri + roof), np.array([[0, 1, 2], [3, 4, 5], [3, 5, 6]])), seed=0)
+    assert STATUS_NAMES[r.status[0]] == "two-sided" and not r.classification.flagged[0]
+    assert r.flipped[0] and not r.flipped[1:].any()
 
 
 def test_decisive_takes_the_dominance_asked_for():
