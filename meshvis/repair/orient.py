@@ -79,10 +79,12 @@ BOTH_SEEN_DOMINANCE = 1.0
 CROSSING_LEVEL = 1e-3
 #: a flagged face whose own rays barely escaped (fewer than
 #: :data:`meshvis.repair.evidence.MIN_ESCAPES`) is left to the cut's sample points, which
-#: disagree between seeds there; the largest such faces get the last round's rays
+#: disagree between seeds there, and a face seen from both sides that its patch does not
+#: speak for keeps its winding; the largest such faces get the last round's rays
 #: (:data:`meshvis.repair.evidence.LAST_RAYS`), at most this many times the rays of the
 #: first round (on the monastery the largest 476 of 42,000 such faces; with seed 2 three
-#: of them, 0.097 % of the decisive area, had taken the wrong side)
+#: of them, 0.097 % of the decisive area, had taken the wrong side; on the pandora level
+#: lone faces seen through a few percent of their directions)
 UNSEEN_SHARE = 0.25
 #: a flagged face whose sign test leans to the side it does not show (below this level, but
 #: not below :data:`CROSSING_LEVEL`) gets :data:`LEANING_RAYS` more rays before the test
@@ -486,9 +488,10 @@ def _visible_sides(
     input does not wind its patch consistently, or the patch is the face alone, it takes
     the side seen more often
     (:data:`BOTH_SEEN_DOMINANCE`).  A flagged face also turns where the side it does not
-    show is seen significantly more often (:data:`CROSSING_LEVEL`); flagged faces whose rays
-    barely escaped, and those whose test leans to the other side without passing, get more
-    rays first (:data:`UNSEEN_SHARE`, :data:`LEANING_LEVEL`).  Faces of closed patches are
+    show is seen significantly more often (:data:`CROSSING_LEVEL`); flagged faces and faces
+    seen from both sides whose rays barely escaped, and flagged faces whose test leans to the
+    other side without passing, get more rays first (:data:`UNSEEN_SHARE`,
+    :data:`LEANING_LEVEL`).  Faces of closed patches are
     left to their patch: a closed patch bounds a volume, and a face of it whose back pokes
     out through the surface is a self-intersection, not a face turned the wrong way.
 
@@ -511,7 +514,9 @@ def _visible_sides(
     shown = outer[test]
     escaped, rays = evidence.seen_counts(c.soup, c.caster, test, shown, rng)
     flagged = c.flagged[test]
-    unseen = np.flatnonzero(flagged & (escaped.sum(axis=1) < evidence.MIN_ESCAPES))
+    # faces that only their own rays decide (flagged, or seen from both sides outside a
+    # patch that speaks for them) and whose rays barely escaped get more first
+    unseen = np.flatnonzero((flagged | both) & (escaped.sum(axis=1) < evidence.MIN_ESCAPES))
     rays += evidence.more_rays(c.soup, c.caster, test, escaped, unseen, evidence.LAST_RAYS, UNSEEN_SHARE, rng)
     leaning = (
         flagged
