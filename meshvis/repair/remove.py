@@ -189,8 +189,7 @@ def remove_interior(
         keep = vis.seen.copy()
         code = np.where(keep, _KEPT_SEEN, _GONE_VIEW)
     else:
-        cut_kw = both_point_budget(classify_kw) if visibility == "both" else classify_kw
-        c = classification or classify(model, **cut_kw)
+        c = classification or classify(model, **_cut_keywords(visibility, classify_kw))
         soup = c.soup
         by_cut = _kept_by_cut(c)
         if visibility == "object":
@@ -205,25 +204,25 @@ def remove_interior(
     return RemovalResult(soup.subset(keep), soup.subset(~keep), keep, c, vis, code, visibility, soup)
 
 
-def both_point_budget(classify_kw: dict[str, Any]) -> dict[str, Any]:
-    """``classify_kw`` with the sample points' ray budget of ``visibility="both"``.
+def _cut_keywords(visibility: str, classify_kw: dict[str, Any]) -> dict[str, Any]:
+    """The keywords of :func:`meshvis.classify` for the cut of ``visibility``.
 
-    A ``rays_per_point`` given (not None) is kept; otherwise it becomes
-    ``max(1, rays_per_node // samples_per_face)``
-    (:func:`~meshvis.repair.remove_modes.cut_rays_per_point`), with
-    :func:`meshvis.classify`'s defaults for what is not given (32 // 4 = 8).
+    ``rays_per_point`` follows :func:`~meshvis.repair.remove_modes.cut_rays_per_point`,
+    with :func:`meshvis.classify`'s defaults for what is not given (``both``: 32 // 4 = 8).
 
     Examples
     --------
-    >>> both_point_budget({"seed": 1})["rays_per_point"]
+    >>> _cut_keywords("both", {"seed": 1})["rays_per_point"]
     8
-    >>> both_point_budget({"rays_per_node": 64, "rays_per_point": 32})["rays_per_point"]
+    >>> _cut_keywords("both", {"rays_per_node": 64, "rays_per_point": 32})["rays_per_point"]
     32
+    >>> _cut_keywords("object", {})["rays_per_point"] is None  # classify: rays_per_node
+    True
     """
     defaults = inspect.signature(classify).parameters
     rays = classify_kw.get("rays_per_node", defaults["rays_per_node"].default)
     samples = classify_kw.get("samples_per_face", defaults["samples_per_face"].default)
-    budget = cut_rays_per_point("both", rays, samples, classify_kw.get("rays_per_point"))
+    budget = cut_rays_per_point(visibility, rays, samples, classify_kw.get("rays_per_point"))
     return {**classify_kw, "rays_per_point": budget}
 
 

@@ -227,7 +227,7 @@ def run_model(
     rays_per_point : int, optional
         Ray budget per sample point of the graph cut (:func:`meshvis.classify`) of the
         object mode and of both; by default each mode's own (``rays_per_node``, and for
-        both :func:`meshvis.repair.remove.both_point_budget`).
+        both :func:`meshvis.repair.remove_modes.cut_rays_per_point`).
 
     Returns
     -------
