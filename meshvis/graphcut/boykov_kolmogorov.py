@@ -321,6 +321,8 @@ def _adopt(time, arcs, tree, queues):  # pragma: no cover - compiled
                 stamp[w], dist[w] = time, d
                 d -= 1
                 w = head[parent[w]]
+            if best_d == 1:  # a root next to the terminal: no parent is closer
+                break
         if best >= 0:
             parent[v], stamp[v], dist[v] = best, time, best_d + 1
             continue
