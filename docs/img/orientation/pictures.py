@@ -96,6 +96,28 @@ def main(root=SHARED):
     lone_faces(root)
 
 
+def _before_after(root, rel, name, value, labels):
+    """The model, its reference, ``orient`` with ``O.<name>`` set to ``value`` and as it is.
+
+    Prints the decisive area each of the two turns away, under ``labels`` (before, after).
+    """
+    soup = load(os.path.join(root, rel))
+    stem = os.path.splitext(os.path.basename(rel))[0]
+    ref = reference(soup, seed=0, cache=os.path.join(CACHE, f"{stem}.seed0.npz"))
+    after = O.orient(soup, seed=0)
+    rule = getattr(O, name)
+    try:
+        setattr(O, name, value)
+        before = O.orient(soup, classification=after.classification)
+    finally:
+        setattr(O, name, rule)
+    total = soup.areas[ref.decisive].sum()
+    for label, r in zip(labels, (before, after)):
+        wrong = ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side)
+        print(f"{stem}, {label}: {100 * soup.areas[wrong].sum() / total:.4f} % turned away")
+    return soup, ref, before, after
+
+
 def _wound_with_lone_faces(p):
     """``orient._consistently_wound`` as it was: a one-face patch counts as consistently wound."""
     patch, front = p.clustering.cluster, p.clustering.side_node[:, 0]
@@ -109,20 +131,10 @@ def _wound_with_lone_faces(p):
 
 def lone_faces(root=SHARED):
     """``pandora_lone.png``: one-face patches held to their winding (left) and not (right)."""
-    soup = load(os.path.join(root, PANDORA))
-    stem = os.path.splitext(os.path.basename(PANDORA))[0]
-    ref = reference(soup, seed=0, cache=os.path.join(CACHE, f"{stem}.seed0.npz"))
-    after = O.orient(soup, seed=0)
-    rule = O._consistently_wound
-    try:
-        O._consistently_wound = _wound_with_lone_faces
-        before = O.orient(soup, classification=after.classification)
-    finally:
-        O._consistently_wound = rule
-    total = soup.areas[ref.decisive].sum()
-    for label, r in (("held", before), ("free", after)):
-        wrong = ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side)
-        print(f"pandora, lone faces {label}: {100 * soup.areas[wrong].sum() / total:.4f} % turned away")
+    labels = ("lone faces held", "lone faces free")
+    soup, ref, before, after = _before_after(
+        root, PANDORA, "_consistently_wound", _wound_with_lone_faces, labels
+    )
     # the level from outside, faces the reference judges and the rule turns away from the
     # side that escapes in red, from the direction of the eight that shows most of them
     # held to their winding (a close view of one face looks at a wall in front of it)
@@ -148,28 +160,15 @@ def lone_faces(root=SHARED):
     gap = np.full((300, 8, 3), 255, np.uint8)
     save_png(np.concatenate([panels[0], gap, panels[1]], axis=1), os.path.join(HERE, "pandora_lone.png"))
     print(
-        f"pandora lone faces, azimuth {az:g}, elevation {el:g}: pixels of faces turned away, held / free:",
+        f"pandora lone faces, azimuth {az:g}, elevation {el:g}: (pixels of faces turned away, back-side pixels), held / free:",
         *counts,
     )
 
 
 def crossing(root=SHARED):
     """``monastery_crossing.png``: the sign test on flagged faces off (left) and on."""
-    rel = MODELS["monastery"]
-    soup = load(os.path.join(root, rel))
-    stem = os.path.splitext(os.path.basename(rel))[0]
-    ref = reference(soup, seed=0, cache=os.path.join(CACHE, f"{stem}.seed0.npz"))
-    after = O.orient(soup, seed=0)
-    level = O.CROSSING_LEVEL
-    try:
-        O.CROSSING_LEVEL = 0.0
-        before = O.orient(soup, classification=after.classification)
-    finally:
-        O.CROSSING_LEVEL = level
-    total = soup.areas[ref.decisive].sum()
-    for label, r in (("off", before), ("on", after)):
-        wrong = ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side)
-        print(f"monastery, sign test {label}: {100 * soup.areas[wrong].sum() / total:.4f} % turned away")
+    labels = ("sign test off", "sign test on")
+    soup, ref, before, after = _before_after(root, MODELS["monastery"], "CROSSING_LEVEL", 0.0, labels)
     wrong = np.flatnonzero(ref.decisive & (before.flipped.astype(np.int8) != ref.outside_side))
     f = wrong[np.argmax(soup.areas[wrong])]
     n = picture(
