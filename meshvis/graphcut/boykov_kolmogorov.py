@@ -2,13 +2,16 @@
 
 The algorithm of Boykov and Kolmogorov ("An experimental comparison of min-cut/max-flow
 algorithms for energy minimization in vision", PAMI 2004), which PyMaxflow wraps in C++,
-written here as one numba kernel over flat arrays:
+written here as numba kernels over flat arrays:
 
 * a *search tree* grows from the source (OUTSIDE) and one from the sink (INSIDE) through
   arcs with residual capacity; where they touch, the path is *augmented* by its bottleneck;
 * arcs saturated by the augmentation cut nodes off their tree (*orphans*); each orphan
   looks for a new parent in its own tree that still leads to the terminal, preferring the
   shortest such path (the distance and time-stamp marks of the paper), or becomes free;
+* two shortcuts that do not change the result: a node that found a path grows on from
+  the arc it stopped at (its neighbour freed by an adoption sends it back to its first
+  arc), and an orphan stops looking at a root next to its terminal (none is closer);
 * the loop ends when neither tree can grow.  The source tree is then exactly the set of
   nodes reachable from the source in the residual graph: a node in it is reached along its
   tree path, and a node outside it would have been adopted by the growth stage.
@@ -16,7 +19,10 @@ written here as one numba kernel over flat arrays:
 That set is the same for every maximum flow (the smallest source side among the minimum
 cuts), so the labels do not depend on which maximum flow the search happens to find: this
 kernel and PyMaxflow give the same labels (``tests/graphcut/test_boykov_kolmogorov.py``
-checks it on random graphs with ties and on the real scenes' graphs).  A node linked to
+checks it on random graphs with ties and on the graphs of bundled models;
+``docs/bench/solver_identity.py`` on every shared model).  Where two minimum cuts have
+exactly the same value, float rounding of the flow decides which one either returns.  A
+node linked to
 neither terminal and reachable from neither is free and counts as INSIDE, as the
 object-based definition wants (DESIGN.md §4).
 
