@@ -181,7 +181,7 @@ def seen_counts(
     faces: np.ndarray,
     shown: np.ndarray,
     rng: np.random.Generator,
-) -> tuple[np.ndarray, int]:
+) -> tuple[np.ndarray, np.ndarray]:
     """Escaping rays per side of each face, over the rounds of the module docstring.
 
     Parameters
@@ -201,8 +201,8 @@ def seen_counts(
     -------
     escaped : (k, 2) int64
         Escaping rays per face through its front (column 0) and its back.
-    rays : int
-        Rays cast.
+    cast : (k,) int64
+        Rays cast per face (about half of them through each side).
     """
     faces = np.asarray(faces, np.int64)
     shown = np.asarray(shown, np.int64)
@@ -210,7 +210,7 @@ def seen_counts(
     escaped = np.zeros((len(faces), 2), np.int64)
     for through in (0, 1):
         escaped += escapes(soup, caster, faces, FIRST_RAYS, rng, through=np.full(len(faces), through))
-    rays = 2 * FIRST_RAYS * len(faces)
+    cast = np.full(len(faces), 2 * FIRST_RAYS, np.int64)
     # faces from which nothing escaped get a second look through each side: one seen in
     # 3 % of its directions escapes none of 32 in a third of the cases (0.97^32)
     none = np.flatnonzero(escaped.sum(axis=1) == 0)
@@ -218,16 +218,16 @@ def seen_counts(
         escaped[none] += escapes(
             soup, caster, faces[none], FIRST_RAYS, rng, through=np.full(len(none), through)
         )
-    rays += 2 * FIRST_RAYS * len(none)
+    cast[none] += 2 * FIRST_RAYS
     other, own = escaped[k, 1 - shown], escaped[k, shown]
     again = np.flatnonzero((other > 0) & (other >= own))
     if len(again):
         escaped[again] += escapes(soup, caster, faces[again], MORE_RAYS, rng)
-        rays += MORE_RAYS * len(again)
+        cast[again] += MORE_RAYS
     other, own = escaped[k, 1 - shown], escaped[k, shown]
     last = np.flatnonzero((other > 0) & (DOMINANCE * other > own) & ~decisive(escaped))
-    rays += more_rays(soup, caster, faces, escaped, last, LAST_RAYS, LAST_SHARE, rng)
-    return escaped, rays
+    more_rays(soup, caster, faces, escaped, cast, last, LAST_RAYS, LAST_SHARE, rng)
+    return escaped, cast
 
 
 def more_rays(
@@ -235,12 +235,13 @@ def more_rays(
     caster: RayCaster,
     faces: np.ndarray,
     escaped: np.ndarray,
+    cast: np.ndarray,
     which: np.ndarray,
     rays: int,
     share: float,
     rng: np.random.Generator,
 ) -> int:
-    """Cast ``rays`` more rays from each face ``faces[which]``, adding to ``escaped`` in place.
+    """Cast ``rays`` more rays from each face ``faces[which]``, adding to ``escaped`` and ``cast`` in place.
 
     At most ``share`` times the rays of the first round (``2 * FIRST_RAYS`` per face of
     ``faces``) are cast, on the largest of the faces first: the error is measured in area.
@@ -250,6 +251,7 @@ def more_rays(
     soup, caster : the model and its RayCaster
     faces : (k,) int64, the faces tested
     escaped : (k, 2) int64, escaping rays per face and side so far (updated)
+    cast : (k,) int64, rays cast per face so far (updated)
     which : (j,) int, positions in ``faces`` that get more rays
     rays : int, rays per face; share : float, the cap; rng : numpy Generator
 
@@ -265,6 +267,7 @@ def more_rays(
         which = np.sort(which[by_area[:cap]])
     if len(which):
         escaped[which] += escapes(soup, caster, faces[which], rays, rng)
+        cast[which] += rays
     return rays * len(which)
 
 
@@ -294,8 +297,8 @@ def seen_side(
     rays : int, rays cast
     """
     shown = np.asarray(shown, np.int64)
-    escaped, rays = seen_counts(soup, caster, faces, shown, rng)
-    return more_seen(escaped, shown), decisive(escaped, dominance), rays
+    escaped, cast = seen_counts(soup, caster, faces, shown, rng)
+    return more_seen(escaped, shown), decisive(escaped, dominance), int(cast.sum())
 
 
 def more_seen(escaped: np.ndarray, shown: np.ndarray) -> np.ndarray:

@@ -15,7 +15,7 @@ import pytest
 
 from meshvis.io import load
 from meshvis.repair import evidence
-from meshvis.repair.orient import STATUS_NAMES, orient
+from meshvis.repair.orient import STATUS_NAMES, orient, patches
 from meshvis.soup import Soup
 
 REAL = Path(__file__).resolve().parents[3] / "shared" / "models" / "real"
@@ -100,6 +100,19 @@ def test_a_lone_face_takes_the_side_seen_more_often():
     r = orient(Soup(np.array(tri + roof), np.array([[0, 1, 2], [3, 4, 5], [3, 5, 6]])), seed=0)
     assert STATUS_NAMES[r.status[0]] == "two-sided" and not r.classification.flagged[0]
     assert r.flipped[0] and not r.flipped[1:].any()
+
+
+def test_a_wound_patch_takes_the_side_its_faces_see_pooled():
+    """cycloidal.ply: the cut settles 142 faces of a 1,118-face consistently wound patch on
+    one side, and their vote turned the patch over, although its faces' own rays escape
+    through its front only (the dense reference: 233 escapes, all through the front).
+    Pooled over the patch, the faces' rays keep it as the input winds it."""
+    soup = _model("cycloidal.ply")
+    r = orient(soup, seed=0)
+    patch = patches(r.classification).clustering.cluster
+    assert (patch == patch[32074]).sum() == 1118
+    assert not r.flipped[patch == patch[32074]].any()
+    assert r.visibility["pooled_patches"] >= 1
 
 
 def test_decisive_takes_the_dominance_asked_for():
