@@ -171,3 +171,26 @@ def test_escapes_counts_the_rays_that_meet_nothing():
     np.add.at(want, (np.repeat(np.arange(len(faces)), rays), side), free)
     assert 0 < want.sum() < len(face)
     np.testing.assert_array_equal(got, want)
+
+
+def test_a_cluster_near_the_opening_threshold_does_not_speak_for_its_faces():
+    """Outside consistently wound patches, a cluster whose hidden side escapes at least half
+    the opening share is cut differently from seed to seed: its faces are tested alone."""
+    from types import SimpleNamespace
+
+    from meshvis.repair.orient import _clearly_one_sided
+
+    # three faces, each a cluster of its own: escape shares (shown side, other side) of
+    # 0.5 / 0.02 (near the 0.03 threshold), 0.5 / 0.01 (far below) and 0.05 / 0.02 (not 4x)
+    escaped = np.array([500, 20, 500, 10, 50, 20])
+    counts = SimpleNamespace(escaped=escaped, cast=np.full(6, 1000), discarded=np.zeros(6, int))
+    c = SimpleNamespace(
+        counts=counts,
+        nodes=SimpleNamespace(side_node=np.array([[0, 1], [2, 3], [4, 5]])),
+        params={"opening": 0.03},
+    )
+    shown = np.zeros(3, np.int8)
+    assert _clearly_one_sided(c, shown, np.zeros(3, bool)).tolist() == [False, True, False]
+    assert _clearly_one_sided(c, shown, np.ones(3, bool)).tolist() == [True, True, False]
+    c.params["opening"] = None  # no opening rule: dominance alone
+    assert _clearly_one_sided(c, shown, np.zeros(3, bool)).tolist() == [True, True, False]
