@@ -295,10 +295,7 @@ def confirm(
         local = np.arange(lo, min(len(faces), lo + per_batch))
         face = np.repeat(faces[local], rays)
         side, out = _escape(caster, uniform_in_triangles(soup.triangles[face], rng), face, rng)
-        slot = np.repeat(local - lo, rays) * 2 + side
-        n = 2 * len(local)
-        escaped[local] = np.bincount(slot, weights=out, minlength=n).reshape(-1, 2).astype(np.int64)
-        cast[local] = np.bincount(slot, minlength=n).reshape(-1, 2)
+        escaped[local], cast[local] = _per_side(np.repeat(local - lo, rays), side, out, len(local))
         if progress is not None:
             progress(local[-1] + 1, len(faces))
     result = Confirmation(faces, escaped, cast)
@@ -331,10 +328,7 @@ def _first_round(soup: Soup, caster: RayCaster, rng: np.random.Generator, progre
         points = np.repeat(points, DIRECTIONS_PER_POINT, axis=0)
         face = np.repeat(idx, per_face)
         side, out = _escape(caster, points, face, rng)
-        slot = (face - lo) * 2 + side
-        n = 2 * len(idx)
-        escaped[idx] = np.bincount(slot, weights=out, minlength=n).reshape(-1, 2).astype(np.int64)
-        cast[idx] = np.bincount(slot, minlength=n).reshape(-1, 2)
+        escaped[idx], cast[idx] = _per_side(face - lo, side, out, len(idx))
         if progress is not None:
             progress(idx[-1] + 1, m)
     seen_side |= escaped > 0
@@ -356,6 +350,13 @@ def _cast(soup: Soup, caster: RayCaster, todo: np.ndarray, per_face: int, rng, p
         if progress is not None:
             progress(local[-1] + 1, len(todo))
     return found, np.full(len(todo), per_face, np.int64)
+
+
+def _per_side(at: np.ndarray, side: np.ndarray, out: np.ndarray, k: int) -> tuple[np.ndarray, np.ndarray]:
+    """(k, 2) escaping rays and (k, 2) rays per face and side, from each ray's face position ``at``."""
+    slot = at * 2 + side
+    escaped = np.bincount(slot, weights=out, minlength=2 * k).reshape(-1, 2).astype(np.int64)
+    return escaped, np.bincount(slot, minlength=2 * k).reshape(-1, 2)
 
 
 def _escape(caster: RayCaster, points: np.ndarray, face: np.ndarray, rng) -> tuple[np.ndarray, np.ndarray]:

@@ -240,7 +240,7 @@ def more_rays(
     rays: int,
     share: float,
     rng: np.random.Generator,
-) -> int:
+) -> None:
     """Cast ``rays`` more rays from each face ``faces[which]``, adding to ``escaped`` and ``cast`` in place.
 
     At most ``share`` times the rays of the first round (``2 * FIRST_RAYS`` per face of
@@ -254,11 +254,6 @@ def more_rays(
     cast : (k,) int64, rays cast per face so far (updated)
     which : (j,) int, positions in ``faces`` that get more rays
     rays : int, rays per face; share : float, the cap; rng : numpy Generator
-
-    Returns
-    -------
-    int
-        Rays cast.
     """
     which = np.asarray(which, np.int64)
     cap = int(share * 2 * FIRST_RAYS * len(faces)) // rays
@@ -268,7 +263,6 @@ def more_rays(
     if len(which):
         escaped[which] += escapes(soup, caster, faces[which], rays, rng)
         cast[which] += rays
-    return rays * len(which)
 
 
 def seen_side(

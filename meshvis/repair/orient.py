@@ -529,7 +529,8 @@ def _visible_sides(
     """
     from meshvis.repair import evidence
 
-    clear = _clearly_one_sided(c, outer, _consistently_wound(p)) & (status == ONE_SIDED)
+    wound = _consistently_wound(p)
+    clear = _clearly_one_sided(c, outer, wound) & (status == ONE_SIDED)
     test = np.flatnonzero(movable & ~p.closed & ~clear)
     decided = np.zeros(len(outer), bool)
     if len(test) == 0:
@@ -537,7 +538,7 @@ def _visible_sides(
     before = outer.copy()
     # inside a patch that the input winds consistently, a face leaves its patch only on
     # decisive evidence (a scan seen from both sides is not speckled with turned faces)
-    both = np.isin(status[test], (TWO_SIDED, CONFLICT)) & ~_consistently_wound(p)[test]
+    both = np.isin(status[test], (TWO_SIDED, CONFLICT)) & ~wound[test]
     dominance = np.where(both, BOTH_SEEN_DOMINANCE, evidence.DOMINANCE)
     # a generator of its own (seeded from the classification's seed), so that the test
     # does not shift the random numbers of anything else
@@ -560,7 +561,7 @@ def _visible_sides(
     )
     # a consistently wound patch turns as a whole where its faces' rays, pooled, decide it;
     # then each face leaves its patch only on evidence of its own
-    pooled = _pooled_patches(c, p, test, escaped, cast, outer, movable, clear)
+    pooled = _pooled_patches(c, p, wound, test, escaped, cast, outer, movable, clear)
     shown = outer[test]
     sure = evidence.decisive(escaped, dominance)
     sure |= flagged & evidence.significant(escaped, CROSSING_LEVEL)
@@ -579,6 +580,7 @@ def _visible_sides(
 def _pooled_patches(
     c: Classification,
     p: Patches,
+    wound: np.ndarray,
     test: np.ndarray,
     escaped: np.ndarray,
     cast: np.ndarray,
@@ -596,7 +598,7 @@ def _pooled_patches(
     where it is decisive (:data:`POOLED_DOMINANCE`, at least
     :data:`~meshvis.repair.evidence.MIN_ESCAPES` escapes) the patch shows the side it sees
     more, as a whole.  A patch with a face whose cluster's rays already show its side
-    (``clear``) is left to them.
+    (``clear``) is left to them.  ``wound`` is :func:`_consistently_wound` of ``p``.
 
     Returns (m,) bool: the faces of the patches the pooled evidence decided.
     """
@@ -604,7 +606,6 @@ def _pooled_patches(
 
     patch = p.clustering.cluster
     n = max(p.clustering.n_clusters, 1)
-    wound = _consistently_wound(p)
     rows = np.flatnonzero(wound[test])
     faces = test[rows]
     weight = c.soup.areas[faces] / np.maximum(cast[rows], 1)

@@ -150,20 +150,15 @@ def run_input(name: str, kind: str, soup, turned, ref, *, sweep, seed: int, log,
     pairs = opposite_copies(weld(soup.vertices, soup.faces)[1])
     judged = ref.decisive.copy()
     judged[pairs.ravel()] = False  # a double-sided pair is judged as a pair: kept opposite
-    total = ref.area[judged].sum()
 
-    def error(flipped):
-        wrong = judged & ((np.asarray(flipped, bool) ^ turned) != ref.outside_side.astype(bool))
-        return float(ref.area[wrong].sum() / total) if total > 0 else 0.0
-
-    def error_confirmed(flipped):
-        if confirmed is None:
-            return float("nan")
-        decisive, side = confirmed
+    def error(flipped, decisive=ref.decisive, side=ref.outside_side):
         decisive = decisive & judged
         total = ref.area[decisive].sum()
         wrong = decisive & ((np.asarray(flipped, bool) ^ turned) != side.astype(bool))
         return float(ref.area[wrong].sum() / total) if total > 0 else 0.0
+
+    def error_confirmed(flipped):
+        return float("nan") if confirmed is None else error(flipped, *confirmed)
 
     def broken(flipped):
         flipped = np.asarray(flipped, bool)
