@@ -7,7 +7,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from meshvis.graphcut.boykov_kolmogorov import arcs_by_tail, min_cut_bk
+from meshvis.graphcut.boykov_kolmogorov import _settle_decided, arcs_by_tail, min_cut_bk
 from meshvis.graphcut.classify import classify
 from meshvis.graphcut.mincut import cut_value, min_cut
 from meshvis.io import load
@@ -66,6 +66,42 @@ def test_a_chain_is_cut_at_its_weakest_directed_link():
     s, t = np.array([3.0, 0, 0, 0]), np.array([0, 0, 0, 3.0])
     out, value = min_cut_bk(4, i, j, cap_ij, cap_ji, s, t)
     assert out.tolist() == [True, True, False, False] and value == 0.5
+
+
+def test_a_node_whose_terminal_link_outweighs_its_edges_is_settled_and_passes_it_on():
+    # source -5-> 0 -3-> 1 -1-> 2 -10-> sink: 0 settles outside (5 > 3), which gives 1 a
+    # source link of 3 > 1, settled in the second pass; 2 settles inside (10 > 1)
+    i, j = np.array([0, 1]), np.array([1, 2])
+    cap_ij, cap_ji = np.array([3.0, 1.0]), np.array([0.0, 0.0])
+    excess = np.array([5.0, 0.0, -10.0])
+    side, flow, *rest = _settle_decided(i, j, cap_ij, cap_ji, excess.copy())
+    assert side.tolist() == [1, 1, -1] and flow == 1.0  # the edge 1 -> 2 is cut
+    assert all(len(a) == 0 for a in rest)
+    out, value = min_cut_bk(3, i, j, cap_ij, cap_ji, np.array([5.0, 0, 0]), np.array([0, 0, 10.0]))
+    assert out.tolist() == [True, True, False] and value == 1.0
+
+
+def test_a_terminal_link_equal_to_the_edges_does_not_settle_a_node():
+    # a tie: node 0 may go either way, so the max flow decides (it leaves 0 inside)
+    i, j = np.array([0]), np.array([1])
+    side, flow, *_ = _settle_decided(i, j, np.array([2.0]), np.array([0.0]), np.array([2.0, -2.0]))
+    assert side.tolist() == [0, 0] and flow == 0.0
+
+
+@pytest.mark.parametrize("seed", range(8))
+def test_labels_equal_pymaxflow_when_most_nodes_have_strong_terminal_links(seed):
+    rng = np.random.default_rng(100 + seed)
+    n = int(rng.integers(50, 400))
+    i, j, cap_ij, cap_ji, _, _ = _random_graph(rng, n, int(rng.integers(n, 3 * n)), False)
+    # terminal links of every size against the edges: many nodes settle, some in the second pass
+    cap_s = np.where(rng.random(n) < 0.6, 4 * rng.random(n), 0.0)
+    cap_t = np.where(rng.random(n) < 0.6, 4 * rng.random(n), 0.0)
+    side, *_ = _settle_decided(i, j, cap_ij, cap_ji, cap_s - cap_t)
+    assert (side != 0).sum() > n // 10
+    ours = min_cut(n, i, j, cap_ij, cap_ji, cap_s, cap_t, solver="bk")
+    theirs = min_cut(n, i, j, cap_ij, cap_ji, cap_s, cap_t, solver="pymaxflow")
+    assert np.array_equal(ours.outside, theirs.outside)
+    assert ours.value == pytest.approx(theirs.value, rel=1e-12)
 
 
 def test_arcs_by_tail_pairs_every_arc_with_its_reverse():
