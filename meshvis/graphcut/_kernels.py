@@ -214,36 +214,6 @@ def edge_maxima(w_max, i, j, w):  # pragma: no cover - compiled
     return w_max
 
 
-@numba.njit(cache=True, nogil=True, inline="always")
-def _damped(w, w_max):  # pragma: no cover - compiled
-    """One value of :func:`~meshvis.graphcut.weights.cosine_filter`, in its order of operations."""
-    r = w / w_max if w_max > 0 else 0.0
-    if r < 0.0:  # np.clip, which keeps NaN
-        r = 0.0
-    elif r > 1.0:
-        r = 1.0
-    r = math.sin(r * (0.5 * np.pi))
-    return r * r * w
-
-
-@numba.njit(cache=True, nogil=True, error_model="numpy")
-def filtered_capacities(i, j, w, w_out, w_in, w_max):  # pragma: no cover - compiled
-    """The four ``cosine_filter`` calls of :func:`~meshvis.graphcut.weights.graph_weights` in one pass.
-
-    Returns ``cap_ij``, ``cap_ji`` (each edge damped by the maximum of its tail) and
-    ``cap_out``, ``cap_in`` (each node's terminal links damped by its own maximum).
-    """
-    cap_ij, cap_ji = np.empty(len(w)), np.empty(len(w))
-    for e in range(len(w)):
-        cap_ij[e] = _damped(w[e], w_max[i[e]])
-        cap_ji[e] = _damped(w[e], w_max[j[e]])
-    cap_out, cap_in = np.empty(len(w_max)), np.empty(len(w_max))
-    for v in range(len(w_max)):
-        cap_out[v] = _damped(w_out[v], w_max[v])
-        cap_in[v] = _damped(w_in[v], w_max[v])
-    return cap_ij, cap_ji, cap_out, cap_in
-
-
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def ray_starts(
     counts,

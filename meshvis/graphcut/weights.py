@@ -214,8 +214,14 @@ def graph_weights(
         return Weights(i, j, w, w_out, w_in, w.copy(), w.copy(), w_out.copy(), w_in.copy())
     w_max = np.maximum(w_out, w_in)
     _kernels.edge_maxima(w_max, i, j, w)
-    # cosine_filter of each link with its tail's maximum, in one compiled pass
-    cap_ij, cap_ji, cap_out, cap_in = _kernels.filtered_capacities(
-        i, j, w, np.asarray(w_out, np.float64), np.asarray(w_in, np.float64), w_max
+    return Weights(
+        i,
+        j,
+        w,
+        w_out,
+        w_in,
+        cap_ij=cosine_filter(w, w_max[i]),
+        cap_ji=cosine_filter(w, w_max[j]),
+        cap_out=cosine_filter(w_out, w_max),
+        cap_in=cosine_filter(w_in, w_max),
     )
-    return Weights(i, j, w, w_out, w_in, cap_ij=cap_ij, cap_ji=cap_ji, cap_out=cap_out, cap_in=cap_in)

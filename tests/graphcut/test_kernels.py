@@ -11,7 +11,7 @@ import scipy.sparse as sp
 from meshvis.graphcut import _kernels
 from meshvis.graphcut.nodes import PERPENDICULAR_COS, _pushed_origins, build_nodes, node_rays, side_normals
 from meshvis.graphcut.preprocess import preprocess
-from meshvis.graphcut.weights import cosine_filter, edge_weights
+from meshvis.graphcut.weights import edge_weights
 from meshvis.io import load
 from meshvis.rays.samples import cosine_about_faces, pushed_points_in_faces, sample_scheme_barycentric
 
@@ -176,31 +176,6 @@ def test_edge_maxima_are_maximum_at():
         np.maximum.at(expected, j, w)
     got = _kernels.edge_maxima(start.copy(), i, j, w)
     assert got.tobytes() == expected.tobytes()
-
-
-def test_filtered_capacities_are_the_cosine_filter():
-    rng = np.random.default_rng(6)
-    n, k = 500, 4000
-    i, j, w = rng.integers(0, n, k), rng.integers(0, n, k), rng.random(k)
-    w_out, w_in = rng.random(n), rng.random(n)
-    w_max = np.maximum(w_out, w_in)
-    _kernels.edge_maxima(w_max, i, j, w)
-    w_max[::50] = 0.0  # no links: damped to 0
-    w_max[1::50] *= 0.5  # below the link: clipped to the full weight
-    w[::97], w_out[::31] = np.nan, np.inf
-    got = _kernels.filtered_capacities(i, j, w, w_out, w_in, w_max)
-    with np.errstate(invalid="ignore"):
-        expected = (
-            cosine_filter(w, w_max[i]),
-            cosine_filter(w, w_max[j]),
-            cosine_filter(w_out, w_max),
-            cosine_filter(w_in, w_max),
-        )
-    for a, b in zip(got, expected):
-        finite = np.isfinite(b)
-        assert np.array_equal(np.isfinite(a), finite) and np.array_equal(np.isnan(a), np.isnan(b))
-        # numba's sin is the C library's; numpy may use its own, within an ulp
-        np.testing.assert_array_max_ulp(a[finite], b[finite], maxulp=1)
 
 
 def _numpy_node_rays(nodes, normals, triangles, counts, rng, offset):
