@@ -65,7 +65,7 @@ def min_cut_bk(
     cap_ji: np.ndarray,
     cap_source: np.ndarray,
     cap_sink: np.ndarray,
-) -> tuple[np.ndarray, float]:
+) -> tuple[np.ndarray, float, int]:
     """Minimum s-t cut by Boykov–Kolmogorov; source = OUTSIDE.
 
     Parameters
@@ -85,19 +85,21 @@ def min_cut_bk(
         Nodes reachable from the source in the residual graph of a maximum flow.
     value : float
         The maximum flow (= the minimum cut's capacity).
+    settled : int
+        Nodes settled before the search (module notes).
 
     Examples
     --------
     >>> import numpy as np
-    >>> out, value = min_cut_bk(2, np.array([0]), np.array([1]), np.array([1.0]),
+    >>> out, value, settled = min_cut_bk(2, np.array([0]), np.array([1]), np.array([1.0]),
     ...                         np.array([0.0]), np.array([5.0, 0.0]), np.array([0.0, 3.0]))
-    >>> out.tolist(), value
-    ([True, False], 1.0)
+    >>> out.tolist(), value, settled
+    ([True, False], 1.0, 2)
     """
     cap_source = np.asarray(cap_source, np.float64)
     cap_sink = np.asarray(cap_sink, np.float64)
     if n == 0:
-        return np.zeros(0, bool), 0.0
+        return np.zeros(0, bool), 0.0, 0
     excess = cap_source - cap_sink
     side, settled_flow, i, j, cap_ij, cap_ji = _settle_decided(
         np.asarray(i, np.int64),
@@ -116,7 +118,8 @@ def min_cut_bk(
         rcap[arc_ji] = cap_ji
         outside[free], flow = _max_flow(first, head, sister, rcap, excess[free])
     # the netted part of each node's two terminal links flows straight through the node
-    return outside, float(settled_flow + flow + np.minimum(cap_source, cap_sink).sum())
+    value = float(settled_flow + flow + np.minimum(cap_source, cap_sink).sum())
+    return outside, value, int(n - free.sum())
 
 
 @numba.njit(cache=True, nogil=True)

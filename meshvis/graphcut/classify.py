@@ -514,6 +514,7 @@ class _Sampling:
                     "rays": int(self.counts.rays),
                     "nodes_sampled": int((give > 0).sum()),
                     "edges": self.graph.n_edges,
+                    "settled_nodes": self.cut.settled,
                     "changed_area_fraction": changed,
                     "sampling_seconds": self.t_sample - t_sample,
                     "cut_seconds": self.t_cut - t_cut,
@@ -607,6 +608,11 @@ class _Sampling:
                 "cut",
                 True,
                 self.t_cut,
-                f"{self.graph.n_edges} edges, solver {self.cut.solver}, filter {'on' if use_filter else 'off'}",
+                f"{self.graph.n_edges} edges, solver {self.cut.solver}, filter {'on' if use_filter else 'off'}"
+                + (
+                    f"; {self.cut.settled} of {self.nodes.n} nodes settled before the search"
+                    if self.cut.settled
+                    else ""
+                ),
             ),
         ]

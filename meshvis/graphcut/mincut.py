@@ -33,12 +33,16 @@ INT_MAX_CAP = 2**30
 
 @dataclass
 class Cut:
-    """Result of a min cut: ``outside[i]`` for every node, and the cut value (flow)."""
+    """Result of a min cut: ``outside[i]`` for every node, and the cut value (flow).
+
+    ``settled`` counts the nodes the ``"bk"`` solver settled before its search.
+    """
 
     outside: np.ndarray
     value: float
     solver: str
     scale: float = 1.0
+    settled: int = 0
 
 
 def min_cut(
@@ -64,8 +68,8 @@ def min_cut(
     Cut, with ``outside[v]`` True where v stays connected to the source.
     """
     if solver == "bk":
-        outside, value = min_cut_bk(n, i, j, cap_ij, cap_ji, cap_source, cap_sink)
-        return Cut(outside, value, "bk")
+        outside, value, settled = min_cut_bk(n, i, j, cap_ij, cap_ji, cap_source, cap_sink)
+        return Cut(outside, value, "bk", settled=settled)
     if solver == "pymaxflow":
         return _cut_pymaxflow(n, i, j, cap_ij, cap_ji, cap_source, cap_sink)
     if solver == "scipy":

@@ -47,7 +47,7 @@ def test_labels_and_value_equal_pymaxflow_on_random_graphs(seed, integer):
 def test_a_node_linked_to_nothing_is_inside_and_equal_links_cancel():
     e = np.zeros(0, np.int64)
     f = np.zeros(0)
-    out, value = min_cut_bk(3, e, e, f, f, np.array([2.0, 1.0, 0.0]), np.array([1.0, 1.0, 0.0]))
+    out, value, _ = min_cut_bk(3, e, e, f, f, np.array([2.0, 1.0, 0.0]), np.array([1.0, 1.0, 0.0]))
     # more from the source than to the sink: outside; a tie or no link: inside
     assert out.tolist() == [True, False, False]
     assert value == 2.0
@@ -55,7 +55,7 @@ def test_a_node_linked_to_nothing_is_inside_and_equal_links_cancel():
 
 def test_the_empty_graph():
     e = np.zeros(0, np.int64)
-    out, value = min_cut_bk(0, e, e, np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0))
+    out, value, _ = min_cut_bk(0, e, e, np.zeros(0), np.zeros(0), np.zeros(0), np.zeros(0))
     assert out.shape == (0,) and value == 0.0
 
 
@@ -64,7 +64,7 @@ def test_a_chain_is_cut_at_its_weakest_directed_link():
     i, j = np.array([0, 1, 2]), np.array([1, 2, 3])
     cap_ij, cap_ji = np.array([5.0, 0.5, 4.0]), np.array([9.0, 9.0, 9.0])
     s, t = np.array([3.0, 0, 0, 0]), np.array([0, 0, 0, 3.0])
-    out, value = min_cut_bk(4, i, j, cap_ij, cap_ji, s, t)
+    out, value, _ = min_cut_bk(4, i, j, cap_ij, cap_ji, s, t)
     assert out.tolist() == [True, True, False, False] and value == 0.5
 
 
@@ -77,8 +77,8 @@ def test_a_node_whose_terminal_link_outweighs_its_edges_is_settled_and_passes_it
     side, flow, *rest = _settle_decided(i, j, cap_ij, cap_ji, excess.copy())
     assert side.tolist() == [1, 1, -1] and flow == 1.0  # the edge 1 -> 2 is cut
     assert all(len(a) == 0 for a in rest)
-    out, value = min_cut_bk(3, i, j, cap_ij, cap_ji, np.array([5.0, 0, 0]), np.array([0, 0, 10.0]))
-    assert out.tolist() == [True, True, False] and value == 1.0
+    out, value, settled = min_cut_bk(3, i, j, cap_ij, cap_ji, np.array([5.0, 0, 0]), np.array([0, 0, 10.0]))
+    assert out.tolist() == [True, True, False] and value == 1.0 and settled == 3
 
 
 def test_a_terminal_link_equal_to_the_edges_does_not_settle_a_node():
