@@ -32,8 +32,11 @@ WEDGE_SLACK = 1e-9
 #: other evaluation order and the gaps can only shrink (more reports, never fewer)
 PROJ_SLACK = 1e-15
 
+# The helpers of the narrow phase are left to LLVM's inlining: numba's own (inline="always")
+# cost the parallel kernel about 3 s of compilation on first use and no speed.
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _proj_gap(ax, ay, az, T, lo, hi):
     """Gap between [lo, hi] and the projection of the 3 corners T (3, 3) on the axis."""
     p0 = ax * T[0, 0] + ay * T[0, 1] + az * T[0, 2]
@@ -44,7 +47,7 @@ def _proj_gap(ax, ay, az, T, lo, hi):
     return max(pmin - hi, lo - pmax), p0, p1, p2
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _unit_from(T, c, k):
     """Unit vector from corner c to corner k of T, as three scalars (no allocation)."""
     x = T[k, 0] - T[c, 0]
@@ -54,7 +57,7 @@ def _unit_from(T, c, k):
     return x / n, y / n, z / n
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _in_wedge(T, c, n, dx, dy, dz):
     """Direction d lies in the wedge of T at corner c (counter-clockwise about n)."""
     ax, ay, az = _unit_from(T, c, (c + 1) % 3)
@@ -66,7 +69,7 @@ def _in_wedge(T, c, n, dx, dy, dz):
     return a >= s and b >= s
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", inline="always")
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _sides(T):
     """Side vectors ``T[s + 1] - T[s]`` (3, 3) and their lengths (3,) of one triangle."""
     E = np.empty((3, 3))
