@@ -15,7 +15,10 @@ whose escape share is within a factor of two of the ``opening`` threshold and, a
 first round, those whose two terminal links are within a factor of two — in the spirit of
 adaptive global visibility sampling (AGVS).  A clean closed model stops after
 one small round.  Stages a model does not need (point nodes when nothing is
-flagged, hint rays without hints) are skipped, and the result says so.
+flagged, hint rays without hints) are skipped, and the result says so; so are the nodes
+that the max flow settles before its search (their terminal link outweighs all their
+edges, :mod:`~meshvis.graphcut.boykov_kolmogorov`), counted per round and in the cut
+stage's note.
 """
 
 from __future__ import annotations
