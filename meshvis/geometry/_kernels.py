@@ -32,8 +32,10 @@ WEDGE_SLACK = 1e-9
 #: other evaluation order and the gaps can only shrink (more reports, never fewer)
 PROJ_SLACK = 1e-15
 
-# The helpers of the narrow phase are left to LLVM's inlining: numba's own (inline="always")
-# cost the parallel kernel about 3 s of compilation on first use and no speed.
+# The narrow phase and the face axes are serial kernels that release the GIL, run on slices
+# in threads (meshvis.geometry.intersect.in_threads), and their helpers are left to LLVM's
+# inlining: numba's parallel loops and its own inlining (inline="always") cost them about
+# 7 s of compilation on first use and no speed (docs/performance.md, "First use").
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -82,7 +84,7 @@ def _sides(T):
     return E, L
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def narrow_phase(
     order,
     tri,
@@ -98,22 +100,23 @@ def narrow_phase(
     tau,
     cos_angle,
     cos_fold,
+    inter,
+    copl,
+    close,
+    fold,
 ):
     """Per-pair (intersects, coplanar, too_close, folded) flags; see ``classify_pairs``.
 
     Faces are stored in the spatial order ``order`` (input id of each row); a pair is
-    tested with the face of the smaller input id first, whatever its rows.
+    tested with the face of the smaller input id first, whatever its rows.  The flags are
+    set in ``inter``, ``copl``, ``close`` and ``fold`` (p,), which come in all False.
     """
     p = pairs.shape[0]
-    inter = np.zeros(p, np.bool_)
-    copl = np.zeros(p, np.bool_)
-    close = np.zeros(p, np.bool_)
-    fold = np.zeros(p, np.bool_)
     pad = max(eps, near)
     eps_r = eps * (1 + SLACK)
     near_r = near * (1 + SLACK)
     pad_r = pad * (1 + SLACK)
-    for q in numba.prange(p):
+    for q in range(p):
         i = pairs[q, 0]
         j = pairs[q, 1]
         if order[i] > order[j]:  # as (smaller, larger) input id, the orientation of the tests
@@ -196,7 +199,6 @@ def narrow_phase(
                 close[q] = meet
             elif nshared == 2 and both:
                 fold[q] = _folded(Ti, Tj, fw[i], fw[j], cos_fold)
-    return inter, copl, close, fold
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -276,23 +278,18 @@ def broad_pairs(first, starts, counts, ent, low_a, low_b, key, lo, hi, bits, m):
     return out[:n]
 
 
-@numba.njit(cache=True, nogil=True, error_model="numpy", parallel=True)
-def face_axes(tri, tau):
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def face_axes(tri, tau, axes, valid, has_normal, low, high):
     """Per-face separating axes of the narrow phase: unit normal and three in-plane edge normals.
 
     The arithmetic is that of the numpy formulation (``cross``, ``norm``, one division per
     component), written per face; the projection intervals are widened by
-    :data:`PROJ_SLACK`.  Returns ``axes`` (m, 4, 3) (zero rows are unusable), ``valid``
-    (m, 4), ``has_normal`` (m,) and the projection interval ``low``, ``high`` (m, 4) of the
-    face on each axis.
+    :data:`PROJ_SLACK`.  Fills ``axes`` (m, 4, 3) (zero rows are unusable), ``valid``
+    (m, 4), ``has_normal`` (m,), which come in all zero, and the projection interval
+    ``low``, ``high`` (m, 4) of the face on each axis.
     """
     m = tri.shape[0]
-    axes = np.zeros((m, 4, 3))
-    valid = np.zeros((m, 4), np.bool_)
-    has_normal = np.zeros(m, np.bool_)
-    low = np.empty((m, 4))
-    high = np.empty((m, 4))
-    for f in numba.prange(m):
+    for f in range(m):
         edges, edge_len = _sides(tri[f])
         a = edges[0]
         b = edges[1]
@@ -330,7 +327,6 @@ def face_axes(tri, tau):
                 hi = max(hi, p)
             low[f, k] = lo - PROJ_SLACK
             high[f, k] = hi + PROJ_SLACK
-    return axes, valid, has_normal, low, high
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

@@ -22,7 +22,8 @@ Pipeline
    pair is emitted once, from the cell that holds the lower corner of the two boxes'
    overlap.  Cell keys are int64 (21 bits per axis), matched by sorting and
    ``searchsorted``; large outputs are produced in bounded chunks.
-3. Narrow phase (:func:`classify_pairs`, one numba loop over the pairs): a
+3. Narrow phase (:func:`classify_pairs`, one numba loop over the pairs, run on slices of
+   them in threads by :func:`in_threads`): a
    separating-axis test on the 17 axes that separate two triangles — the two normals, the
    six in-plane edge normals (precomputed per face, :func:`meshvis.geometry._kernels.face_axes`)
    and the 9 edge x edge directions.  Each
@@ -70,6 +71,7 @@ about 1e-9 approaches float64 round-off of the normalised coordinates and is ref
 from __future__ import annotations
 
 from collections.abc import Callable
+from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
@@ -85,6 +87,10 @@ ANGLE_EPS = 1e-3
 FOLD_ANGLE = np.radians(2.0)
 #: candidate pairs per call of the narrow-phase kernel (a progress step)
 NARROW_CHUNK = 1 << 21
+#: rows per slice below which a kernel runs in fewer slices or one call, and slices per
+#: thread (:func:`in_threads`)
+THREAD_ROWS = 1 << 14
+THREAD_PARTS = 4
 #: pairs expanded at once in the broad phase
 BROAD_CHUNK = 1 << 20
 _BITS = 21  # bits per axis of a cell key
@@ -293,32 +299,69 @@ def classify_pairs(
     # (~ machine eps / tau, relative to unit coordinates) must stay far below eps
     tau = min(1e-3, 100 * np.finfo(np.float64).eps / min(eps, near))
     tri = np.ascontiguousarray(triangles, np.float64)
-    axes, valid, has_normal, low, high = face_axes(tri, float(tau))
+    m = len(tri)
+    axes, valid, has_normal = np.zeros((m, 4, 3)), np.zeros((m, 4), bool), np.zeros(m, bool)
+    low, high = np.empty((m, 4)), np.empty((m, 4))
+    in_threads(
+        lambda a, b: face_axes(
+            tri[a:b], float(tau), axes[a:b], valid[a:b], has_normal[a:b], low[a:b], high[a:b]
+        ),
+        m,
+    )
     fw = np.ascontiguousarray(faces_welded, np.int64)
     order = np.arange(len(tri)) if order is None else np.asarray(order, np.int64)
     out = np.zeros((3, len(pairs)), bool)
     for s in range(0, len(pairs), NARROW_CHUNK):
         sl = slice(s, s + NARROW_CHUNK)
-        inter, copl, close, fold = narrow_phase(
-            order,
-            tri,
-            fw,
-            axes,
-            valid,
-            has_normal,
-            low,
-            high,
-            np.ascontiguousarray(pairs[sl]),
-            float(eps),
-            float(near),
-            float(tau),
-            float(np.cos(angle_eps)),
-            float(np.cos(fold_angle)),
+        chunk = np.ascontiguousarray(pairs[sl])
+        inter, copl, close, fold = np.zeros((4, len(chunk)), bool)
+        in_threads(
+            lambda a, b: narrow_phase(
+                order,
+                tri,
+                fw,
+                axes,
+                valid,
+                has_normal,
+                low,
+                high,
+                chunk[a:b],
+                float(eps),
+                float(near),
+                float(tau),
+                float(np.cos(angle_eps)),
+                float(np.cos(fold_angle)),
+                inter[a:b],
+                copl[a:b],
+                close[a:b],
+                fold[a:b],
+            ),
+            len(chunk),
         )
         out[0, sl], out[1, sl], out[2, sl] = inter, copl | fold, close
         if progress is not None:
             progress(min(s + NARROW_CHUNK, len(pairs)) / len(pairs))
     return out[0], out[1], out[2]
+
+
+def in_threads(work: Callable[[int, int], object], n: int) -> None:
+    """Call ``work(start, stop)`` on slices of ``range(n)``, in threads when ``n`` is large.
+
+    For compiled kernels that release the GIL and write each row of their slice into
+    output arrays on their own: the result is the one of ``work(0, n)``.  The threads
+    are numba's count (``NUMBA_NUM_THREADS``, by default the cores).
+    """
+    import numba
+
+    threads = numba.get_num_threads()
+    k = min(THREAD_PARTS * threads, n // THREAD_ROWS)
+    if threads < 2 or k < 2:
+        work(0, n)
+        return
+    # a few slices per thread even out the rows that cost more than others
+    bounds = np.linspace(0, n, k + 1).astype(np.int64)
+    with ThreadPoolExecutor(threads) as pool:
+        list(pool.map(work, bounds[:-1], bounds[1:]))
 
 
 def _spread_bits(x: np.ndarray) -> np.ndarray:
