@@ -41,7 +41,8 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     command : str, optional
         A name of :data:`COMMANDS`: add only the parser of its module (importing every
         module, labeling and the benchmarks included, takes about half a second, which a
-        command that runs in seconds should not pay).  Default: every command.
+        command that runs in seconds should not pay); any other name adds none.  Default:
+        every command.
 
     Returns
     -------
@@ -104,8 +105,10 @@ def main(argv: list[str] | None = None) -> int:
     from meshvis.errors import MeshvisError
 
     argv = sys.argv[1:] if argv is None else list(argv)
-    # the top level has only -h and --version, so a command is the first argument
-    parser = build_parser(argv[0] if argv and argv[0] in COMMANDS else None)
+    # the top level has only -h and --version, so a command is the first argument; the
+    # version needs no subcommand (building them all imports labeling and the kernels)
+    first = argv[0] if argv else None
+    parser = build_parser(first if first in COMMANDS or first == "--version" else None)
     args = parser.parse_args(argv)
     if not getattr(args, "func", None):
         parser.print_help()

@@ -40,3 +40,15 @@ def test_a_command_builds_only_its_own_parser(tmp_path):
     run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
     assert run.returncode == 0, run.stderr
     assert run.stdout.splitlines()[-2:] == ["0 False False", "True"]
+
+
+def test_the_version_builds_no_command_parser(tmp_path):
+    code = (
+        "import sys; from meshvis.cli.main import main\n"
+        "try:\n    main(['--version'])\nexcept SystemExit as e:\n    print(e.code)\n"
+        "print('meshvis.labeling' in sys.modules, 'meshvis.cli.cmd_repair' in sys.modules)"
+    )
+    run = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, cwd=tmp_path)
+    assert run.returncode == 0, run.stderr
+    assert run.stdout.splitlines()[0].startswith("meshvis ")
+    assert run.stdout.splitlines()[-2:] == ["0", "False False"]
