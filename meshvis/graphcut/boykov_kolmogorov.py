@@ -142,13 +142,11 @@ def _settle_decided(i, j, cap_ij, cap_ji, excess):  # pragma: no cover - compile
     i_kept, j_kept = np.empty(k, np.int64), np.empty(k, np.int64)
     ij_kept, ji_kept = np.empty(k), np.empty(k)
     side = np.zeros(n, np.int8)
-    out_sum = np.empty(n)
-    in_sum = np.empty(n)
-    to_source = np.empty(n)
+    out_sum = np.zeros(n)  # capacity of the arcs leaving / entering each node
+    in_sum = np.zeros(n)
+    to_source = np.empty(n)  # the terminal links that a pass's merges add
     to_sink = np.empty(n)
     flow = 0.0
-    out_sum[:] = 0.0
-    in_sum[:] = 0.0
     for e in range(k):
         out_sum[i[e]] += cap_ij[e]
         out_sum[j[e]] += cap_ji[e]
@@ -182,7 +180,7 @@ def _settle_decided(i, j, cap_ij, cap_ji, excess):  # pragma: no cover - compile
                 in_sum[a] += cap_ji[e]
                 in_sum[b] += cap_ij[e]
                 kept += 1
-            elif side[b] == 0:  # a settled: a -> b becomes source -> b, or b -> a b -> sink
+            elif side[b] == 0:  # a settled: a -> b becomes source -> b, or b -> a becomes b -> sink
                 if side[a] > 0:
                     to_source[b] += cap_ij[e]
                 else:
