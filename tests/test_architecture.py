@@ -19,6 +19,7 @@ LAYERS = {
     "meshvis.soup": 0,
     "meshvis.limits": 0,
     "meshvis._validate": 0,
+    "meshvis._threads": 0,
     "meshvis.io": 1,
     "meshvis.rays": 2,
     "meshvis.geometry": 2,

@@ -75,6 +75,7 @@ from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
+from meshvis._threads import default_threads
 from meshvis.errors import ParameterError
 from meshvis.geometry.adjacency import WELD_TOL, weld
 
@@ -349,8 +350,8 @@ def in_threads(work: Callable[[int, int], object], n: int) -> None:
 
     For compiled kernels that release the GIL and write each row of their slice into
     output arrays on their own: the result is the one of ``work(0, n)``.  The threads
-    are numba's count (``NUMBA_NUM_THREADS``, by default the cores); below
-    ``2 * THREAD_ROWS`` rows there is one call.
+    are :func:`meshvis._threads.default_threads` (``MESHVIS_THREADS`` or the cores), as
+    for the ray batches; below ``2 * THREAD_ROWS`` rows there is one call.
 
     Parameters
     ----------
@@ -368,9 +369,7 @@ def in_threads(work: Callable[[int, int], object], n: int) -> None:
     >>> bool((y == 2 * x).all())
     True
     """
-    import numba
-
-    threads = numba.get_num_threads()
+    threads = default_threads()
     k = min(THREAD_PARTS * threads, n // THREAD_ROWS)
     if threads < 2 or k < 2:
         work(0, n)

@@ -23,7 +23,6 @@ slower.  ``meshvis bench rays`` measures all three side by side.
 
 from __future__ import annotations
 
-import os
 from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
@@ -31,6 +30,7 @@ from typing import Any
 import numpy as np
 
 from meshvis import _validate
+from meshvis._threads import default_threads
 from meshvis.geometry.adjacency import VertexGroups, group_vertices
 from meshvis.io import as_soup
 from meshvis.rays import _kernels
@@ -39,14 +39,6 @@ from meshvis.rays import _kernels
 DEFAULT_OFFSET = 1e-5
 #: rays per chunk handed to one thread; large enough to amortise the call overhead
 CHUNK = 1 << 17
-
-
-def default_threads() -> int:
-    """Threads used for large batches: the ``MESHVIS_THREADS`` variable or the core count."""
-    env = os.environ.get("MESHVIS_THREADS")
-    if env:
-        return max(1, int(env))
-    return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
 
 
 def _used_bounds(soup, firsts: np.ndarray) -> np.ndarray:
