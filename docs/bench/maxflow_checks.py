@@ -16,38 +16,26 @@ one of the last max-flow of ``classify(model, seed=0)``.
 
 from __future__ import annotations
 
+import os
 import sys
 import threading
 import time
-import warnings
 
 import numpy as np
 import scipy.sparse as sp
 from scipy.sparse.csgraph import reverse_cuthill_mckee
 
-import meshvis
 from meshvis.graphcut import mincut
+
+sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+from settle_nodes import round_graphs  # noqa: E402 - the recording of the script beside this one
 
 MODEL = "../shared/models/real/pybullet__samurai_monastry.obj"
 
 
 def last_graph(path: str) -> tuple:
     """The arguments of the last max-flow that ``classify(path, seed=0)`` runs."""
-    calls = []
-    solve = mincut._cut_pymaxflow
-
-    def record(*args):
-        calls.append(args)
-        return solve(*args)
-
-    mincut._cut_pymaxflow = record
-    try:
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            meshvis.classify(meshvis.load(path), seed=0)
-    finally:
-        mincut._cut_pymaxflow = solve
-    return calls[-1]
+    return round_graphs(path)[-1]
 
 
 def seconds(f) -> float:

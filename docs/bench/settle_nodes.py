@@ -45,12 +45,8 @@ def round_graphs(path: str) -> list[tuple]:
 
 
 def whole_graph(n, i, j, cap_ij, cap_ji, cap_source, cap_sink):
-    """The search on every node and edge: ``min_cut_bk`` without the settling passes."""
-    first, head, sister, arc_ij, arc_ji = bk.arcs_by_tail(n, np.asarray(i, np.int64), np.asarray(j, np.int64))
-    rcap = np.empty(len(head))
-    rcap[arc_ij] = cap_ij
-    rcap[arc_ji] = cap_ji
-    outside, flow = bk._max_flow(first, head, sister, rcap, cap_source - cap_sink)
+    """``min_cut_bk`` without the settling passes: the search on every node and edge."""
+    outside, flow = bk.search(n, i, j, cap_ij, cap_ji, cap_source - cap_sink)
     return outside, float(flow + np.minimum(cap_source, cap_sink).sum())
 
 

@@ -112,14 +112,27 @@ def min_cut_bk(
     free = side == 0
     if free.any():  # the max flow of the free nodes and the edges between them, renumbered
         index = np.cumsum(free) - 1
-        first, head, sister, arc_ij, arc_ji = arcs_by_tail(int(index[-1]) + 1, index[i], index[j])
-        rcap = np.empty(len(head), np.float64)
-        rcap[arc_ij] = cap_ij
-        rcap[arc_ji] = cap_ji
-        outside[free], flow = _max_flow(first, head, sister, rcap, excess[free])
+        outside[free], flow = search(int(index[-1]) + 1, index[i], index[j], cap_ij, cap_ji, excess[free])
     # the netted part of each node's two terminal links flows straight through the node
     value = float(settled_flow + flow + np.minimum(cap_source, cap_sink).sum())
     return outside, value, int(n - free.sum())
+
+
+def search(
+    n: int, i: np.ndarray, j: np.ndarray, cap_ij: np.ndarray, cap_ji: np.ndarray, excess: np.ndarray
+) -> tuple[np.ndarray, float]:
+    """The Boykov–Kolmogorov search on a whole graph, without settling any node.
+
+    ``excess`` (n,) is each node's netted terminal capacity (positive from the source); it
+    is used up in place.  Returns the source tree's nodes and the flow through the edges
+    (without the netted part of the terminal links).  :func:`min_cut_bk` runs it on the
+    nodes its settling leaves.
+    """
+    first, head, sister, arc_ij, arc_ji = arcs_by_tail(n, np.asarray(i, np.int64), np.asarray(j, np.int64))
+    rcap = np.empty(len(head), np.float64)
+    rcap[arc_ij] = cap_ij
+    rcap[arc_ji] = cap_ji
+    return _max_flow(first, head, sister, rcap, excess)
 
 
 @numba.njit(cache=True, nogil=True)
