@@ -99,8 +99,7 @@ class Reference:
     @property
     def decisive(self) -> np.ndarray:
         """(m,) bool: the faces whose first-round counts decide which side is outside."""
-        lo, hi = np.sort(self.escaped, axis=1).T
-        return (self.escaped.sum(axis=1) >= MIN_ESCAPES) & (hi >= DOMINANCE * lo)
+        return _dominant(self.escaped, 1)  # counts, as DESIGN.md §10 defines it
 
     @property
     def outside_side(self) -> np.ndarray:
@@ -190,8 +189,11 @@ def reference(model, *, seed: int = 0, cache: str | os.PathLike | None = None, p
 _ARRAYS = ("escaped", "cast", "seen", "seen_side", "rays", "area")
 
 
-def _dominant(escaped: np.ndarray, cast: np.ndarray) -> np.ndarray:
-    """Enough escapes, and one side's escape share at least :data:`DOMINANCE` times the other's."""
+def _dominant(escaped: np.ndarray, cast: np.ndarray | int) -> np.ndarray:
+    """Enough escapes, and one side's escape share at least :data:`DOMINANCE` times the other's.
+
+    With ``cast`` 1 the shares are the counts themselves (exactly: integers in float64).
+    """
     share = escaped / np.maximum(cast, 1)
     lo, hi = np.sort(share, axis=1).T
     return (escaped.sum(axis=1) >= MIN_ESCAPES) & (hi >= DOMINANCE * lo)

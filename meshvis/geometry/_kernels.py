@@ -33,7 +33,7 @@ WEDGE_SLACK = 1e-9
 PROJ_SLACK = 1e-15
 
 # The narrow phase and the face axes are serial kernels that release the GIL, run on slices
-# in threads (meshvis.geometry.intersect.in_threads), and their helpers are left to LLVM's
+# in threads (meshvis._threads.in_threads), and their helpers are left to LLVM's
 # inlining: numba's parallel loops and its own inlining (inline="always") cost them about
 # 7 s of compilation on first use and no speed (docs/performance.md, "First use").
 

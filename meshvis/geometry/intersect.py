@@ -23,7 +23,7 @@ Pipeline
    overlap.  Cell keys are int64 (21 bits per axis), matched by sorting and
    ``searchsorted``; large outputs are produced in bounded chunks.
 3. Narrow phase (:func:`classify_pairs`, one numba loop over the pairs, run on slices of
-   them in threads by :func:`in_threads`): a
+   them in threads by :func:`meshvis._threads.in_threads`): a
    separating-axis test on the 17 axes that separate two triangles — the two normals, the
    six in-plane edge normals (precomputed per face, :func:`meshvis.geometry._kernels.face_axes`)
    and the 9 edge x edge directions.  Each
@@ -71,11 +71,10 @@ about 1e-9 approaches float64 round-off of the normalised coordinates and is ref
 from __future__ import annotations
 
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
 
 import numpy as np
 
-from meshvis._threads import default_threads
+from meshvis._threads import in_threads
 from meshvis.errors import ParameterError
 from meshvis.geometry.adjacency import WELD_TOL, weld
 
@@ -88,10 +87,6 @@ ANGLE_EPS = 1e-3
 FOLD_ANGLE = np.radians(2.0)
 #: candidate pairs per call of the narrow-phase kernel (a progress step)
 NARROW_CHUNK = 1 << 21
-#: rows per slice below which a kernel runs in fewer slices or one call, and slices per
-#: thread (:func:`in_threads`)
-THREAD_ROWS = 1 << 14
-THREAD_PARTS = 4
 #: pairs expanded at once in the broad phase
 BROAD_CHUNK = 1 << 20
 _BITS = 21  # bits per axis of a cell key
@@ -343,41 +338,6 @@ def classify_pairs(
         if progress is not None:
             progress(min(s + NARROW_CHUNK, len(pairs)) / len(pairs))
     return out[0], out[1], out[2]
-
-
-def in_threads(work: Callable[[int, int], object], n: int) -> None:
-    """Call ``work(start, stop)`` on slices of ``range(n)``, in threads when ``n`` is large.
-
-    For compiled kernels that release the GIL and write each row of their slice into
-    output arrays on their own: the result is the one of ``work(0, n)``.  The threads
-    are :func:`meshvis._threads.default_threads` (``MESHVIS_THREADS`` or the cores), as
-    for the ray batches; below ``2 * THREAD_ROWS`` rows there is one call.
-
-    Parameters
-    ----------
-    work : callable
-        ``work(start, stop)`` handles rows ``start .. stop - 1``; its return value is ignored.
-    n : int
-        Number of rows.
-
-    Examples
-    --------
-    >>> import numpy as np
-    >>> x = np.arange(100_000.0)
-    >>> y = np.empty_like(x)
-    >>> in_threads(lambda a, b: np.multiply(x[a:b], 2.0, out=y[a:b]), len(x))
-    >>> bool((y == 2 * x).all())
-    True
-    """
-    threads = default_threads()
-    k = min(THREAD_PARTS * threads, n // THREAD_ROWS)
-    if threads < 2 or k < 2:
-        work(0, n)
-        return
-    # a few slices per thread even out the rows that cost more than others
-    bounds = np.linspace(0, n, k + 1).astype(np.int64)
-    with ThreadPoolExecutor(threads) as pool:
-        list(pool.map(work, bounds[:-1], bounds[1:]))
 
 
 def _spread_bits(x: np.ndarray) -> np.ndarray:

@@ -304,6 +304,7 @@ def test_real_model_agrees_with_meshlab():
 
 def test_flags_in_threads_are_those_of_one_call(monkeypatch):
     """The narrow phase and the face axes on slices in threads give the flags of one call."""
+    import meshvis._threads as T
     import meshvis.geometry.intersect as I
 
     rng = np.random.default_rng(11)
@@ -311,9 +312,9 @@ def test_flags_in_threads_are_those_of_one_call(monkeypatch):
     tri = rng.random((3000, 1, 3)) + rng.normal(scale=0.03, size=(3000, 3, 3))
     tri[-300:] = tri[-600:-300]
     v, f = tri.reshape(-1, 3), np.arange(9000).reshape(-1, 3)
-    monkeypatch.setattr(I, "THREAD_ROWS", 1 << 40)  # one call
+    monkeypatch.setattr(T, "THREAD_ROWS", 1 << 40)  # one call
     one = I.intersection_flags(v, f)
-    monkeypatch.setattr(I, "THREAD_ROWS", 7)  # many uneven slices
+    monkeypatch.setattr(T, "THREAD_ROWS", 7)  # many uneven slices
     sliced = I.intersection_flags(v, f)
     assert 100 < one["intersects"].sum() < 2400 and one["coplanar"].sum() >= 600
     for key, flags in one.items():
