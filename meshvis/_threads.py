@@ -31,7 +31,7 @@ def default_threads() -> int:
     return max(1, len(os.sched_getaffinity(0)) if hasattr(os, "sched_getaffinity") else os.cpu_count() or 1)
 
 
-def in_threads(work: Callable[[int, int], object], n: int) -> None:
+def in_threads(work: Callable[[int, int], object], n: int, rows_per_item: int = 1) -> None:
     """Call ``work(start, stop)`` on slices of ``range(n)``, in threads when ``n`` is large.
 
     For compiled kernels that release the GIL and write each row of their slice into
@@ -44,7 +44,10 @@ def in_threads(work: Callable[[int, int], object], n: int) -> None:
     work : callable
         ``work(start, stop)`` handles rows ``start .. stop - 1``; its return value is ignored.
     n : int
-        Number of rows.
+        Number of rows (items).
+    rows_per_item : int
+        Rows each item stands for when the slices are sized (an item that is a face
+        casting 32 rays is 32 rows of work).
 
     Examples
     --------
@@ -56,7 +59,7 @@ def in_threads(work: Callable[[int, int], object], n: int) -> None:
     True
     """
     threads = default_threads()
-    k = min(THREAD_PARTS * threads, n // THREAD_ROWS)
+    k = min(THREAD_PARTS * threads, n * rows_per_item // THREAD_ROWS, n)
     if threads < 2 or k < 2:
         work(0, n)
         return

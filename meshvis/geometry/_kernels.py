@@ -11,16 +11,11 @@ operations can only add reports (the flags stay conservative).
 from __future__ import annotations
 
 import math
-import warnings
 
 import numba
 import numpy as np
 
-# Numba tries the TBB threading layer first and warns when the installed TBB is too old,
-# then falls back to OpenMP or its own work queue, which serve these kernels as well: the
-# warning says nothing a user of meshvis can act on (printed by every command that runs a
-# parallel kernel on such a machine).
-warnings.filterwarnings("ignore", message=".*The TBB threading layer requires", category=numba.NumbaWarning)
+from meshvis._threads import in_threads
 
 #: relative slack of every reporting comparison (far above float64 reordering error)
 SLACK = 1e-12
@@ -32,10 +27,11 @@ WEDGE_SLACK = 1e-9
 #: other evaluation order and the gaps can only shrink (more reports, never fewer)
 PROJ_SLACK = 1e-15
 
-# The narrow phase and the face axes are serial kernels that release the GIL, run on slices
-# in threads (meshvis._threads.in_threads), and their helpers are left to LLVM's
-# inlining: numba's parallel loops and its own inlining (inline="always") cost them about
-# 7 s of compilation on first use and no speed (docs/performance.md, "First use").
+# The kernels are serial and release the GIL; the large ones (the narrow phase, the face
+# axes, the corner gather) run on slices in threads (meshvis._threads.in_threads), and
+# their helpers are left to LLVM's inlining: numba's parallel loops and its own inlining
+# (inline="always") cost them about 7 s of compilation on first use and no speed
+# (docs/performance.md, "First use").
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -511,14 +507,17 @@ def corner_bounds(v, faces):
     return out
 
 
-@numba.njit(cache=True, nogil=True, parallel=True)
-def gather_normalised(v, faces, centre, scale):
-    """(m, 3, 3) corners ``(v[faces] - centre) * scale``, in that order of operations."""
-    m = faces.shape[0]
-    out = np.empty((m, 3, 3))
-    for f in numba.prange(m):
+@numba.njit(cache=True, nogil=True)
+def _gather_normalised(v, faces, centre, scale, out):
+    for f in range(faces.shape[0]):
         for c in range(3):
             p = faces[f, c]
             for d in range(3):
                 out[f, c, d] = (v[p, d] - centre[d]) * scale
+
+
+def gather_normalised(v: np.ndarray, faces: np.ndarray, centre: np.ndarray, scale: float) -> np.ndarray:
+    """(m, 3, 3) corners ``(v[faces] - centre) * scale``, in that order of operations."""
+    out = np.empty((faces.shape[0], 3, 3))
+    in_threads(lambda a, b: _gather_normalised(v, faces[a:b], centre, scale, out[a:b]), faces.shape[0])
     return out

@@ -18,19 +18,13 @@ import math
 import numba
 import numpy as np
 
+from meshvis._threads import in_threads
 from meshvis.rays._kernels import einsum_dot3
 
 
-@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def nearest_sample(metric, u, v, sample_u, sample_v):  # pragma: no cover - compiled
-    """(n,) index of the sample nearest to each hit under the face metric ``Δᵀ G Δ``.
-
-    ``metric[k] = (e1·e1, e1·e2, e2·e2)`` of hit k's face; ``u, v`` the hits' barycentric
-    coordinates; ``sample_u, sample_v`` the samples' (the same pattern on every face).
-    """
-    n = len(u)
-    best = np.zeros(n, np.int64)
-    for k in numba.prange(n):
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _nearest_sample(metric, u, v, sample_u, sample_v, best):  # pragma: no cover - compiled
+    for k in range(len(u)):
         g0, g1, g2 = metric[k, 0], metric[k, 1], metric[k, 2]
         uk, vk = np.float64(u[k]), np.float64(v[k])
         best_d2 = 0.0
@@ -40,6 +34,21 @@ def nearest_sample(metric, u, v, sample_u, sample_v):  # pragma: no cover - comp
             if s == 0 or d2 < best_d2:
                 best[k] = s
                 best_d2 = d2
+
+
+def nearest_sample(
+    metric: np.ndarray, u: np.ndarray, v: np.ndarray, sample_u: np.ndarray, sample_v: np.ndarray
+) -> np.ndarray:
+    """(n,) index of the sample nearest to each hit under the face metric ``Δᵀ G Δ``.
+
+    ``metric[k] = (e1·e1, e1·e2, e2·e2)`` of hit k's face; ``u, v`` the hits' barycentric
+    coordinates; ``sample_u, sample_v`` the samples' (the same pattern on every face).
+    Serial over slices of the hits, in threads (:func:`meshvis._threads.in_threads`).
+    """
+    best = np.zeros(len(u), np.int64)
+    in_threads(
+        lambda a, b: _nearest_sample(metric[a:b], u[a:b], v[a:b], sample_u, sample_v, best[a:b]), len(u)
+    )
     return best
 
 

@@ -11,7 +11,7 @@ replace.
 The kernels of the propagation loop (:func:`far_origins`, :func:`aimed_from`) run
 thousands of times per search on batches of a few thousand rays, where starting the
 thread pool costs more than the loop: they are serial.  The seed kernels run once per
-chunk of up to a million rays and are parallel.
+chunk of up to a million rays, on slices in threads (:func:`meshvis._threads.in_threads`).
 
 The summation orders of numpy's norm and einsum are the helpers of
 :mod:`meshvis.rays._kernels`.
@@ -22,6 +22,7 @@ from __future__ import annotations
 import numba
 import numpy as np
 
+from meshvis._threads import in_threads
 from meshvis.rays._kernels import einsum_dot3, norm3, query_buffers, segment_query
 
 
@@ -51,35 +52,69 @@ def aimed_from(origins, targets):  # pragma: no cover - compiled
     return out
 
 
-@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def facing_sides(directions, normals, face):  # pragma: no cover - compiled
-    """(n,) int8: ``einsum("ij,ij->i", directions, normals[face]) >= 0``."""
-    out = np.empty(len(face), np.int8)
-    for k in numba.prange(len(face)):
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _facing_sides(directions, normals, face, out):  # pragma: no cover - compiled
+    for k in range(len(face)):
         f = face[k]
         dot = einsum_dot3(
             directions[k, 0], directions[k, 1], directions[k, 2], normals[f, 0], normals[f, 1], normals[f, 2]
         )
         out[k] = 1 if dot >= 0 else 0
+
+
+def facing_sides(directions: np.ndarray, normals: np.ndarray, face: np.ndarray) -> np.ndarray:
+    """(n,) int8: ``einsum("ij,ij->i", directions, normals[face]) >= 0``."""
+    out = np.empty(len(face), np.int8)
+    in_threads(lambda a, b: _facing_sides(directions[a:b], normals, face[a:b], out[a:b]), len(face))
     return out
 
 
-@numba.njit(cache=True, nogil=True, parallel=True, error_model="numpy")
-def seed_segments(points, normals, face, side, viewers, center, scale, offset, diagonal):  # pragma: no cover
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _seed_segments(
+    points, normals, face, side, viewers, center, scale, offset, diagonal, o32, d32, dist, ok
+):  # pragma: no cover - compiled
+    pushed = np.empty(3)
+    for k in range(len(points)):
+        f = face[k]
+        s = ((1.0 if side[k] == 0 else -1.0) * offset) * diagonal
+        for c in range(3):
+            pushed[c] = points[k, c] + normals[f, c] * s
+        segment_query(k, pushed, viewers[k], center, scale, offset, o32, d32, dist, ok)
+
+
+def seed_segments(
+    points: np.ndarray,
+    normals: np.ndarray,
+    face: np.ndarray,
+    side: np.ndarray,
+    viewers: np.ndarray,
+    center: np.ndarray,
+    scale: float,
+    offset: float,
+    diagonal: float,
+) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Embree inputs of ``RayCaster.occluded(RayCaster.push_off(points, face, side), viewers)``.
 
     ``center, scale, offset, diagonal`` are the caster's.  Returns ``(o32, d32, dist, ok)``
     as :func:`meshvis.rays._kernels.segment_queries`.
     """
-    o32, d32, dist, ok = query_buffers(len(points))
-    pushed = np.empty_like(points)
-    for k in numba.prange(len(points)):
-        f = face[k]
-        s = ((1.0 if side[k] == 0 else -1.0) * offset) * diagonal
-        for c in range(3):
-            pushed[k, c] = points[k, c] + normals[f, c] * s
-        segment_query(k, pushed[k], viewers[k], center, scale, offset, o32, d32, dist, ok)
-    return o32, d32, dist, ok
+    out = query_buffers(len(points))
+    in_threads(
+        lambda a, b: _seed_segments(
+            points[a:b],
+            normals,
+            face[a:b],
+            side[a:b],
+            viewers[a:b],
+            center,
+            scale,
+            offset,
+            diagonal,
+            *(x[a:b] for x in out),
+        ),
+        len(points),
+    )
+    return out
 
 
 @numba.njit(cache=True, nogil=True, inline="always")
