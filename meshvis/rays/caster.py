@@ -23,14 +23,13 @@ slower.  ``meshvis bench rays`` measures all three side by side.
 
 from __future__ import annotations
 
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 from typing import Any
 
 import numpy as np
 
 from meshvis import _validate
-from meshvis._threads import default_threads
+from meshvis._threads import default_threads, pool
 from meshvis.geometry.adjacency import VertexGroups, group_vertices
 from meshvis.io import as_soup
 from meshvis.rays import _kernels
@@ -182,13 +181,13 @@ class RayCaster:
                 np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), query=query, **kw
             )
 
-        if self.threads == 1 or n < 2 * CHUNK:
+        workers = pool(self.threads) if self.threads > 1 and n >= 2 * CHUNK else None
+        if workers is None:
             return call(slice(0, n))
         k = max(self.threads, -(-n // (4 * CHUNK)) * self.threads)
         bounds = np.linspace(0, n, k + 1).astype(int)
         slices = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
-        with ThreadPoolExecutor(self.threads) as pool:
-            parts = list(pool.map(call, slices))
+        parts = list(workers.map(call, slices))
         if query == "INTERSECT":
             return {
                 "primID": np.concatenate([p["primID"] for p in parts]),
