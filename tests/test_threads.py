@@ -5,6 +5,7 @@ from __future__ import annotations
 import threading
 
 import numpy as np
+import pytest
 
 from meshvis import _threads
 
@@ -138,3 +139,34 @@ def _module_of(name: str):
         if hasattr(module, name) and hasattr(module, "_" + name):
             return module
     raise LookupError(name)
+
+
+def test_work_in_a_pool_thread_is_not_sliced_again(monkeypatch):
+    monkeypatch.setenv("MESHVIS_THREADS", "2")
+    inner = []
+
+    def outer(a, b):
+        # slicing again here would wait for the pool's threads, which are busy with `outer`
+        _threads.in_threads(lambda c, d: inner.append((int(c), int(d))), 1 << 20)
+
+    _threads.in_threads(outer, 1 << 20)
+    assert sorted(inner) == [(0, 1 << 20)] * (2 * _threads.THREAD_PARTS)
+    assert _threads.pool(2) is _threads.pool(2)
+
+
+def _sliced_sum(n: int) -> float:
+    x = np.arange(float(n))
+    parts = np.zeros(n)
+    _threads.in_threads(lambda a, b: np.copyto(parts[a:b], x[a:b]), n)
+    return float(parts.sum())
+
+
+@pytest.mark.filterwarnings("ignore:This process .* is multi-threaded:DeprecationWarning")
+def test_a_forked_process_gets_its_own_pool(monkeypatch):
+    import multiprocessing
+
+    monkeypatch.setenv("MESHVIS_THREADS", "2")
+    assert _sliced_sum(1 << 20) == _sliced_sum(1 << 20)  # the parent's pool is running
+    with multiprocessing.get_context("fork").Pool(1) as child:
+        # the parent's threads do not exist in the child: reusing its pool would hang
+        assert child.apply_async(_sliced_sum, (1 << 20,)).get(timeout=30) == float(np.arange(1 << 20).sum())
