@@ -39,12 +39,14 @@ def last_graph(path: str) -> tuple:
 
 
 def seconds(f) -> float:
+    """Wall seconds of one call of ``f()``."""
     t = time.perf_counter()
     f()
     return time.perf_counter() - t
 
 
 def main(path: str) -> None:
+    """Time PyMaxflow on the last graph of ``path``: two cuts serially and in threads, and in RCM order."""
     args = last_graph(path)
     n, i, j = args[0], args[1], args[2]
     print(f"{path}: last graph {n} nodes, {len(i)} edges")
@@ -54,7 +56,9 @@ def main(path: str) -> None:
     serial = seconds(lambda: (cut(*args), cut(*args)))
     pair = [threading.Thread(target=cut, args=args) for _ in range(2)]
     threaded = seconds(lambda: ([t.start() for t in pair], [t.join() for t in pair]))
-    print(f"two cuts one after another {serial:.2f} s, in two threads {threaded:.2f} s (ratio {threaded / serial:.2f})")
+    print(
+        f"two cuts one after another {serial:.2f} s, in two threads {threaded:.2f} s (ratio {threaded / serial:.2f})"
+    )
 
     adjacency = sp.coo_matrix((np.ones(len(i)), (i, j)), shape=(n, n)).tocsr()
     order = reverse_cuthill_mckee((adjacency + adjacency.T).tocsr(), symmetric_mode=True)
@@ -65,7 +69,9 @@ def main(path: str) -> None:
     same = np.array_equal(base.outside, reordered.outside[rank])
     t_base = min(seconds(lambda: cut(*args)) for _ in range(3))
     t_moved = min(seconds(lambda: cut(*moved)) for _ in range(3))
-    print(f"reverse Cuthill-McKee order: same labels {same}, cut {t_base:.2f} s -> {t_moved:.2f} s (best of 3)")
+    print(
+        f"reverse Cuthill-McKee order: same labels {same}, cut {t_base:.2f} s -> {t_moved:.2f} s (best of 3)"
+    )
 
 
 if __name__ == "__main__":

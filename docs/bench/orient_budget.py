@@ -65,7 +65,10 @@ def main() -> None:
                 errors = _errors(
                     r.flipped, turned, judged, side, confirmed & judged, confirmed_side.astype(bool), ref.area
                 )
-                print(f"{kind:6} {str(budget or 'default'):24} seed {seed}  {seconds:.3f} s  {errors}", flush=True)
+                print(
+                    f"{kind:6} {str(budget or 'default'):24} seed {seed}  {seconds:.3f} s  {errors}",
+                    flush=True,
+                )
 
 
 if __name__ == "__main__":

@@ -45,6 +45,7 @@ def _errors(flipped, turned, judged, side, confirmed, confirmed_side, area) -> s
 
 
 def main() -> None:
+    """Parse the command line and print the table."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("models", nargs="+", help="model files")
     ap.add_argument("--seeds", default="0", help="comma-separated seeds of orient")

@@ -58,6 +58,7 @@ def _best(f, args, runs: dict, key: str):
 
 
 def main(paths: list[str]) -> int:
+    """Time every cut of each model whole and settled; 1 if any labels differ."""
     same_everywhere = True
     for path in paths:
         graphs = round_graphs(path)

@@ -52,6 +52,7 @@ def _compare(name: str, soup, repairs: bool) -> bool:
 
 
 def main(argv: list[str]) -> int:
+    """Compare the labels of the solvers on every model of the folders; 1 if any differ."""
     repairs = "--repairs" in argv
     folders = [a for a in argv if a != "--repairs"]
     if not folders:
