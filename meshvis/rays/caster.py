@@ -36,8 +36,11 @@ from meshvis.rays import _kernels
 
 #: default push of an origin off its surface, as a fraction of the bounding-box diagonal
 DEFAULT_OFFSET = 1e-5
-#: rays per chunk handed to one thread; large enough to amortise the call overhead
-CHUNK = 1 << 17
+#: rays per chunk handed to one thread; a batch of two chunks or more is split over the
+#: threads of the kept pool (:func:`meshvis._threads.pool`).  Handing a chunk to the pool
+#: costs tens of microseconds, Embree traces 16 k rays in 2-5 ms: from 32 k rays two
+#: threads pay (``orient`` of the van Gogh room 0.64 -> 0.53 s, docs/performance.md)
+CHUNK = 1 << 14
 
 
 def _used_bounds(soup, firsts: np.ndarray) -> np.ndarray:

@@ -102,9 +102,11 @@ def test_threads_give_identical_hits():
     rng = np.random.default_rng(4)
     d = uniform_sphere(300_000, rng)
     o = rng.uniform(-0.5, 0.5, (300_000, 3))
-    a = RayCaster(s, threads=1).intersect(o, d)
-    b = RayCaster(s, threads=2).intersect(o, d)
+    one, two = RayCaster(s, threads=1), RayCaster(s, threads=2)
+    a, b = one.intersect(o, d), two.intersect(o, d)
     assert np.array_equal(a.face, b.face) and np.array_equal(a.side, b.side)
+    assert np.array_equal(a.distance, b.distance) and np.array_equal(a.bary, b.bary)
+    assert np.array_equal(one.occluded(o, o + d), two.occluded(o, o + d))
 
 
 def test_part_ids():
