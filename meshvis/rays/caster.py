@@ -29,7 +29,7 @@ from typing import Any
 import numpy as np
 
 from meshvis import _validate
-from meshvis._threads import default_threads, pool
+from meshvis._threads import THREAD_PARTS, default_threads, pool
 from meshvis.geometry.adjacency import VertexGroups, group_vertices
 from meshvis.io import as_soup
 from meshvis.rays import _kernels
@@ -187,7 +187,8 @@ class RayCaster:
         workers = pool(self.threads) if self.threads > 1 and n >= 2 * CHUNK else None
         if workers is None:
             return call(slice(0, n))
-        k = max(self.threads, -(-n // (4 * CHUNK)) * self.threads)
+        # a few chunks per thread even out the rays that cost more than others
+        k = min(THREAD_PARTS * self.threads, n // CHUNK)
         bounds = np.linspace(0, n, k + 1).astype(int)
         slices = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
         parts = list(workers.map(call, slices))
