@@ -432,16 +432,22 @@ def baseline_point(
 def warm_up() -> None:
     """Run every method once on a tiny model, so that start-up is not charged to a measured run.
 
-    Library start-up (Embree devices, imports) then happens here; the CGAL peel, which runs
-    in its own process anyway, is left out.
+    Library start-up (Embree devices, imports, loading compiled kernels) then happens here:
+    meshvis orients two spheres that cut into each other and removes their inside, which
+    reaches the kernels of the intersection tests, the sample points, the per-face evidence
+    and the from-region search.  The CGAL peel, which runs in its own process anyway, is
+    left out.
     """
     import trimesh
 
-    from meshvis.graphcut.classify import classify
+    from meshvis.repair.orient import orient
+    from meshvis.repair.remove import remove_interior
 
     m = trimesh.creation.icosphere(1)
     tiny = (np.asarray(m.vertices, np.float64), np.asarray(m.faces, np.int64))
-    classify(tiny, rays_per_node=1, seed=0)
+    pair = (np.vstack([tiny[0], tiny[0] + [0.5, 0.0, 0.0]]), np.vstack([tiny[1], tiny[1] + len(tiny[0])]))
+    orient(pair, rays_per_node=1, seed=0)
+    remove_interior(pair, rays_per_node=1, seed=0)
     for name, b in BASELINES.items():
         if name != "libigl_peel":
             b.run(tiny, **b.fixed)
