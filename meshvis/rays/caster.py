@@ -38,9 +38,10 @@ from meshvis.rays import _kernels
 DEFAULT_OFFSET = 1e-5
 #: rays per chunk handed to one thread; a batch of two chunks or more is split over the
 #: threads of the kept pool (:func:`meshvis._threads.pool`).  Handing a chunk to the pool
-#: costs tens of microseconds, Embree traces 16 k rays in 2-5 ms: from 32 k rays two
-#: threads pay (``orient`` of the van Gogh room 0.64 -> 0.53 s, docs/performance.md)
-CHUNK = 1 << 14
+#: costs tens of microseconds, Embree traces 2 k rays in 0.3-1 ms: from 4 k rays two
+#: threads pay (the from-region search traces hundreds of batches of 4-32 k rays;
+#: docs/performance.md, "Ray backend")
+CHUNK = 1 << 11
 
 
 def _used_bounds(soup, firsts: np.ndarray) -> np.ndarray:

@@ -5,7 +5,7 @@ import numpy as np
 import pytest
 import trimesh
 
-from meshvis.rays.caster import RayCaster
+from meshvis.rays.caster import CHUNK, RayCaster
 from meshvis.rays.samples import uniform_sphere
 from meshvis.soup import Soup
 
@@ -107,6 +107,10 @@ def test_threads_give_identical_hits():
     assert np.array_equal(a.face, b.face) and np.array_equal(a.side, b.side)
     assert np.array_equal(a.distance, b.distance) and np.array_equal(a.bary, b.bary)
     assert np.array_equal(one.occluded(o, o + d), two.occluded(o, o + d))
+    # the smallest batch that is split: two chunks and a few rays more
+    n = 2 * CHUNK + 7
+    a, b = one.intersect(o[:n], d[:n]), two.intersect(o[:n], d[:n])
+    assert np.array_equal(a.face, b.face) and np.array_equal(a.distance, b.distance)
 
 
 def test_part_ids():
