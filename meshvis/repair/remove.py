@@ -41,6 +41,7 @@ from meshvis.io import as_soup
 from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, LEVELS, VISIBILITY_MODES, cut_rays_per_point
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, visible_from
+from meshvis.visibility.visible import ORIGIN_OFFSET
 
 #: reason of each face, by code
 REASONS = (
@@ -196,7 +197,9 @@ def remove_interior(
             keep = by_cut
             code = np.where(keep, _KEPT_CUT, _GONE_CUT)
         else:
-            vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut)
+            # the search traces the cut's Embree scene, with the search's own ray offset
+            caster = c.caster.with_offset(ORIGIN_OFFSET)
+            vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut, caster=caster)
             keep = by_cut | vis.seen
             code = np.where(by_cut, _KEPT_CUT, np.where(vis.seen, _KEPT_RESCUED, _GONE_BOTH))
     code = code.astype(np.int8)

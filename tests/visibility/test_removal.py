@@ -127,6 +127,30 @@ def test_both_searches_only_around_the_faces_the_cut_calls_hidden(scenes):
     assert whole.keep.all() and whole.visibility.rays["total"] == 0
 
 
+def test_both_searches_the_cuts_scene_as_a_scene_of_its_own(monkeypatch):
+    import meshvis.repair.remove as remove
+    from meshvis.visibility import visible_from
+    from meshvis.visibility.visible import ORIGIN_OFFSET
+
+    used = []
+
+    def spy(*args, **kwargs):
+        used.append(kwargs["caster"])
+        return visible_from(*args, **kwargs)
+
+    monkeypatch.setattr(remove, "visible_from", spy)
+    soup = load(MODELS / "assembly.obj")
+    r = remove_interior(soup, seed=0)
+    # the cut's Embree scene, with the search's own ray offset
+    assert used[0]._scene is r.classification.caster._scene and used[0].offset == ORIGIN_OFFSET
+    by_cut = r.reason_code == REASONS.index("kept: an outside side by the cut")
+    # the search of its own, with a scene and a weld built anew
+    alone = visible_from(r.classification.soup, seed=0, faces=~by_cut)
+    np.testing.assert_array_equal(r.visibility.seen_side, alone.seen_side)
+    np.testing.assert_array_equal(r.visibility.rays_seen, alone.rays_seen)
+    assert r.visibility.rays == alone.rays and r.visibility.rays["total"] > 0
+
+
 def test_both_gives_the_cuts_sample_points_the_budget_of_a_one_face_side(scenes):
     soup, _ = scenes.pierced_box()  # the triangle crosses the box: flagged faces, sample points
     budget = {
