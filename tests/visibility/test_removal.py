@@ -144,7 +144,7 @@ def test_both_searches_the_cuts_scene_as_a_scene_of_its_own(monkeypatch):
     # the cut's Embree scene, with the search's own ray offset
     assert used[0]._scene is r.classification.caster._scene and used[0].offset == ORIGIN_OFFSET
     by_cut = r.reason_code == REASONS.index("kept: an outside side by the cut")
-    # the search of its own, with a scene and a weld built anew
+    # a search of its own, on a scene built anew
     alone = visible_from(r.classification.soup, seed=0, faces=~by_cut)
     np.testing.assert_array_equal(r.visibility.seen_side, alone.seen_side)
     np.testing.assert_array_equal(r.visibility.rays_seen, alone.rays_seen)
