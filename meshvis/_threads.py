@@ -6,6 +6,7 @@ import os
 import threading
 from collections.abc import Callable
 from concurrent.futures import ThreadPoolExecutor
+from typing import Any
 
 import numpy as np
 
@@ -65,39 +66,57 @@ def pool(threads: int) -> ThreadPoolExecutor | None:
         return _POOLS[key]
 
 
-def in_threads(work: Callable[[int, int], object], n: int, rows_per_item: int = 1) -> None:
+def in_threads(
+    work: Callable[[int, int], Any],
+    n: int,
+    rows_per_item: int = 1,
+    *,
+    threads: int | None = None,
+    rows: int = THREAD_ROWS,
+) -> list:
     """Call ``work(start, stop)`` on slices of ``range(n)``, in threads when ``n`` is large.
 
-    For compiled kernels that release the GIL and write each row of their slice into
-    output arrays on their own: the result is the one of ``work(0, n)``.  The threads
-    are :func:`default_threads` (``MESHVIS_THREADS`` or the cores), as for the ray
-    batches; below ``2 * THREAD_ROWS`` rows there is one call.
+    For compiled kernels and Embree calls that release the GIL and handle each row of their
+    slice on their own: the results are those of ``work(0, n)``, cut at the slices.  Below
+    ``2 * rows`` rows there is one call; above, at most :data:`THREAD_PARTS` slices per
+    thread, run in the kept pool (:func:`pool`).
 
     Parameters
     ----------
     work : callable
-        ``work(start, stop)`` handles rows ``start .. stop - 1``; its return value is ignored.
+        ``work(start, stop)`` handles rows ``start .. stop - 1``.
     n : int
         Number of rows (items).
     rows_per_item : int
         Rows each item stands for when the slices are sized (an item that is a face
         casting 32 rays is 32 rows of work).
+    threads : int, optional
+        Threads to use (default :func:`default_threads`: ``MESHVIS_THREADS`` or the cores).
+    rows : int
+        The fewest rows worth a slice of their own.
+
+    Returns
+    -------
+    list
+        What ``work`` returned for each slice, in order (one entry when it ran unsliced).
 
     Examples
     --------
     >>> import numpy as np
     >>> x = np.arange(100_000.0)
     >>> y = np.empty_like(x)
-    >>> in_threads(lambda a, b: np.multiply(x[a:b], 2.0, out=y[a:b]), len(x))
+    >>> _ = in_threads(lambda a, b: np.multiply(x[a:b], 2.0, out=y[a:b]), len(x))
     >>> bool((y == 2 * x).all())
     True
+    >>> parts = in_threads(lambda a, b: x[a:b].sum(), len(x), threads=2)
+    >>> len(parts) > 1, float(sum(parts)) == float(x.sum())
+    (True, True)
     """
-    threads = default_threads()
-    k = min(THREAD_PARTS * threads, n * rows_per_item // THREAD_ROWS, n)
+    threads = default_threads() if threads is None else threads
+    k = min(THREAD_PARTS * threads, n * rows_per_item // rows, n)
     workers = pool(threads) if threads > 1 and k > 1 else None
     if workers is None:
-        work(0, n)
-        return
+        return [work(0, n)]
     # a few slices per thread even out the rows that cost more than others
     bounds = np.linspace(0, n, k + 1).astype(np.int64)
-    list(workers.map(work, bounds[:-1], bounds[1:]))
+    return list(workers.map(work, bounds[:-1], bounds[1:]))

@@ -30,7 +30,7 @@ from typing import Any
 import numpy as np
 
 from meshvis import _validate
-from meshvis._threads import THREAD_PARTS, default_threads, pool
+from meshvis._threads import default_threads, in_threads
 from meshvis.geometry.adjacency import VertexGroups, group_vertices
 from meshvis.io import as_soup
 from meshvis.rays import _kernels
@@ -40,7 +40,7 @@ DEFAULT_OFFSET = 1e-5
 #: rays per chunk handed to one thread; a batch of two chunks or more is split over the
 #: threads of the kept pool (:func:`meshvis._threads.pool`).  Handing a chunk to the pool
 #: costs tens of microseconds, Embree traces 2 k rays in 0.3-1 ms: from 4 k rays two
-#: threads pay (the from-region search traces hundreds of batches of 4-32 k rays;
+#: threads pay (the monastery's from-region search traces 114 batches of 4-32 k rays;
 #: docs/performance.md, "Ray backend")
 CHUNK = 1 << 11
 
@@ -194,24 +194,19 @@ class RayCaster:
                 }
             return np.zeros(0, np.int32)
 
-        def call(sl: slice) -> Any:
-            kw = {} if dists is None else {"dists": np.ascontiguousarray(dists[sl])}
+        def call(a: int, b: int) -> Any:
+            kw = {} if dists is None else {"dists": np.ascontiguousarray(dists[a:b])}
             if query == "INTERSECT":
                 return self._scene.run(
-                    np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), output=1, **kw
+                    np.ascontiguousarray(o32[a:b]), np.ascontiguousarray(d32[a:b]), output=1, **kw
                 )
             return self._scene.run(
-                np.ascontiguousarray(o32[sl]), np.ascontiguousarray(d32[sl]), query=query, **kw
+                np.ascontiguousarray(o32[a:b]), np.ascontiguousarray(d32[a:b]), query=query, **kw
             )
 
-        workers = pool(self.threads) if self.threads > 1 and n >= 2 * CHUNK else None
-        if workers is None:
-            return call(slice(0, n))
-        # a few chunks per thread even out the rays that cost more than others
-        k = min(THREAD_PARTS * self.threads, n // CHUNK)
-        bounds = np.linspace(0, n, k + 1).astype(int)
-        slices = [slice(a, b) for a, b in zip(bounds[:-1], bounds[1:])]
-        parts = list(workers.map(call, slices))
+        parts = in_threads(call, n, threads=self.threads, rows=CHUNK)
+        if len(parts) == 1:
+            return parts[0]
         if query == "INTERSECT":
             return {
                 "primID": np.concatenate([p["primID"] for p in parts]),
