@@ -24,7 +24,9 @@ Rays are cast in rounds, each for the faces the rounds before leave open:
 
 :func:`more_rays` casts further rounds for faces a caller picks: :func:`meshvis.repair.orient`
 gives flagged faces whose rays barely escaped, and those whose sign test leans to the side
-they do not show without passing, more rays before it decides.
+they do not show without passing, more rays before it decides.  :func:`until_decisive`
+casts doubling rounds until a face's few escapes grow to a decision (orient's lone faces,
+whose patch cannot speak for them).
 
 Most faces cost 64 rays.  A face's evidence is *decisive* when at least
 :data:`MIN_ESCAPES` rays escape and one side escapes at least ``dominance`` (default
@@ -53,6 +55,16 @@ LAST_RAYS = 2048
 #: largest of its faces first: an open sheet seen from both sides (a scan) leaves most of
 #: its faces undecided, and 2048 rays for each would cost 30x the rest of ``orient``
 LAST_SHARE = 1.0
+#: :func:`until_decisive` gives its faces this many more rays in its first round, twice
+#: as many in each round after it, up to this many: a face seen through 4.6 % of its back
+#: directions escaped none of 64 back rays in 5 % of the cases (0.954^64), and on the
+#: pandora level 210 lone faces of 0.15 % of the decisive area had kept their side that
+#: way, after fewer than 8 escapes
+RARE_FIRST_RAYS = 192
+RARE_MOST_RAYS = 4096
+#: ... and casts at most this many times the rays of the first round, largest faces first
+#: (on the pandora level its rounds cast 1.1-1.2 times them)
+RARE_SHARE = 2.0
 #: evidence is decisive from this many escaping rays ...
 MIN_ESCAPES = 8
 #: ... when one side escapes at least this many times as often as the other
@@ -255,14 +267,78 @@ def more_rays(
     which : (j,) int, positions in ``faces`` that get more rays
     rays : int, rays per face; share : float, the cap; rng : numpy Generator
     """
-    which = np.asarray(which, np.int64)
-    cap = int(share * 2 * FIRST_RAYS * len(faces)) // rays
-    if len(which) > cap:
-        by_area = np.argsort(-soup.areas[faces[which]], kind="stable")
-        which = np.sort(which[by_area[:cap]])
+    which = _largest(
+        soup, faces, np.asarray(which, np.int64), int(share * 2 * FIRST_RAYS * len(faces)) // rays
+    )
     if len(which):
         escaped[which] += escapes(soup, caster, faces[which], rays, rng)
         cast[which] += rays
+
+
+def until_decisive(
+    soup: Soup,
+    caster: RayCaster,
+    faces: np.ndarray,
+    escaped: np.ndarray,
+    cast: np.ndarray,
+    which: np.ndarray,
+    shown: np.ndarray,
+    rng: np.random.Generator,
+) -> None:
+    """Rounds of more rays for faces whose few escapes leave their side open (in place).
+
+    Every face of ``faces[which]`` gets :data:`RARE_FIRST_RAYS` more rays, and then each
+    round twice as many as the one before (up to :data:`RARE_MOST_RAYS`) while its escapes
+    stay below :data:`MIN_ESCAPES`, some of its rays escaped, and the side it does not
+    show escaped at least as often as the side it shows (where the shown side leads, more
+    rays would mostly confirm it; where none escaped after a round, the face is all but
+    unseen).  The rounds cast at most :data:`RARE_SHARE` times the rays of the first round
+    (``2 * FIRST_RAYS`` per face of ``faces``), on the largest faces first.
+
+    Parameters
+    ----------
+    soup, caster : the model and its RayCaster
+    faces : (k,) int64, the faces tested
+    escaped : (k, 2) int64, escaping rays per face and side so far (updated)
+    cast : (k,) int64, rays cast per face so far (updated)
+    which : (j,) int, positions in ``faces`` that get the rounds
+    shown : (k,) int, the side (0 front, 1 back) each face shows
+    rng : numpy Generator
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> box = trimesh.creation.box()
+    >>> soup = Soup(np.asarray(box.vertices), np.asarray(box.faces))
+    >>> caster = RayCaster(soup)
+    >>> faces = np.arange(soup.n_faces)
+    >>> escaped, cast = np.zeros((12, 2), np.int64), np.zeros(12, np.int64)
+    >>> shown = np.ones(12, np.int64)  # every face shows its back, the side inside the box
+    >>> until_decisive(soup, caster, faces, escaped, cast, [0, 1, 2], shown, np.random.default_rng(0))
+    >>> cast[:4].tolist(), bool((escaped[:3, 0] >= MIN_ESCAPES).all()), int(escaped[:, 1].sum())
+    ([192, 192, 192, 0], True, 0)
+    """
+    which = np.asarray(which, np.int64)
+    shown = np.asarray(shown, np.int64)
+    budget = int(RARE_SHARE * 2 * FIRST_RAYS * len(faces))
+    rays = RARE_FIRST_RAYS
+    while len(which) and rays <= min(RARE_MOST_RAYS, budget):
+        which = _largest(soup, faces, which, budget // rays)
+        escaped[which] += escapes(soup, caster, faces[which], rays, rng)
+        cast[which] += rays
+        budget -= rays * len(which)
+        total = escaped[which].sum(axis=1)
+        other, own = escaped[which, 1 - shown[which]], escaped[which, shown[which]]
+        which = which[(total > 0) & (total < MIN_ESCAPES) & (other >= own)]
+        rays *= 2
+
+
+def _largest(soup: Soup, faces: np.ndarray, which: np.ndarray, cap: int) -> np.ndarray:
+    """The ``cap`` largest faces of ``faces[which]`` (all of them when fewer), as sorted positions."""
+    if len(which) <= cap:
+        return which
+    by_area = np.argsort(-soup.areas[faces[which]], kind="stable")
+    return np.sort(which[by_area[:cap]])
 
 
 def seen_side(
