@@ -86,11 +86,13 @@ CROSSING_LEVEL = 1e-3
 #: speak for keeps its winding; the largest such faces get the last round's rays
 #: (:data:`meshvis.repair.evidence.LAST_RAYS`), at most this many times the rays of the
 #: first round (on the monastery the largest 476 of 42,000 such faces; with seed 2 three
-#: of them, 0.097 % of the decisive area, had taken the wrong side).  Lone faces (a patch
-#: of one face) get the doubling rounds of :func:`meshvis.repair.evidence.until_decisive`
-#: instead: nothing but their own rays speaks for them (on the pandora level, whose lone
-#: faces are seen through a few percent of their directions, the error fell from 0.250 %
-#: to 0.082 % of the decisive area, seed 0; docs/benchmarks.md)
+#: of them, 0.097 % of the decisive area, had taken the wrong side).  Every lone face (a
+#: patch of one face) whose rays barely escaped gets the doubling rounds of
+#: :func:`meshvis.repair.evidence.until_decisive` instead, whatever the cut said of its
+#: sides: nothing but its own rays speaks for it (on the pandora level, whose lone faces
+#: are seen through a few percent of their directions, the error fell from 0.250 % to
+#: 0.071 % of the decisive area as it is and from 0.274 % to 0.089 % as a soup, seed 0;
+#: docs/benchmarks.md)
 UNSEEN_SHARE = 0.25
 #: a flagged face whose sign test leans to the side it does not show (below this level, but
 #: not below :data:`CROSSING_LEVEL`) gets :data:`LEANING_RAYS` more rays before the test
@@ -557,16 +559,15 @@ def _visible_sides(
     shown = outer[test]
     escaped, cast = evidence.seen_counts(c.soup, c.caster, test, shown, rng)
     flagged = c.flagged[test]
-    # faces that only their own rays decide (flagged, or seen from both sides outside a
-    # patch that speaks for them) and whose rays barely escaped get more first
-    unseen = np.flatnonzero((flagged | both) & (escaped.sum(axis=1) < evidence.MIN_ESCAPES))
-    # a lone face (its patch is the face alone) has nothing else to speak for it: its rays
-    # get doubling rounds until they decide it (the others, the largest first, one round)
-    lone = _patch_size(p)[test[unseen]] == 1
-    evidence.more_rays(
-        c.soup, c.caster, test, escaped, cast, unseen[~lone], evidence.LAST_RAYS, UNSEEN_SHARE, rng
-    )
-    evidence.until_decisive(c.soup, c.caster, test, escaped, cast, unseen[lone], shown, rng)
+    # faces whose rays barely escaped get more first: a lone face (its patch is the face
+    # alone), which nothing else speaks for, doubling rounds until its rays decide it;
+    # the other faces that only their own rays decide (flagged, or seen from both sides
+    # outside a patch that speaks for them) one round, the largest first
+    few = escaped.sum(axis=1) < evidence.MIN_ESCAPES
+    lone = _patch_size(p)[test] == 1
+    unseen = np.flatnonzero((flagged | both) & few & ~lone)
+    evidence.more_rays(c.soup, c.caster, test, escaped, cast, unseen, evidence.LAST_RAYS, UNSEEN_SHARE, rng)
+    evidence.until_decisive(c.soup, c.caster, test, escaped, cast, np.flatnonzero(lone & few), shown, rng)
     leaning = (
         flagged
         & (evidence.more_seen(escaped, shown) != shown)

@@ -13,9 +13,14 @@ returns it (right), at the largest decisive face that the left one turns away.
 wound (left: such a face seen from both sides keeps its winding unless 4x evidence turns
 it) and as ``orient`` returns it (right), at the largest decisive face that the left one
 turns away.
+``pandora_rare.png``: the pandora level with its lone faces whose rays barely escaped
+left to the capped round of 2,048 rays (largest first) that flagged and two-sided faces
+share (left: the rule before, where lone one-sided faces got no more rays) and given the
+doubling rounds of ``meshvis.repair.evidence.until_decisive`` (right).
 
     python docs/img/orientation/pictures.py        (writes docs/img/orientation/*.png)
     python docs/img/orientation/pictures.py lone   (only pandora_lone.png)
+    python docs/img/orientation/pictures.py rare   (only pandora_rare.png)
 """
 
 import os
@@ -27,6 +32,7 @@ from meshvis.eval.reference import reference
 from meshvis.io import load
 from meshvis.rays.camera import Camera
 from meshvis.rays.render import render, save_png
+from meshvis.repair import evidence
 from meshvis.repair import orient as O
 
 CACHE = "/tmp/meshvis-refcache"
@@ -94,6 +100,7 @@ def main(root=SHARED):
             )
     crossing(root)
     lone_faces(root)
+    rare_faces(root)
 
 
 def _before_after(root, rel, name, value, labels):
@@ -135,21 +142,103 @@ def lone_faces(root=SHARED):
     soup, ref, before, after = _before_after(
         root, PANDORA, "_consistently_wound", _wound_with_lone_faces, labels
     )
-    # the level from outside, faces the reference judges and the rule turns away from the
-    # side that escapes in red, from the direction of the eight that shows most of them
-    # held to their winding (a close view of one face looks at a wall in front of it)
+    _level_from_outside(ref, before, after, ("held", "free"), "pandora_lone.png")
+
+
+def rare_faces(root=SHARED):
+    """``pandora_rare.png``: lone faces that barely escaped in the shared capped round (left) or in rounds."""
+    labels = ("lone faces in the shared round", "lone faces in rounds")
+    soup = load(os.path.join(root, PANDORA))
+    ref = reference(soup, seed=0, cache=os.path.join(CACHE, "pandora_level.seed0.npz"))
+    after = O.orient(soup, seed=0)
+    # the code before: one round of LAST_RAYS for every such face, lone or not, under one
+    # cap; the non-lone ones are cast with the lone ones, in the order of their positions
+    more, until = evidence.more_rays, evidence.until_decisive
+    held = []
+
+    def non_lone_later(soup_, caster, faces, escaped, cast, which, rays, share, rng):
+        if share == O.UNSEEN_SHARE and not held:
+            held.append(np.asarray(which))
+            return None
+        return more(soup_, caster, faces, escaped, cast, which, rays, share, rng)
+
+    def together(soup_, caster, faces, escaped, cast, which, shown, rng):
+        # of the lone faces, only those that only their own rays decide joined the round
+        which = np.asarray(which, np.int64)
+        own = after.classification.flagged | np.isin(after.status, (O.TWO_SIDED, O.CONFLICT))
+        joint = np.sort(np.concatenate([held.pop(), which[own[faces[which]]]]))
+        more(soup_, caster, faces, escaped, cast, joint, evidence.LAST_RAYS, O.UNSEEN_SHARE, rng)
+
+    try:
+        evidence.more_rays, evidence.until_decisive = non_lone_later, together
+        before = O.orient(soup, classification=after.classification)
+    finally:
+        evidence.more_rays, evidence.until_decisive = more, until
+    total = soup.areas[ref.decisive].sum()
+    for label, r in zip(labels, (before, after)):
+        wrong = ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side)
+        print(f"pandora_level, {label}: {100 * soup.areas[wrong].sum() / total:.4f} % turned away")
+    # the largest face the rounds turn to the side the reference sees, from outside along
+    # a free line of sight to it
+    fixed = ref.decisive & (before.flipped.astype(np.int8) != ref.outside_side)
+    fixed &= after.flipped.astype(np.int8) == ref.outside_side
+    f = int(np.flatnonzero(fixed)[np.argmax(soup.areas[fixed])])
+    cam = _seen_view(soup, f, int(ref.outside_side[f]))
+    panels, counts = [], []
+    for r in (before, after):
+        view = render(r.soup, cam, size=(400, 300))
+        image, hit = view.image.copy(), view.face >= 0
+        turned_away = ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side)
+        mask = np.zeros(hit.shape, bool)
+        mask[hit] = turned_away[view.face[hit]]
+        image[mask] = (215, 25, 40)
+        panels.append(image)
+        counts.append((int(mask.sum()), int((view.side == 1).sum())))
+    gap = np.full((300, 8, 3), 255, np.uint8)
+    save_png(np.concatenate([panels[0], gap, panels[1]], axis=1), os.path.join(HERE, "pandora_rare.png"))
+    print(
+        f"pandora_rare.png: face {f}, reference escapes {ref.escaped[f].tolist()}; (pixels of faces"
+        " turned away, back-side pixels), shared round / rounds:",
+        *counts,
+    )
+
+
+def _seen_view(soup, f, side):
+    """A camera outside along the free line of sight to face ``f``'s ``side`` nearest its normal."""
+    from meshvis.rays.caster import RayCaster
+    from meshvis.rays.samples import uniform_sphere
+
+    normal = soup.normals[f] * (1.0 if side == 0 else -1.0)
+    d = uniform_sphere(1 << 14, np.random.default_rng(0))
+    d = d[d @ normal > 0]
+    centre = soup.triangles[f].mean(axis=0)
+    origin = np.repeat(centre[None], len(d), axis=0)
+    free = (
+        RayCaster(soup).intersect_from_surface(origin, np.full(len(d), f), np.full(len(d), side), d).face < 0
+    )
+    best = d[free][np.argmax(d[free] @ normal)]
+    return Camera(centre + best * 0.2 * soup.diagonal, centre, up=(0.0, 0.0, 1.0), fov=12.0)
+
+
+def _level_from_outside(ref, before, after, names, png):
+    """Save the level from outside, before (left) and after (right), as ``png``.
+
+    Faces the reference judges and a result turns away from the side that escapes are
+    red; the view is the one of eight directions that shows most of them before (a close
+    view of one face looks at a wall in front of it).
+    """
     wrong = {
         label: ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side)
-        for label, r in (("held", before), ("free", after))
+        for label, r in zip(names, (before, after))
     }
     views = [(az, el) for az in (45.0, 135.0, 225.0, 315.0) for el in (30.0, -30.0)]
     red = []
     for az, el in views:
         face = render(before.soup, azimuth=az, elevation=el, size=(200, 150)).face
-        red.append(int(wrong["held"][face[face >= 0]].sum()))
+        red.append(int(wrong[names[0]][face[face >= 0]].sum()))
     az, el = views[int(np.argmax(red))]
     panels, counts = [], []
-    for label, r in (("held", before), ("free", after)):
+    for label, r in zip(names, (before, after)):
         view = render(r.soup, azimuth=az, elevation=el, size=(400, 300))
         image, hit = view.image.copy(), view.face >= 0
         mask = np.zeros(hit.shape, bool)
@@ -158,9 +247,10 @@ def lone_faces(root=SHARED):
         panels.append(image)
         counts.append((int(mask.sum()), int((view.side == 1).sum())))
     gap = np.full((300, 8, 3), 255, np.uint8)
-    save_png(np.concatenate([panels[0], gap, panels[1]], axis=1), os.path.join(HERE, "pandora_lone.png"))
+    save_png(np.concatenate([panels[0], gap, panels[1]], axis=1), os.path.join(HERE, png))
     print(
-        f"pandora lone faces, azimuth {az:g}, elevation {el:g}: (pixels of faces turned away, back-side pixels), held / free:",
+        f"{png}, azimuth {az:g}, elevation {el:g}: (pixels of faces turned away, back-side pixels),",
+        " / ".join(names),
         *counts,
     )
 
@@ -180,5 +270,7 @@ def crossing(root=SHARED):
 if __name__ == "__main__":
     if sys.argv[1:2] == ["lone"]:
         lone_faces(*sys.argv[2:])
+    elif sys.argv[1:2] == ["rare"]:
+        rare_faces(*sys.argv[2:])
     else:
         main(*sys.argv[1:])
