@@ -178,8 +178,9 @@ def region_option(p: argparse.ArgumentParser, default: str | None, what: str) ->
 def removal_options(p: argparse.ArgumentParser) -> None:
     """Add the options of inside removal by sight (shared with ``meshvis batch``).
 
-    The options are ``--visibility``, ``--from``, ``--level`` and ``--keep-border``, with the
-    defaults of ``remove-interior`` in :data:`meshvis.repair.operation.OPERATION_DEFAULTS`.
+    The options are ``--visibility``, ``--from``, ``--budget``, ``--level`` and
+    ``--keep-border``, with the defaults of ``remove-interior`` in
+    :data:`meshvis.repair.operation.OPERATION_DEFAULTS`.
 
     Parameters
     ----------
@@ -195,6 +196,14 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         "or only what both call hidden (default both)",
     )
     region_option(p, d["from_region"], "where viewers are: outside (default)")
+    p.add_argument(
+        "--budget",
+        type=positive_int,
+        metavar="RAYS",
+        help="stop the search for views (view and both) after about this many rays (default: its stop "
+        "rule ends it); fewer rays are faster and delete more visible faces (docs/benchmarks.md, error "
+        "against time of the default removal)",
+    )
     p.add_argument(
         "--level",
         choices=LEVELS,

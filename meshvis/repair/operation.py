@@ -52,6 +52,7 @@ OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
         "from_region": "outside",
         "level": "face",
         "keep_border": 0,
+        "budget": None,  # rays of the from-region search (None: its stop rule ends it)
         "up": "auto",
     },
     "layers": {"max_layers": None},
@@ -263,6 +264,7 @@ def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
         region=o["from_region"],
         level=o["level"],
         keep_border=int(o["keep_border"]),
+        budget=None if o["budget"] is None else int(o["budget"]),
         up=up_axis(o["up"], [soup.path] if soup.path else []),
         seed=int(o["seed"]),
     )

@@ -183,3 +183,19 @@ def test_the_command_gives_both_the_same_sample_point_budget(tmp_path):
     assert budget("--visibility", "object") == 32
     assert budget("--rays-per-point", "16") == 16
     assert budget("--rays-per-node", "64") == 16
+
+
+def test_remove_interior_budget_stops_the_search_for_views(tmp_path):
+    """``--budget`` reaches the search of ``both`` (and of ``meshvis batch``, which shares the
+    option): a small budget ends it on the budget, the default on its stop rule."""
+    src = MODELS / "house.obj"
+    argv = ["remove-interior", str(src), "-o", str(tmp_path / "out.obj"), "-q", "--force"]
+    rep = tmp_path / "r.json"
+    assert main(argv + ["--report", str(rep), "--budget", "3000"]) == 0
+    view = json.loads(rep.read_text())["view"]
+    assert view["stopped"] == "budget" and 3000 <= view["rays"]["total"] < 2 * 3000
+    assert main(argv + ["--report", str(rep)]) == 0
+    assert json.loads(rep.read_text())["view"]["stopped"] != "budget"
+    with pytest.raises(SystemExit) as exit_:
+        main(argv + ["--budget", "0"])
+    assert exit_.value.code == 2
