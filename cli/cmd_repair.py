@@ -176,7 +176,7 @@ def region_option(p: argparse.ArgumentParser, default: str | None, what: str) ->
 
 
 def removal_options(p: argparse.ArgumentParser) -> None:
-    """Add the options of inside removal by sight (shared with ``meshvis batch``).
+    """Add the options of inside removal by sight to the ``remove-interior`` parser.
 
     The options are ``--visibility``, ``--from``, ``--budget``, ``--level`` and
     ``--keep-border``, with the defaults of ``remove-interior`` in

@@ -186,8 +186,8 @@ def test_the_command_gives_both_the_same_sample_point_budget(tmp_path):
 
 
 def test_remove_interior_budget_stops_the_search_for_views(tmp_path):
-    """``--budget`` reaches the search of ``both`` (and of ``meshvis batch``, which shares the
-    option): a small budget ends it on the budget, the default on its stop rule."""
+    """``--budget`` reaches the search of ``both``: a small budget ends it on the budget, the
+    default on its stop rule."""
     src = MODELS / "house.obj"
     argv = ["remove-interior", str(src), "-o", str(tmp_path / "out.obj"), "-q", "--force"]
     rep = tmp_path / "r.json"
