@@ -35,12 +35,10 @@ def _positive_float(text: str) -> float:
     return v
 
 
-def _algorithm_dests() -> list[str]:
-    """``dest`` names of the options added by :func:`meshvis.cli.cmd_repair.algorithm_options`."""
-    from .cmd_repair import algorithm_options
-
+def _dests(add_options) -> list[str]:
+    """``dest`` names of the options that ``add_options(parser)`` adds."""
     p = argparse.ArgumentParser(add_help=False)
-    algorithm_options(p)
+    add_options(p)
     return [a.dest for a in p._actions]
 
 
@@ -49,7 +47,9 @@ def add_parser(sub) -> None:
 
     Its options are the inputs, ``--op``, ``--out``, ``--jobs``, ``--resume``,
     ``--time-limit``, ``--dask-scheduler``, the graph-cut options of
-    :func:`meshvis.cli.cmd_repair.algorithm_options` and ``--quiet``.
+    :func:`meshvis.cli.cmd_repair.algorithm_options`, the inside-removal options of
+    :func:`meshvis.cli.cmd_repair.removal_options` (used with ``--op remove-interior``)
+    and ``--quiet``.
 
     Parameters
     ----------
@@ -58,7 +58,7 @@ def add_parser(sub) -> None:
     """
     from meshvis.batch import OPERATIONS
 
-    from .cmd_repair import algorithm_options
+    from .cmd_repair import algorithm_options, removal_options
 
     p = sub.add_parser(
         "batch",
@@ -99,6 +99,8 @@ def add_parser(sub) -> None:
         help="run the files on this Dask scheduler (e.g. tcp://10.0.0.5:8786) instead of locally",
     )
     algorithm_options(p)
+    removal = p.add_argument_group("with --op remove-interior")
+    removal_options(removal)
     p.add_argument("--quiet", "-q", action="store_true", help="print nothing but errors")
     p.set_defaults(func=run)
 
@@ -243,7 +245,12 @@ def run(args: argparse.Namespace) -> int:
 
     if args.dask_scheduler and args.jobs:
         raise ParameterError("--jobs sets local worker processes; with --dask-scheduler the cluster decides")
-    options = {dest: getattr(args, dest) for dest in _algorithm_dests()}
+    from .cmd_repair import algorithm_options, removal_options
+
+    dests = _dests(algorithm_options)
+    if args.op == "remove-interior":  # orient has a --from of its own meaning
+        dests += _dests(removal_options)
+    options = {dest: getattr(args, dest) for dest in dests}
     _validate.operation_options(options)  # a bad --seed fails here once, not in every file
     tasks = plan(args.inputs, args.op, args.out, options)
     ensure_folder(args.out)

@@ -602,3 +602,21 @@ def test_discard_partial_finds_the_temporary_files_of_long_names(tmp_path, stem_
     discard_partial(task)
     assert not any(p.exists() for p in leftovers)
     assert keep.exists()
+
+
+def test_batch_passes_the_removal_options_to_remove_interior_only(tmp_path, capsys):
+    """``--visibility``, ``--budget`` and the other removal options reach each file's
+    ``remove-interior`` (its report says so); ``--op orient`` runs without them (its own
+    ``--from`` would orient toward a region)."""
+    src = os.path.join(ROOT, "models", "house.obj")
+    out = str(tmp_path / "out")
+    argv = ["batch", src, "--out", out, "--jobs", "1", "-q"]
+    assert main(argv + ["--op", "remove-interior", "--visibility", "both", "--budget", "3000"]) == 0
+    report = json.load(open(os.path.join(out, "house.remove-interior.report.json")))
+    assert report["visibility"] == "both" and report["view"]["stopped"] == "budget"
+    assert main(argv + ["--op", "remove-interior", "--visibility", "object"]) == 0
+    report = json.load(open(os.path.join(out, "house.remove-interior.report.json")))
+    assert report["visibility"] == "object" and "view" not in report
+    assert main(argv + ["--op", "orient"]) == 0, capsys.readouterr().err
+    report = json.load(open(os.path.join(out, "house.orient.report.json")))
+    assert "classification" in report and "view" not in report  # the cut, not orient --from
