@@ -29,7 +29,7 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--budget",
         type=positive_int,
-        help="most rays to trace (default: the stop rule ends the search, capped at 1024 rays per face, "
+        help="stop after about this many rays (default: the stop rule ends the search, capped at 1024 rays per face, "
         "at least 2**22, at most meshvis.limits.MAX_RAYS)",
     )
     p.add_argument("--per-side", action="store_true", help="keep looking until both sides of a face are seen")

@@ -254,7 +254,9 @@ def visible_from(
         ``"outside"``, ``"upper-hemisphere"``, ``"box:x0,y0,z0,x1,y1,z1"``,
         ``"points:x,y,z;..."``, ``"path:FILE.json"``.
     budget : int, optional
-        Most rays to trace.  Default: :func:`default_budget`, a cap that the stop rule
+        Rays to trace before the search stops (its last propagation batch, sized to the
+        rays left, may trace a few more).  Default:
+        :func:`default_budget`, a cap that the stop rule
         (``min_new``) normally ends the search before.
     seed : int
         Seed of the one random generator; same model, region and seed give the same result.
