@@ -63,8 +63,11 @@ LAST_SHARE = 1.0
 RARE_FIRST_RAYS = 192
 RARE_MOST_RAYS = 4096
 #: ... and casts at most this many times the rays of the first round, largest faces first
-#: (on the pandora level its rounds cast 1.1-1.2 times them)
+#: (on the pandora level its rounds cast 1.1-1.2 times them), or at least
+#: :data:`RARE_MIN_BUDGET` rays: a model with a few faces tested would otherwise give a
+#: lone face no round at all
 RARE_SHARE = 2.0
+RARE_MIN_BUDGET = 1 << 16
 #: evidence is decisive from this many escaping rays ...
 MIN_ESCAPES = 8
 #: ... when one side escapes at least this many times as often as the other
@@ -293,7 +296,8 @@ def until_decisive(
     show escaped at least as often as the side it shows (where the shown side leads, more
     rays would mostly confirm it; where none escaped after a round, the face is all but
     unseen).  The rounds cast at most :data:`RARE_SHARE` times the rays of the first round
-    (``2 * FIRST_RAYS`` per face of ``faces``), on the largest faces first.
+    (``2 * FIRST_RAYS`` per face of ``faces``) or :data:`RARE_MIN_BUDGET` rays, whichever is
+    more, on the largest faces first.
 
     Parameters
     ----------
@@ -320,7 +324,7 @@ def until_decisive(
     """
     which = np.asarray(which, np.int64)
     shown = np.asarray(shown, np.int64)
-    budget = int(RARE_SHARE * 2 * FIRST_RAYS * len(faces))
+    budget = max(int(RARE_SHARE * 2 * FIRST_RAYS * len(faces)), RARE_MIN_BUDGET)
     rays = RARE_FIRST_RAYS
     while len(which) and rays <= min(RARE_MOST_RAYS, budget):
         which = _largest(soup, faces, which, budget // rays)
