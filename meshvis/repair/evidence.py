@@ -270,12 +270,8 @@ def more_rays(
     which : (j,) int, positions in ``faces`` that get more rays
     rays : int, rays per face; share : float, the cap; rng : numpy Generator
     """
-    which = _largest(
-        soup, faces, np.asarray(which, np.int64), int(share * 2 * FIRST_RAYS * len(faces)) // rays
-    )
-    if len(which):
-        escaped[which] += escapes(soup, caster, faces[which], rays, rng)
-        cast[which] += rays
+    cap = int(share * 2 * FIRST_RAYS * len(faces)) // rays
+    _cast_largest(soup, caster, faces, escaped, cast, np.asarray(which, np.int64), rays, cap, rng)
 
 
 def until_decisive(
@@ -301,13 +297,9 @@ def until_decisive(
 
     Parameters
     ----------
-    soup, caster : the model and its RayCaster
-    faces : (k,) int64, the faces tested
-    escaped : (k, 2) int64, escaping rays per face and side so far (updated)
-    cast : (k,) int64, rays cast per face so far (updated)
-    which : (j,) int, positions in ``faces`` that get the rounds
+    soup, caster, faces, escaped, cast, which, rng : as :func:`more_rays` (``which``: the
+        positions in ``faces`` that get the rounds)
     shown : (k,) int, the side (0 front, 1 back) each face shows
-    rng : numpy Generator
 
     Examples
     --------
@@ -327,9 +319,7 @@ def until_decisive(
     budget = max(int(RARE_SHARE * 2 * FIRST_RAYS * len(faces)), RARE_MIN_BUDGET)
     rays = RARE_FIRST_RAYS
     while len(which) and rays <= min(RARE_MOST_RAYS, budget):
-        which = _largest(soup, faces, which, budget // rays)
-        escaped[which] += escapes(soup, caster, faces[which], rays, rng)
-        cast[which] += rays
+        which = _cast_largest(soup, caster, faces, escaped, cast, which, rays, budget // rays, rng)
         budget -= rays * len(which)
         total = escaped[which].sum(axis=1)
         other, own = escaped[which, 1 - shown[which]], escaped[which, shown[which]]
@@ -337,12 +327,18 @@ def until_decisive(
         rays *= 2
 
 
-def _largest(soup: Soup, faces: np.ndarray, which: np.ndarray, cap: int) -> np.ndarray:
-    """The ``cap`` largest faces of ``faces[which]`` (all of them when fewer), as sorted positions."""
-    if len(which) <= cap:
-        return which
-    by_area = np.argsort(-soup.areas[faces[which]], kind="stable")
-    return np.sort(which[by_area[:cap]])
+def _cast_largest(soup, caster, faces, escaped, cast, which, rays: int, cap: int, rng) -> np.ndarray:
+    """``rays`` more rays from the ``cap`` largest faces of ``faces[which]`` (all when fewer).
+
+    Adds to ``escaped`` and ``cast`` in place; returns the positions cast from, sorted.
+    """
+    if len(which) > cap:
+        by_area = np.argsort(-soup.areas[faces[which]], kind="stable")
+        which = np.sort(which[by_area[:cap]])
+    if len(which):
+        escaped[which] += escapes(soup, caster, faces[which], rays, rng)
+        cast[which] += rays
+    return which
 
 
 def seen_side(
