@@ -27,19 +27,12 @@ from pathlib import Path
 
 import numpy as np
 
+# the scenes of remove_split.py beside this script, largest first (the last warms up)
+from remove_split import SCENES
+
 import meshvis
 from meshvis.eval.false_pixels import face_pixels, false_pixels
 
-SCENES = (
-    "real/pybullet__samurai_monastry.obj",
-    "real2/so101_arm_assembly.ply",
-    "real2/pandora_level.obj",
-    "real2/dutch_ship.glb",
-    "real2/zdm2_level.glb",
-    "real2/van_gogh_room.glb",
-    "real2/mannequiny.glb",
-    "real2/ferrari348_lowpoly.glb",
-)
 #: the false-pixel targets of the removal (issue 17): mean and worst view, per million
 TARGET_MEAN, TARGET_WORST = 30.0, 300.0
 #: shares of the default search's rays shown in the table
