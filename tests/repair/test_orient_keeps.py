@@ -223,7 +223,7 @@ def test_until_decisive_casts_rounds_until_a_rarely_seen_face_is_decided(shown, 
     from meshvis.rays.caster import RayCaster
 
     soup = _well(0.4)
-    faces = np.arange(soup.n_faces)  # the faces tested: the rounds' cap counts them all
+    faces = np.arange(soup.n_faces)  # the faces tested; the rounds are for the triangle
     escaped, cast = np.zeros((soup.n_faces, 2), np.int64), np.zeros(soup.n_faces, np.int64)
     shown = np.full(soup.n_faces, shown)
     evidence.until_decisive(soup, RayCaster(soup), faces, escaped, cast, [0], shown, np.random.default_rng(1))
