@@ -1,4 +1,4 @@
-"""What several test modules need: the shared real models, the glTF validator, a GLB writer.
+"""What several test modules need: the shared real models, the glTF validator, a GLB writer, a scene.
 
 ``pyproject.toml`` puts this folder on ``sys.path`` (pytest's ``pythonpath``), so a test
 module imports it as ``from helpers import real_model``.  The real models are read from
@@ -14,7 +14,10 @@ import struct
 import subprocess
 from pathlib import Path
 
+import numpy as np
 import pytest
+
+from meshvis.soup import Soup
 
 HERE = Path(__file__).resolve().parent
 #: the shared real models, next to the checkout (never copied into it)
@@ -63,3 +66,22 @@ def write_glb(doc: dict, blob: bytes, path: str) -> None:
         fh.write(struct.pack("<4sII", b"glTF", 2, 28 + len(js) + len(blob)))
         fh.write(struct.pack("<II", len(js), 0x4E4F534A) + js)
         fh.write(struct.pack("<II", len(blob), 0x004E4942) + blob)
+
+
+def two_holes(top: float, bottom: float) -> Soup:
+    """A small triangle (front down) in the middle of a 2 x 2 x 2 box with a square hole of
+    half-side ``top`` in its lid and one of half-side ``bottom`` in its floor: its back
+    sees out through the lid's hole, its front through the floor's."""
+    t, lo, hi = 0.01, -1.0, 1.0
+    tri = [[-t, -t, 0.0], [0.0, t, 0.0], [t, -t, 0.0]]  # clockwise seen from +z: front down
+    box = [[x, y, z] for z in (lo, hi) for y in (lo, hi) for x in (lo, hi)]  # 3..10
+    walls = [[3, 4, 8], [3, 8, 7], [5, 6, 10], [5, 10, 9], [3, 5, 9], [3, 9, 7], [4, 6, 10], [4, 10, 8]]
+    points, faces = tri + box, [[0, 1, 2]] + walls
+    for z, h in ((hi, top), (lo, bottom)):
+        first = len(points)
+        points += [
+            [x, y, z] for x, y in [[lo, lo], [hi, lo], [hi, hi], [lo, hi], [-h, -h], [h, -h], [h, h], [-h, h]]
+        ]
+        ring = [[0, 1, 5], [0, 5, 4], [1, 2, 6], [1, 6, 5], [2, 3, 7], [2, 7, 6], [3, 0, 4], [3, 4, 7]]
+        faces += [[first + a for a in f] for f in ring]
+    return Soup(np.array(points, float), np.array(faces))

@@ -24,7 +24,9 @@
    (:mod:`meshvis.repair.evidence`).  A consistently wound patch first takes, as a whole,
    the side its tested faces see where their rays pooled decide it (the patch vote
    counts only the faces the cut settled on one side); then each face is turned where
-   its own evidence is decisive and shows its other side; a face whose own sides the cut did not settle (two-sided, or flagged
+   its own evidence is decisive and shows its other side (a face whose rays lean to its
+   other side near the 4x line gets more rays until they tell on which side of it the
+   face is); a face whose own sides the cut did not settle (two-sided, or flagged
    with sample points that disagree) is seen from both sides and, where the input does
    not wind its patch consistently or the patch is the face alone, takes the side seen
    more often; a flagged face (it
@@ -529,7 +531,9 @@ def _visible_sides(
     seen from both sides whose rays barely escaped, and flagged faces whose test leans to the
     other side without passing, get more rays first (:data:`UNSEEN_SHARE`; lone faces
     :func:`meshvis.repair.evidence.until_decisive`,
-    :data:`LEANING_LEVEL`).  Faces of closed patches are
+    :data:`LEANING_LEVEL`); and every face that a 4x dominance decides, whose rays lean to
+    its other side near that line, gets rounds until they tell on which side of it the face
+    is (:func:`meshvis.repair.evidence.until_settled`).  Faces of closed patches are
     left to their patch: a closed patch bounds a volume, and a face of it whose back pokes
     out through the surface is a self-intersection, not a face turned the wrong way.
 
@@ -581,6 +585,9 @@ def _visible_sides(
     # then each face leaves its patch only on evidence of its own
     pooled = _pooled_patches(c, p, wound, test, escaped, cast, outer, movable, clear)
     shown = outer[test]
+    # a face whose rays lean toward its other side near the 4x line gets rounds until they settle
+    near = np.flatnonzero(dominance == evidence.DOMINANCE)
+    evidence.until_settled(c.soup, c.caster, test, escaped, cast, near, shown, rng)
     sure = evidence.decisive(escaped, dominance)
     sure |= flagged & evidence.significant(escaped, CROSSING_LEVEL)
     turn = test[sure & (evidence.more_seen(escaped, shown) != shown)]

@@ -63,3 +63,42 @@ def test_confirm_takes_the_side_by_escape_share():
     c = Confirmation(np.array([1]), np.array([[4, 90]]), np.array([[1000, 1000]]))
     decisive, side = c.judged(3)
     assert decisive.tolist() == [False, True, False] and side.tolist() == [0, 1, 0]
+
+
+def test_judged_leaves_out_a_face_whose_counts_do_not_tell_its_side_of_the_line():
+    # 90 : 20 escapes of 1000 rays each is 4.5x, but a face of exactly 4x escapes that way
+    # often (the line's mean is 88 of 110): no verdict either way; 90 : 5 tells
+    c = Confirmation(np.array([0, 1]), np.array([[20, 90], [5, 90]]), np.array([[1000, 1000]] * 2))
+    decisive, side = c.judged(2)
+    assert decisive.tolist() == [False, True] and side.tolist() == [0, 1]
+
+
+@pytest.mark.slow
+def test_confirm_settles_a_face_near_the_line_with_more_rays():
+    """The triangle between two holes (its back sees 6.3x the solid angle its front sees):
+    64 rays leave its side of the 4x line open, so the recount doubles them until the
+    counts tell, and then calls it decisive, back out."""
+    from helpers import two_holes
+
+    from meshvis.repair.evidence import near_the_line
+
+    soup = two_holes(0.4, 0.15)
+    ref = reference(soup, seed=0)
+    assert ref.decisive[0]
+    short = Confirmation(*_first_rays(soup, ref, 64))
+    assert near_the_line(short.escaped[:1], short.cast[:1])[0]  # 64 rays do not tell
+    c = confirm(soup, ref, rays=64)
+    assert c.faces[0] == 0 and c.cast[0].sum() > 64
+    assert not near_the_line(c.escaped[:1], c.cast[:1])[0]
+    decisive, side = c.judged(soup.n_faces)
+    assert decisive[0] and side[0] == 1
+
+
+def _first_rays(soup, ref, rays):
+    """The recount's first round alone (the same generator as :func:`confirm`)."""
+    from meshvis.eval.reference import ORIGIN_OFFSET, _recount
+    from meshvis.rays.caster import RayCaster
+
+    faces = np.flatnonzero(ref.decisive)
+    rng = np.random.default_rng([0, 0xC0F])
+    return (faces, *_recount(soup, RayCaster(soup, offset=ORIGIN_OFFSET), faces, rays, rng, None))

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from helpers import two_holes
 
 from meshvis.io import load
 from meshvis.repair import evidence
@@ -242,3 +243,27 @@ def test_orient_shows_the_side_a_rarely_seen_lone_face_is_seen_from(seed):
     best, and with seeds 2 and 3 a decision on them alone left it facing the floor."""
     r = orient(_well(0.3), seed=seed)
     assert r.flipped[0]
+
+
+def test_until_settled_casts_rounds_until_the_counts_tell_the_side_of_the_line():
+    """The triangle's back sees out through a hole 6.3x the solid angle of its front's
+    (square holes of half-sides 0.4 and 0.15 at distance 1).  After 64 rays its counts
+    lean to the back without telling on which side of 4x it is; it shows its front, so
+    :func:`until_settled` casts rounds until the counts tell, and they then show the back
+    decisively.  A face that shows the side its rays lean to gets no round."""
+    from meshvis.rays.caster import RayCaster
+
+    soup = two_holes(0.4, 0.15)
+    caster = RayCaster(soup)
+    rng = np.random.default_rng(5)
+    faces = np.arange(soup.n_faces)
+    escaped, cast = np.zeros((soup.n_faces, 2), np.int64), np.zeros(soup.n_faces, np.int64)
+    escaped[:1] = evidence.escapes(soup, caster, faces[:1], 64, rng)
+    cast[0] = 64
+    assert evidence.near_the_line(escaped[:1])[0] and escaped[0, 1] > escaped[0, 0]
+    for shown, rounds in ((1, False), (0, True)):
+        e, c = escaped.copy(), cast.copy()
+        evidence.until_settled(soup, caster, faces, e, c, [0], np.full(soup.n_faces, shown), rng)
+        assert (c[0] > 64) == rounds and not c[1:].any()
+    assert not evidence.near_the_line(e[:1])[0]
+    assert evidence.decisive(e[:1])[0] and e[0, 1] > e[0, 0]
