@@ -2,7 +2,7 @@
 
 Usage (from the repository root; references from the cache of the benchmark):
     python docs/bench/orientation/meshvis_only.py STEM[,STEM...]|all ["as is"|soup[,...]]
-        [--seeds 0,1] [--cache /tmp/meshvis-refcache] [--confirm]
+        [--seeds 0,1] [--cache /tmp/meshvis-refcache] [--confirm] [--dump DIR]
 
 ``all``: every model of ``../shared/models/real`` and ``real2`` but so101 (whose
 reference and recount take long).  Prints per model, input and seed the time, the error
@@ -35,6 +35,7 @@ def main() -> None:
     ap.add_argument("--seeds", default="0")
     ap.add_argument("--cache", default="/tmp/meshvis-refcache")
     ap.add_argument("--confirm", action="store_true", help="also judge on the faces a recount confirms")
+    ap.add_argument("--dump", metavar="DIR", help="save the faces each run turns (judge_dumps.py reads them)")
     args = ap.parse_args()
     files = {
         os.path.splitext(f)[0]: os.path.join(d, f)
@@ -59,6 +60,9 @@ def main() -> None:
                 t = time.perf_counter()
                 r = orient(s, seed=seed)
                 sec = time.perf_counter() - t
+                if args.dump:  # turned relative to the file, as judge_dumps.py reads them
+                    stem = f"{name}.{kind.replace(' ', '')}.{seed}.npy"
+                    np.save(os.path.join(args.dump, stem), np.asarray(r.flipped, bool) ^ turned)
                 errors = []
                 for decisive, side in sides:
                     d = judged & decisive

@@ -17,10 +17,15 @@ turns away.
 left to the capped round of 2,048 rays (largest first) that flagged and two-sided faces
 share (left: the rule before, where lone one-sided faces got no more rays) and given the
 doubling rounds of ``meshvis.repair.evidence.until_decisive`` (right).
+``van_gogh_near_line.png``: the van Gogh room with faces near the 4x line decided on their
+first rays (left: ``meshvis.repair.evidence.until_settled`` off) and settled (right), at
+the largest face the rounds turn to the side the settled recount of
+``meshvis.eval.reference.confirm`` finds; red = faces that recount finds turned away.
 
     python docs/img/orientation/pictures.py        (writes docs/img/orientation/*.png)
     python docs/img/orientation/pictures.py lone   (only pandora_lone.png)
     python docs/img/orientation/pictures.py rare   (only pandora_rare.png)
+    python docs/img/orientation/pictures.py near   (only van_gogh_near_line.png)
 """
 
 import os
@@ -44,6 +49,7 @@ MODELS = {
     "ferrari": "real2/ferrari348_lowpoly.glb",
 }
 PANDORA = "real2/pandora_level.obj"
+VAN_GOGH = "real2/van_gogh_room.glb"
 
 
 def two_steps(soup, c):
@@ -101,6 +107,7 @@ def main(root=SHARED):
     crossing(root)
     lone_faces(root)
     rare_faces(root)
+    near_line(root)
 
 
 def _before_after(root, rel, name, value, labels):
@@ -184,23 +191,62 @@ def rare_faces(root=SHARED):
     fixed &= after.flipped.astype(np.int8) == ref.outside_side
     f = int(np.flatnonzero(fixed)[np.argmax(soup.areas[fixed])])
     cam = _seen_view(soup, f, int(ref.outside_side[f]))
-    panels, counts = [], []
-    for r in (before, after):
-        view = render(r.soup, cam, size=(400, 300))
-        image, hit = view.image.copy(), view.face >= 0
-        turned_away = ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side)
-        mask = np.zeros(hit.shape, bool)
-        mask[hit] = turned_away[view.face[hit]]
-        image[mask] = (215, 25, 40)
-        panels.append(image)
-        counts.append((int(mask.sum()), int((view.side == 1).sum())))
-    gap = np.full((300, 8, 3), 255, np.uint8)
-    save_png(np.concatenate([panels[0], gap, panels[1]], axis=1), os.path.join(HERE, "pandora_rare.png"))
+    away = [ref.decisive & (r.flipped.astype(np.int8) != ref.outside_side) for r in (before, after)]
+    counts = _marked((before, after), away, "pandora_rare.png", cam)
     print(
         f"pandora_rare.png: face {f}, reference escapes {ref.escaped[f].tolist()}; (pixels of faces"
         " turned away, back-side pixels), shared round / rounds:",
         *counts,
     )
+
+
+def near_line(root=SHARED):
+    """``van_gogh_near_line.png``: faces near the 4x line decided on their first rays (left) or settled."""
+    from meshvis.eval.reference import confirm
+
+    soup = load(os.path.join(root, VAN_GOGH))
+    ref = reference(soup, seed=0, cache=os.path.join(CACHE, "van_gogh_room.seed0.npz"))
+    decisive, side = confirm(soup, ref, cache=os.path.join(CACHE, "van_gogh_room.confirm2048.npz")).judged(
+        soup.n_faces
+    )
+    after = O.orient(soup, seed=0)
+    settle = evidence.until_settled
+    try:
+        evidence.until_settled = lambda *args: None  # the rule before: no rounds
+        before = O.orient(soup, classification=after.classification)
+    finally:
+        evidence.until_settled = settle
+    total = soup.areas[decisive].sum()
+    away = [decisive & (r.flipped.astype(np.int8) != side) for r in (before, after)]
+    for label, wrong in zip(("first rays", "settled"), away):
+        print(f"van_gogh_room, {label}: {100 * soup.areas[wrong].sum() / total:.4f} % turned away (recount)")
+    fixed = away[0] & ~away[1]
+    f = int(np.flatnonzero(fixed)[np.argmax(soup.areas[fixed])])
+    counts = _marked((before, after), away, "van_gogh_near_line.png", _seen_view(soup, f, int(side[f])))
+    print(
+        f"van_gogh_near_line.png: face {f}; (pixels of faces turned away, back-side pixels),"
+        " first rays / settled:",
+        *counts,
+    )
+
+
+def _marked(results, away, png, camera=None, **view_kw):
+    """Render each result (``camera``, or ``render``'s view keywords) with its faces in ``away`` red.
+
+    Saves them side by side as ``png``; returns (red pixels, back-side pixels) per result.
+    """
+    panels, counts = [], []
+    for r, wrong in zip(results, away):
+        view = render(r.soup, camera, size=(400, 300), **view_kw)
+        image, hit = view.image.copy(), view.face >= 0
+        mask = np.zeros(hit.shape, bool)
+        mask[hit] = wrong[view.face[hit]]
+        image[mask] = (215, 25, 40)
+        panels.append(image)
+        counts.append((int(mask.sum()), int((view.side == 1).sum())))
+    gap = np.full((300, 8, 3), 255, np.uint8)
+    save_png(np.concatenate([panels[0], gap, panels[1]], axis=1), os.path.join(HERE, png))
+    return counts
 
 
 def _seen_view(soup, f, side):
@@ -237,17 +283,7 @@ def _level_from_outside(ref, before, after, names, png):
         face = render(before.soup, azimuth=az, elevation=el, size=(200, 150)).face
         red.append(int(wrong[names[0]][face[face >= 0]].sum()))
     az, el = views[int(np.argmax(red))]
-    panels, counts = [], []
-    for label, r in zip(names, (before, after)):
-        view = render(r.soup, azimuth=az, elevation=el, size=(400, 300))
-        image, hit = view.image.copy(), view.face >= 0
-        mask = np.zeros(hit.shape, bool)
-        mask[hit] = wrong[label][view.face[hit]]
-        image[mask] = (215, 25, 40)
-        panels.append(image)
-        counts.append((int(mask.sum()), int((view.side == 1).sum())))
-    gap = np.full((300, 8, 3), 255, np.uint8)
-    save_png(np.concatenate([panels[0], gap, panels[1]], axis=1), os.path.join(HERE, png))
+    counts = _marked((before, after), [wrong[n] for n in names], png, azimuth=az, elevation=el)
     print(
         f"{png}, azimuth {az:g}, elevation {el:g}: (pixels of faces turned away, back-side pixels),",
         " / ".join(names),
@@ -272,5 +308,7 @@ if __name__ == "__main__":
         lone_faces(*sys.argv[2:])
     elif sys.argv[1:2] == ["rare"]:
         rare_faces(*sys.argv[2:])
+    elif sys.argv[1:2] == ["near"]:
+        near_line(*sys.argv[2:])
     else:
         main(*sys.argv[1:])
