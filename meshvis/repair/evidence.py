@@ -289,6 +289,7 @@ def until_decisive(
     which: np.ndarray,
     shown: np.ndarray,
     rng: np.random.Generator,
+    share: float = RARE_SHARE,
 ) -> None:
     """Rounds of more rays for faces whose few escapes leave their side open (in place).
 
@@ -306,6 +307,7 @@ def until_decisive(
     soup, caster, faces, escaped, cast, which, rng : as :func:`more_rays` (``which``: the
         positions in ``faces`` that get the rounds)
     shown : (k,) int, the side (0 front, 1 back) each face shows
+    share : float, the cap in place of :data:`RARE_SHARE` (the floor stays)
 
     Examples
     --------
@@ -327,7 +329,7 @@ def until_decisive(
         other, own = escaped[rows, 1 - shown[rows]], escaped[rows, shown[rows]]
         return (total > 0) & (total < MIN_ESCAPES) & (other >= own)
 
-    _rounds(soup, caster, faces, escaped, cast, which, keep, RARE_FIRST_RAYS, rng)
+    _rounds(soup, caster, faces, escaped, cast, which, keep, RARE_FIRST_RAYS, rng, share)
 
 
 def until_settled(
@@ -409,10 +411,12 @@ def near_the_line(
     return (n > 0) & (chance >= level)
 
 
-def _rounds(soup, caster, faces, escaped, cast, which, keep, first: int, rng) -> None:
+def _rounds(
+    soup, caster, faces, escaped, cast, which, keep, first: int, rng, share: float = RARE_SHARE
+) -> None:
     """Doubling rounds of rays from ``faces[which]`` while ``keep(rows)`` holds (the budget of :func:`until_decisive`)."""
     which = np.asarray(which, np.int64)
-    budget = max(int(RARE_SHARE * 2 * FIRST_RAYS * len(faces)), RARE_MIN_BUDGET)
+    budget = max(int(share * 2 * FIRST_RAYS * len(faces)), RARE_MIN_BUDGET)
     rays = first
     while len(which) and rays <= min(RARE_MOST_RAYS, budget):
         which = _cast_largest(soup, caster, faces, escaped, cast, which, rays, budget // rays, rng)

@@ -88,7 +88,11 @@ CROSSING_LEVEL = 1e-3
 #: speak for keeps its winding; the largest such faces get the last round's rays
 #: (:data:`meshvis.repair.evidence.LAST_RAYS`), at most this many times the rays of the
 #: first round (on the monastery the largest 476 of 42,000 such faces; with seed 2 three
-#: of them, 0.097 % of the decisive area, had taken the wrong side).  Every lone face (a
+#: of them, 0.097 % of the decisive area, had taken the wrong side); the faces that round
+#: does not reach get the doubling rounds of
+#: :func:`meshvis.repair.evidence.until_decisive` under the same cap (on the van Gogh
+#: room as a soup, with seed 1, two flagged faces of 0.084 % together, seen only through
+#: their fronts, had escaped none of 128 rays and kept their patches' sides).  Every lone face (a
 #: patch of one face) whose rays barely escaped gets the doubling rounds of
 #: :func:`meshvis.repair.evidence.until_decisive` instead, whatever the cut said of its
 #: sides: nothing but its own rays speaks for it (on the pandora level, whose lone faces
@@ -529,7 +533,8 @@ def _visible_sides(
     (:data:`BOTH_SEEN_DOMINANCE`).  A flagged face also turns where the side it does not
     show is seen significantly more often (:data:`CROSSING_LEVEL`); flagged faces and faces
     seen from both sides whose rays barely escaped, and flagged faces whose test leans to the
-    other side without passing, get more rays first (:data:`UNSEEN_SHARE`; lone faces
+    other side without passing, get more rays first (:data:`UNSEEN_SHARE`, then rounds for
+    the faces that round does not reach; lone faces
     :func:`meshvis.repair.evidence.until_decisive`,
     :data:`LEANING_LEVEL`); and every face that a 4x dominance decides, whose rays lean to
     its other side near that line, gets rounds until they tell on which side of it the face
@@ -566,12 +571,16 @@ def _visible_sides(
     # faces whose rays barely escaped get more first: a lone face (its patch is the face
     # alone), which nothing else speaks for, doubling rounds until its rays decide it;
     # the other faces that only their own rays decide (flagged, or seen from both sides
-    # outside a patch that speaks for them) one round, the largest first
+    # outside a patch that speaks for them) one capped round, the largest first, and
+    # those it does not reach doubling rounds under the same cap
     few = escaped.sum(axis=1) < evidence.MIN_ESCAPES
     lone = _patch_size(p)[test] == 1
     unseen = np.flatnonzero((flagged | both) & few & ~lone)
+    cast_before = cast[unseen].copy()
     evidence.more_rays(c.soup, c.caster, test, escaped, cast, unseen, evidence.LAST_RAYS, UNSEEN_SHARE, rng)
     evidence.until_decisive(c.soup, c.caster, test, escaped, cast, np.flatnonzero(lone & few), shown, rng)
+    missed = unseen[cast[unseen] == cast_before]
+    evidence.until_decisive(c.soup, c.caster, test, escaped, cast, missed, shown, rng, UNSEEN_SHARE)
     leaning = (
         flagged
         & (evidence.more_seen(escaped, shown) != shown)
