@@ -169,7 +169,9 @@ def rare_faces(root=SHARED):
             return None
         return more(soup_, caster, faces, escaped, cast, which, rays, share, rng)
 
-    def together(soup_, caster, faces, escaped, cast, which, shown, rng):
+    def together(soup_, caster, faces, escaped, cast, which, shown, rng, share=None):
+        if share is not None:
+            return None  # the rounds for the faces the capped round misses came later
         # of the lone faces, only those that only their own rays decide joined the round
         which = np.asarray(which, np.int64)
         own = after.classification.flagged | np.isin(after.status, (O.TWO_SIDED, O.CONFLICT))
