@@ -261,7 +261,7 @@ def more_rays(
     rays: int,
     share: float,
     rng: np.random.Generator,
-) -> None:
+) -> np.ndarray:
     """Cast ``rays`` more rays from each face ``faces[which]``, adding to ``escaped`` and ``cast`` in place.
 
     At most ``share`` times the rays of the first round (``2 * FIRST_RAYS`` per face of
@@ -275,9 +275,14 @@ def more_rays(
     cast : (k,) int64, rays cast per face so far (updated)
     which : (j,) int, positions in ``faces`` that get more rays
     rays : int, rays per face; share : float, the cap; rng : numpy Generator
+
+    Returns
+    -------
+    (i,) int64, the positions of ``which`` that were cast from (all, or the largest under
+    the cap), sorted
     """
     cap = int(share * 2 * FIRST_RAYS * len(faces)) // rays
-    _cast_largest(soup, caster, faces, escaped, cast, np.asarray(which, np.int64), rays, cap, rng)
+    return _cast_largest(soup, caster, faces, escaped, cast, np.asarray(which, np.int64), rays, cap, rng)
 
 
 def until_decisive(

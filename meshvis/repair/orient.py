@@ -318,10 +318,12 @@ class Patches:
         over every non-degenerate face
     closed : (m,) bool, the face's patch is closed: every edge of every face of it is a
         manifold edge between two faces of the patch
+    size : (m,) int64, faces in the face's patch (0 for a face in none)
     """
 
     clustering: Any
     closed: np.ndarray
+    size: np.ndarray
 
 
 def patches(c: Classification) -> Patches:
@@ -340,7 +342,8 @@ def patches(c: Classification) -> Patches:
     for side in (f[across], g[across]):
         open_patch[patch[side][patch[side] >= 0]] = True
     closed = (patch >= 0) & ~open_patch[np.maximum(patch, 0)]
-    return Patches(cl, closed)
+    size = np.bincount(patch[patch >= 0], minlength=max(cl.n_clusters, 1))
+    return Patches(cl, closed, np.where(patch >= 0, size[np.maximum(patch, 0)], 0))
 
 
 def _closed_body(c: Classification) -> np.ndarray:
@@ -507,15 +510,7 @@ def _consistently_wound(p: Patches) -> np.ndarray:
     np.minimum.at(lo, patch[ok], front[ok])
     np.maximum.at(hi, patch[ok], front[ok])
     at = np.maximum(patch, 0)
-    return ok & (lo[at] == hi[at]) & (_patch_size(p) > 1)
-
-
-def _patch_size(p: Patches) -> np.ndarray:
-    """(m,) int64: faces in each face's patch (0 for a face in none)."""
-    patch = p.clustering.cluster
-    ok = patch >= 0
-    size = np.bincount(patch[ok], minlength=max(p.clustering.n_clusters, 1))
-    return np.where(ok, size[np.maximum(patch, 0)], 0)
+    return ok & (lo[at] == hi[at]) & (p.size > 1)
 
 
 def _visible_sides(
@@ -574,12 +569,13 @@ def _visible_sides(
     # outside a patch that speaks for them) one capped round, the largest first, and
     # those it does not reach doubling rounds under the same cap
     few = escaped.sum(axis=1) < evidence.MIN_ESCAPES
-    lone = _patch_size(p)[test] == 1
+    lone = p.size[test] == 1
     unseen = np.flatnonzero((flagged | both) & few & ~lone)
-    cast_before = cast[unseen].copy()
-    evidence.more_rays(c.soup, c.caster, test, escaped, cast, unseen, evidence.LAST_RAYS, UNSEEN_SHARE, rng)
+    reached = evidence.more_rays(
+        c.soup, c.caster, test, escaped, cast, unseen, evidence.LAST_RAYS, UNSEEN_SHARE, rng
+    )
     evidence.until_decisive(c.soup, c.caster, test, escaped, cast, np.flatnonzero(lone & few), shown, rng)
-    missed = unseen[cast[unseen] == cast_before]
+    missed = np.setdiff1d(unseen, reached)
     evidence.until_decisive(c.soup, c.caster, test, escaped, cast, missed, shown, rng, UNSEEN_SHARE)
     leaning = (
         flagged

@@ -166,7 +166,7 @@ def rare_faces(root=SHARED):
     def non_lone_later(soup_, caster, faces, escaped, cast, which, rays, share, rng):
         if share == O.UNSEEN_SHARE and not held:
             held.append(np.asarray(which))
-            return None
+            return np.zeros(0, np.int64)  # reached none (the later rounds are left out below)
         return more(soup_, caster, faces, escaped, cast, which, rays, share, rng)
 
     def together(soup_, caster, faces, escaped, cast, which, shown, rng, share=None):
