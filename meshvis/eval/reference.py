@@ -308,10 +308,12 @@ def confirm(
     escaped, cast = _recount(soup, caster, faces, rays, rng, progress)
     # a face near the DOMINANCE line gets rounds of as many rays again until its counts tell
     todo = np.flatnonzero(near_the_line(escaped, cast))
-    while len(todo) and 2 * cast[todo[0]].sum() <= SETTLE_RAYS:
-        more = _recount(soup, caster, faces[todo], int(cast[todo[0]].sum()), rng, None)
+    total = rays  # every face still in the rounds has had this many rays
+    while len(todo) and 2 * total <= SETTLE_RAYS:
+        more = _recount(soup, caster, faces[todo], total, rng, None)
         escaped[todo] += more[0]
         cast[todo] += more[1]
+        total *= 2
         todo = todo[near_the_line(escaped[todo], cast[todo])]
     result = Confirmation(faces, escaped, cast)
     if cache is not None:

@@ -16,13 +16,11 @@ import os
 
 import numpy as np
 
-from meshvis.eval.bench.orientation import soup_of
-from meshvis.eval.reference import confirm, reference
-from meshvis.geometry.adjacency import weld
-from meshvis.geometry.duplicates import opposite_copies
-from meshvis.io import load
+# the judging of meshvis_only.py beside this script
+from meshvis_only import errors, judged_faces, judges, model_files
 
-R = ["../shared/models/real", "../shared/models/real2"]
+from meshvis.eval.bench.orientation import soup_of
+from meshvis.io import load
 
 
 def main() -> None:
@@ -32,43 +30,26 @@ def main() -> None:
     ap.add_argument("stems", nargs="?", default="")
     ap.add_argument("--cache", default="/tmp/meshvis-refcache")
     args = ap.parse_args()
-    files = {os.path.splitext(f)[0]: os.path.join(d, f) for d in R for f in os.listdir(d) if f != "README.md"}
+    files = model_files()
     dirs = args.dirs.split(",")
-    stems = (
-        args.stems.split(",")
-        if args.stems
-        else sorted(
-            {os.path.basename(p).split(".")[0] for d in dirs for p in glob.glob(os.path.join(d, "*.npy"))}
-        )
-    )
+    found = {os.path.basename(p).split(".")[0] for d in dirs for p in glob.glob(os.path.join(d, "*.npy"))}
+    stems = args.stems.split(",") if args.stems else sorted(found)
     for name in stems:
         soup = load(files[name])
-        ref = reference(soup, seed=0, cache=os.path.join(args.cache, f"{name}.seed0.npz"))
-        recount = confirm(soup, ref, seed=0, cache=os.path.join(args.cache, f"{name}.confirm2048.npz"))
-        judges = [(ref.decisive, ref.outside_side), recount.judged(soup.n_faces)]
+        ref, sides = judges(name, soup, args.cache, recount=True)
         for kind in ("asis", "soup"):
-            s = soup if kind == "asis" else soup_of(soup, 0)[0]
-            judged = np.ones(soup.n_faces, bool)
-            judged[opposite_copies(weld(s.vertices, s.faces)[1]).ravel()] = False  # pairs: as pairs
+            judged = judged_faces(soup if kind == "asis" else soup_of(soup, 0)[0])
             cells = []
             for d in dirs:
-                errors = []  # per seed: (by the reference, on the confirmed faces), in %
-                for path in sorted(glob.glob(os.path.join(d, f"{name}.{kind}.*.npy"))):
-                    turned = np.load(path)
-                    row = []
-                    for decisive, side in judges:
-                        dd = judged & decisive
-                        wrong = dd & (turned != side.astype(bool))
-                        row.append(100 * ref.area[wrong].sum() / max(ref.area[dd].sum(), 1e-300))
-                    errors.append(row)
-                if errors:
-                    e = np.array(errors)
-                    cells.append(
-                        f"{os.path.basename(d.rstrip('/'))} ({len(e)} seeds): "
-                        + " / ".join(
-                            f"{m:.4f} [{lo:.4f}-{hi:.4f}]" for m, lo, hi in zip(e.mean(0), e.min(0), e.max(0))
-                        )
-                    )
+                paths = sorted(glob.glob(os.path.join(d, f"{name}.{kind}.*.npy")))
+                if not paths:
+                    continue
+                # per seed: (by the reference, on the confirmed faces), in %
+                e = np.array([errors(np.load(path), ref, sides, judged) for path in paths])
+                spread = " / ".join(
+                    f"{m:.4f} [{lo:.4f}-{hi:.4f}]" for m, lo, hi in zip(e.mean(0), e.min(0), e.max(0))
+                )
+                cells.append(f"{os.path.basename(d.rstrip('/'))} ({len(e)} seeds): {spread}")
             if cells:
                 print(f"{name:28} {kind:5} " + "   ".join(cells), flush=True)
 

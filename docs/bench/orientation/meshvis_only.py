@@ -27,6 +27,49 @@ R = ["../shared/models/real", "../shared/models/real2"]
 SKIPPED_BY_ALL = ("so101_arm_assembly",)
 
 
+def model_files() -> dict[str, str]:
+    """Path of every real model by its stem."""
+    return {
+        os.path.splitext(f)[0]: os.path.join(d, f)
+        for d in R
+        for f in sorted(os.listdir(d))
+        if f != "README.md"
+    }
+
+
+def judges(name: str, soup, cache: str, recount: bool) -> tuple:
+    """The reference, and its judges: ``(decisive, outside_side)`` by the reference, then by the recount."""
+    ref = reference(soup, seed=0, cache=os.path.join(cache, f"{name}.seed0.npz"))
+    sides = [(ref.decisive, ref.outside_side)]
+    if recount:
+        sides.append(
+            confirm(soup, ref, seed=0, cache=os.path.join(cache, f"{name}.confirm2048.npz")).judged(
+                soup.n_faces
+            )
+        )
+    return ref, sides
+
+
+def judged_faces(s) -> np.ndarray:
+    """(m,) bool: the faces judged one by one (a double-sided pair of ``s`` is judged as a pair)."""
+    judged = np.ones(s.n_faces, bool)
+    judged[opposite_copies(weld(s.vertices, s.faces)[1]).ravel()] = False
+    return judged
+
+
+def errors(turned: np.ndarray, ref, sides, judged: np.ndarray) -> list[float]:
+    """% of the judged decisive area whose front is not the outside side, per judge.
+
+    ``turned``: (m,) bool, each face turned over relative to the file the reference is of.
+    """
+    out = []
+    for decisive, side in sides:
+        d = judged & decisive
+        wrong = d & (turned != side.astype(bool))
+        out.append(100 * ref.area[wrong].sum() / max(ref.area[d].sum(), 1e-300))
+    return out
+
+
 def main() -> None:
     """Run the models and print one line per input and seed."""
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
@@ -37,40 +80,25 @@ def main() -> None:
     ap.add_argument("--confirm", action="store_true", help="also judge on the faces a recount confirms")
     ap.add_argument("--dump", metavar="DIR", help="save the faces each run turns (judge_dumps.py reads them)")
     args = ap.parse_args()
-    files = {
-        os.path.splitext(f)[0]: os.path.join(d, f)
-        for d in R
-        for f in sorted(os.listdir(d))
-        if f != "README.md"
-    }
+    files = model_files()
     stems = [s for s in files if s not in SKIPPED_BY_ALL] if args.stems == "all" else args.stems.split(",")
     for name in stems:
         soup = load(files[name])
-        ref = reference(soup, seed=0, cache=os.path.join(args.cache, f"{name}.seed0.npz"))
-        sides = [(ref.decisive, ref.outside_side)]
-        if args.confirm:
-            recount = confirm(soup, ref, seed=0, cache=os.path.join(args.cache, f"{name}.confirm2048.npz"))
-            sides.append(recount.judged(soup.n_faces))
+        ref, sides = judges(name, soup, args.cache, args.confirm)
         for kind in args.kinds.split(","):
             s, turned = (soup, np.zeros(soup.n_faces, bool)) if kind == "as is" else soup_of(soup, 0)
-            pairs = opposite_copies(weld(s.vertices, s.faces)[1])
-            judged = np.ones(soup.n_faces, bool)
-            judged[pairs.ravel()] = False  # a double-sided pair is judged as a pair
+            judged = judged_faces(s)
             for seed in (int(x) for x in args.seeds.split(",")):
                 t = time.perf_counter()
                 r = orient(s, seed=seed)
                 sec = time.perf_counter() - t
-                if args.dump:  # turned relative to the file, as judge_dumps.py reads them
-                    stem = f"{name}.{kind.replace(' ', '')}.{seed}.npy"
-                    np.save(os.path.join(args.dump, stem), np.asarray(r.flipped, bool) ^ turned)
-                errors = []
-                for decisive, side in sides:
-                    d = judged & decisive
-                    wrong = d & ((np.asarray(r.flipped, bool) ^ turned) != side.astype(bool))
-                    errors.append(f"{100 * ref.area[wrong].sum() / max(ref.area[d].sum(), 1e-300):.4f}")
+                relative = np.asarray(r.flipped, bool) ^ turned  # turned relative to the file
+                if args.dump:
+                    np.save(os.path.join(args.dump, f"{name}.{kind.replace(' ', '')}.{seed}.npy"), relative)
+                err = " / ".join(f"{e:.4f}" for e in errors(relative, ref, sides, judged))
                 rays = r.visibility["rays"] if r.visibility else 0
                 print(
-                    f"{name:32} {kind:6} seed {seed} {sec:7.2f} s  error {' / '.join(errors)} %"
+                    f"{name:32} {kind:6} seed {seed} {sec:7.2f} s  error {err} %"
                     f"  rays {rays}  turned {int(r.flipped.sum())}",
                     flush=True,
                 )
