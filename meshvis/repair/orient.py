@@ -21,7 +21,7 @@
 4. **visible sides** — the side a viewer sees wins over the patch vote and over layer
    semantics: every face of an *open* patch, except one-sided faces whose cluster's own
    rays already show their side clearly, is tested with rays of its own
-   (:mod:`meshvis.repair.evidence`).  A consistently wound patch first takes, as a whole,
+   (:mod:`meshvis.repair.evidence`).  A patch of several faces first takes, as a whole,
    the side its tested faces see where their rays pooled decide it (the patch vote
    counts only the faces the cut settled on one side); then each face is turned where
    its own evidence is decisive and shows its other side (a face whose rays lean to its
@@ -117,13 +117,15 @@ LEANING_SHARE = 0.5
 #: faces seen only from the front were not tested: 0.40 % of the decisive area the recount
 #: confirms, against 0.15 % with seeds 0 and 2)
 OPENING_NEAR = 0.5
-#: a consistently wound open patch whose faces' own rays, pooled (area times escape
+#: an open patch of several faces whose faces' own rays, pooled (area times escape
 #: share), see one side this many times as much as the other shows that side as a whole
 #: (the per-face dominance of :mod:`meshvis.repair.evidence`).  The patch vote counts
 #: only the faces the cut settled on one side: on cycloidal.ply 142 such faces turned a
 #: 1,118-face patch whose faces' rays escape through its front only; on the van Gogh room
 #: a patch of 248 faces whose rays escape 17 times as often through the front showed
-#: its back
+#: its back; and on the van Gogh room as a soup, with seed 0, a patch of 24 faces that the
+#: cut called hidden, not consistently wound, gave no vote, and its largest face (0.033 %
+#: of the decisive area), which escaped none of its 128 rays, kept its layer's side
 POOLED_DOMINANCE = 4.0
 
 
@@ -141,8 +143,8 @@ class OrientResult:
     parity_faces : int, hidden faces whose side came from ray parity (:func:`parity_side`)
     patch_faces : int, faces turned to agree with the vote of their patch
     visibility : dict, the per-face visibility test: faces ``tested``, faces ``turned``
-        to show the side a viewer sees, ``rays`` cast, ``pooled_patches`` (consistently
-        wound patches given the side their faces' rays see, pooled)
+        to show the side a viewer sees, ``rays`` cast, ``pooled_patches`` (patches
+        given the side their faces' rays see, pooled)
     double_sided : int, faces kept as they are because they are one copy of a sheet stored
         twice with opposite winding (:mod:`meshvis.geometry.duplicates`)
     view : Visibility or None, the from-region visibility of :func:`orient_from` (then
@@ -537,7 +539,7 @@ def _visible_sides(
     left to their patch: a closed patch bounds a volume, and a face of it whose back pokes
     out through the surface is a self-intersection, not a face turned the wrong way.
 
-    Before the faces are tested one by one, a consistently wound patch takes the side its
+    Before the faces are tested one by one, a patch of several faces takes the side its
     tested faces see, pooled, where that is decisive (:func:`_pooled_patches`).
 
     Returns the faces whose side this decided, and the report: faces ``tested``, faces
@@ -588,7 +590,7 @@ def _visible_sides(
     )
     # a consistently wound patch turns as a whole where its faces' rays, pooled, decide it;
     # then each face leaves its patch only on evidence of its own
-    pooled = _pooled_patches(c, p, wound, test, escaped, cast, outer, movable, clear)
+    pooled = _pooled_patches(c, p, test, escaped, cast, outer, movable, clear)
     shown = outer[test]
     # a face whose rays lean toward its other side near the 4x line gets rounds until they settle
     near = np.flatnonzero(dominance == evidence.DOMINANCE)
@@ -610,7 +612,6 @@ def _visible_sides(
 def _pooled_patches(
     c: Classification,
     p: Patches,
-    wound: np.ndarray,
     test: np.ndarray,
     escaped: np.ndarray,
     cast: np.ndarray,
@@ -618,34 +619,45 @@ def _pooled_patches(
     movable: np.ndarray,
     clear: np.ndarray,
 ) -> np.ndarray:
-    """Give every consistently wound patch the side its tested faces see, pooled (in place).
+    """Give every open patch of several faces the side its tested faces see, pooled (in place).
 
     The patch vote of :func:`_whole_patches` counts only the faces the cut settled on one
     side; in a patch seen rarely, or from one side here and the other there, a few of them
-    decide for all.  Each face's own rays (:func:`meshvis.repair.evidence.seen_counts`)
-    estimate how much of its area is seen through each side (its escape share); summed
-    over a patch whose faces all share one front, they are the patch's own evidence, and
-    where it is decisive (:data:`POOLED_DOMINANCE`, at least
+    decide for all, and in a patch the cut calls hidden none does.  Each face's own rays
+    (:func:`meshvis.repair.evidence.seen_counts`) estimate how much of its area is seen
+    through each side (its escape share); summed over the patch, each face's front
+    counting for the side of the patch it lies on (a patch the input does not wind
+    consistently has faces with their fronts on either side), they are the patch's own
+    evidence, and where it is decisive (:data:`POOLED_DOMINANCE`, at least
     :data:`~meshvis.repair.evidence.MIN_ESCAPES` escapes) the patch shows the side it sees
     more, as a whole.  A patch with a face whose cluster's rays already show its side
-    (``clear``) is left to them.  ``wound`` is :func:`_consistently_wound` of ``p``.
+    (``clear``) is left to them.
 
     Returns (m,) bool: the faces of the patches the pooled evidence decided.
     """
     from meshvis.repair.evidence import MIN_ESCAPES
 
-    patch = p.clustering.cluster
+    patch, node = p.clustering.cluster, p.clustering.side_node
     n = max(p.clustering.n_clusters, 1)
-    rows = np.flatnonzero(wound[test])
+    pool = (patch >= 0) & (p.size > 1)
+    rows = np.flatnonzero(pool[test])
     faces = test[rows]
     weight = c.soup.areas[faces] / np.maximum(cast[rows], 1)
-    seen = np.stack([np.bincount(patch[faces], weight * escaped[rows, s], n) for s in (0, 1)], axis=1)
+    # the share seen through each side of the patch: a face's front is one of the patch's
+    # two sides (node), its back the other
+    seen = sum(np.bincount(node[faces, s], weight * escaped[rows, s], p.clustering.n_nodes) for s in (0, 1))
     escapes = np.bincount(patch[faces], escaped[rows].sum(axis=1), n)
-    lo, hi = seen.min(axis=1), seen.max(axis=1)
-    sure = (escapes >= MIN_ESCAPES) & (hi >= POOLED_DOMINANCE * lo)
-    sure[patch[clear & wound]] = False
-    decided = wound & movable & sure[np.maximum(patch, 0)]
-    outer[decided] = (seen[:, 1] > seen[:, 0])[patch[decided]]
+    at = np.flatnonzero(pool)
+    front, back = seen[node[at, 0]], seen[node[at, 1]]
+    sure = (escapes[patch[at]] >= MIN_ESCAPES) & (
+        np.maximum(front, back) >= POOLED_DOMINANCE * np.minimum(front, back)
+    )
+    left = np.zeros(n, bool)
+    left[patch[clear & pool]] = True
+    sure &= ~left[patch[at]] & movable[at]
+    decided = np.zeros(len(outer), bool)
+    decided[at[sure]] = True
+    outer[at[sure]] = (back > front)[sure]
     return decided
 
 
