@@ -645,7 +645,9 @@ def _pooled_patches(
     weight = c.soup.areas[faces] / np.maximum(cast[rows], 1)
     # the share seen through each side of the patch: a face's front is one of the patch's
     # two sides (node), its back the other
-    seen = sum(np.bincount(node[faces, s], weight * escaped[rows, s], p.clustering.n_nodes) for s in (0, 1))
+    nodes = p.clustering.n_nodes
+    seen = np.bincount(node[faces, 0], weight * escaped[rows, 0], nodes)
+    seen += np.bincount(node[faces, 1], weight * escaped[rows, 1], nodes)
     escapes = np.bincount(patch[faces], escaped[rows].sum(axis=1), n)
     at = np.flatnonzero(pool)
     front, back = seen[node[at, 0]], seen[node[at, 1]]
