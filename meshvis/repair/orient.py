@@ -563,7 +563,10 @@ def _visible_sides(
     # does not shift the random numbers of anything else
     rng = np.random.default_rng([seed, 0x5EE9])
     shown = outer[test]
-    escaped, cast = evidence.seen_counts(c.soup, c.caster, test, shown, rng)
+    # the rays start as close to their faces as the reference's: a surface nearer than the
+    # caster's default push would be jumped over
+    caster = c.caster.with_offset(evidence.ORIGIN_OFFSET)
+    escaped, cast = evidence.seen_counts(c.soup, caster, test, shown, rng)
     flagged = c.flagged[test]
     # faces whose rays barely escaped get more first: a lone face (its patch is the face
     # alone), which nothing else speaks for, doubling rounds until its rays decide it;
@@ -574,11 +577,11 @@ def _visible_sides(
     lone = p.size[test] == 1
     unseen = np.flatnonzero((flagged | both) & few & ~lone)
     reached = evidence.more_rays(
-        c.soup, c.caster, test, escaped, cast, unseen, evidence.LAST_RAYS, UNSEEN_SHARE, rng
+        c.soup, caster, test, escaped, cast, unseen, evidence.LAST_RAYS, UNSEEN_SHARE, rng
     )
-    evidence.until_decisive(c.soup, c.caster, test, escaped, cast, np.flatnonzero(lone & few), shown, rng)
+    evidence.until_decisive(c.soup, caster, test, escaped, cast, np.flatnonzero(lone & few), shown, rng)
     missed = np.setdiff1d(unseen, reached)
-    evidence.until_decisive(c.soup, c.caster, test, escaped, cast, missed, shown, rng, UNSEEN_SHARE)
+    evidence.until_decisive(c.soup, caster, test, escaped, cast, missed, shown, rng, UNSEEN_SHARE)
     leaning = (
         flagged
         & (evidence.more_seen(escaped, shown) != shown)
@@ -586,15 +589,15 @@ def _visible_sides(
         & ~evidence.significant(escaped, CROSSING_LEVEL)
     )
     evidence.more_rays(
-        c.soup, c.caster, test, escaped, cast, np.flatnonzero(leaning), LEANING_RAYS, LEANING_SHARE, rng
+        c.soup, caster, test, escaped, cast, np.flatnonzero(leaning), LEANING_RAYS, LEANING_SHARE, rng
     )
-    # a consistently wound patch turns as a whole where its faces' rays, pooled, decide it;
+    # a patch of several faces turns as a whole where its faces' rays, pooled, decide it;
     # then each face leaves its patch only on evidence of its own
     pooled = _pooled_patches(c, p, test, escaped, cast, outer, movable, clear)
     shown = outer[test]
     # a face whose rays lean toward its other side near the 4x line gets rounds until they settle
     near = np.flatnonzero(dominance == evidence.DOMINANCE)
-    evidence.until_settled(c.soup, c.caster, test, escaped, cast, near, shown, rng)
+    evidence.until_settled(c.soup, caster, test, escaped, cast, near, shown, rng)
     sure = evidence.decisive(escaped, dominance)
     sure |= flagged & evidence.significant(escaped, CROSSING_LEVEL)
     turn = test[sure & (evidence.more_seen(escaped, shown) != shown)]
