@@ -44,7 +44,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshvis.io import as_soup, atomic_write
-from meshvis.rays.caster import RayCaster
+from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.rays.samples import uniform_in_triangles, uniform_sphere
 from meshvis.repair.evidence import SETTLE_LEVEL, near_the_line
 from meshvis.soup import Soup
@@ -55,8 +55,6 @@ POINTS_PER_FACE = 8
 DIRECTIONS_PER_POINT = 64
 #: rays per still-unseen face in each refinement round
 REFINE_ROUNDS = (64, 256, 1024, 4096)
-#: push of a ray origin off its surface, as a fraction of the bounding-box diagonal
-ORIGIN_OFFSET = 1e-6
 #: a face decides orientation when at least this many of its first-round rays escape ...
 MIN_ESCAPES = 8
 #: ... and one side escapes at least this many times as often as the other
@@ -168,7 +166,7 @@ def reference(model, *, seed: int = 0, cache: str | os.PathLike | None = None, p
                 return Reference(**{f: data[f] for f in _ARRAYS}, seconds=float(data["seconds"]))
     start = time.perf_counter()
     rng = np.random.default_rng(seed)
-    caster = RayCaster(soup, offset=ORIGIN_OFFSET)
+    caster = RayCaster(soup, offset=VISIBILITY_OFFSET)
     escaped, cast, seen_side, rays = _first_round(soup, caster, rng, progress)
     for per_face in REFINE_ROUNDS:
         todo = np.flatnonzero(~seen_side.any(axis=1) & (soup.areas > 0))
@@ -304,7 +302,7 @@ def confirm(
             if str(data["key"]) == key:
                 return Confirmation(faces, data["escaped"], data["cast"])
     rng = np.random.default_rng([seed, 0xC0F])
-    caster = RayCaster(soup, offset=ORIGIN_OFFSET)
+    caster = RayCaster(soup, offset=VISIBILITY_OFFSET)
     escaped, cast = _recount(soup, caster, faces, rays, rng, progress)
     # a face near the DOMINANCE line gets rounds of as many rays again until its counts tell
     todo = np.flatnonzero(near_the_line(escaped, cast))
@@ -341,7 +339,7 @@ def _key(soup: Soup, seed: int) -> str:
     h = hashlib.sha256()
     h.update(np.ascontiguousarray(soup.vertices, np.float64).tobytes())
     h.update(np.ascontiguousarray(soup.faces, np.int64).tobytes())
-    params = (VERSION, seed, POINTS_PER_FACE, DIRECTIONS_PER_POINT, REFINE_ROUNDS, ORIGIN_OFFSET)
+    params = (VERSION, seed, POINTS_PER_FACE, DIRECTIONS_PER_POINT, REFINE_ROUNDS, VISIBILITY_OFFSET)
     h.update(repr(params).encode())
     return h.hexdigest()
 

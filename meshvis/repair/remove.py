@@ -38,10 +38,10 @@ from meshvis.geometry.adjacency import components, edges, face_adjacency, weld
 from meshvis.geometry.duplicates import hidden_copies, opposite_copies
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.io import as_soup
+from meshvis.rays.caster import VISIBILITY_OFFSET
 from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, LEVELS, VISIBILITY_MODES, cut_rays_per_point
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, visible_from
-from meshvis.visibility.visible import ORIGIN_OFFSET
 
 #: reason of each face, by code
 REASONS = (
@@ -198,7 +198,7 @@ def remove_interior(
             code = np.where(keep, _KEPT_CUT, _GONE_CUT)
         else:
             # the search traces the cut's Embree scene, with the search's own ray offset
-            caster = c.caster.with_offset(ORIGIN_OFFSET)
+            caster = c.caster.with_offset(VISIBILITY_OFFSET)
             vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut, caster=caster)
             keep = by_cut | vis.seen
             code = np.where(by_cut, _KEPT_CUT, np.where(vis.seen, _KEPT_RESCUED, _GONE_BOTH))

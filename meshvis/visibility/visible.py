@@ -29,7 +29,7 @@ from meshvis import limits
 from meshvis.errors import ParameterError
 from meshvis.geometry.adjacency import weld
 from meshvis.io import as_soup
-from meshvis.rays.caster import RayCaster
+from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.visibility.regions import Region, parse_region
 from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling
 
@@ -70,8 +70,6 @@ ROUND_CHUNK_RAYS = 1 << 20
 #: :data:`meshvis.limits.MAX_RAYS`)
 MAX_RAYS_PER_FACE = 1024
 DEFAULT_MIN_BUDGET = 1 << 22
-#: push of seed origins off their face, as a fraction of the diagonal (as the reference)
-ORIGIN_OFFSET = 1e-6
 #: with ``faces=``, sightings are propagated only on the faces asked about and on this many
 #: rings of faces around them (faces sharing a vertex): spreading from every sighting would
 #: search the whole visible model, and without the rings the faces seen only from a viewer
@@ -308,7 +306,7 @@ def visible_from(
     budget = default_budget(int(asked.sum())) if budget is None else int(budget)
     if budget < 0:
         raise ParameterError(f"budget must be at least 0, got {budget}")
-    caster = caster or RayCaster(soup, offset=ORIGIN_OFFSET)
+    caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET)
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new, min_new_area)
     skipped = _presee(state, soup, region)

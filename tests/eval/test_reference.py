@@ -96,9 +96,9 @@ def test_confirm_settles_a_face_near_the_line_with_more_rays():
 
 def _first_rays(soup, ref, rays):
     """The recount's first round alone (the same generator as :func:`confirm`)."""
-    from meshvis.eval.reference import ORIGIN_OFFSET, _recount
-    from meshvis.rays.caster import RayCaster
+    from meshvis.eval.reference import _recount
+    from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 
     faces = np.flatnonzero(ref.decisive)
     rng = np.random.default_rng([0, 0xC0F])
-    return (faces, *_recount(soup, RayCaster(soup, offset=ORIGIN_OFFSET), faces, rays, rng, None))
+    return (faces, *_recount(soup, RayCaster(soup, offset=VISIBILITY_OFFSET), faces, rays, rng, None))

@@ -334,7 +334,7 @@ def test_the_evidence_pushes_its_origins_as_little_as_the_reference():
     diagonals, its rays start above the cover and escape as if it were not there (on the
     pandora level face 7772, whose front the recount sees 36 : 262 less than its back,
     looked seen from both sides about equally); the evidence's push is the reference's."""
-    from meshvis.rays.caster import RayCaster
+    from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 
     diagonal = np.hypot(4.0, 4.0)
     h = 3e-6 * diagonal
@@ -347,7 +347,7 @@ def test_the_evidence_pushes_its_origins_as_little_as_the_reference():
         return int(e[0, 0])
 
     assert front(caster) > 4000
-    assert front(caster.with_offset(evidence.ORIGIN_OFFSET)) == 0
+    assert front(caster.with_offset(VISIBILITY_OFFSET)) == 0
 
 
 def test_until_decisive_goes_on_while_the_counts_do_not_tell_a_side():

@@ -129,8 +129,8 @@ def test_both_searches_only_around_the_faces_the_cut_calls_hidden(scenes):
 
 def test_both_searches_the_cuts_scene_as_a_scene_of_its_own(monkeypatch):
     import meshvis.repair.remove as remove
+    from meshvis.rays.caster import VISIBILITY_OFFSET
     from meshvis.visibility import visible_from
-    from meshvis.visibility.visible import ORIGIN_OFFSET
 
     used = []
 
@@ -142,7 +142,7 @@ def test_both_searches_the_cuts_scene_as_a_scene_of_its_own(monkeypatch):
     soup = load(MODELS / "assembly.obj")
     r = remove_interior(soup, seed=0)
     # the cut's Embree scene, with the search's own ray offset
-    assert used[0]._scene is r.classification.caster._scene and used[0].offset == ORIGIN_OFFSET
+    assert used[0]._scene is r.classification.caster._scene and used[0].offset == VISIBILITY_OFFSET
     by_cut = r.reason_code == REASONS.index("kept: an outside side by the cut")
     # a search of its own, on a scene built anew
     alone = visible_from(r.classification.soup, seed=0, faces=~by_cut)
