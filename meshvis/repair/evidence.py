@@ -87,13 +87,6 @@ DOMINANCE = 4.0
 #: a ray that meets nothing within this many bounding-box diagonals of its origin (on
 #: the model) has left the model
 ESCAPE_REACH = 2.0
-#: push of a ray origin off its face, as a fraction of the bounding-box diagonal: that of
-#: the reference of DESIGN.md §10 (:mod:`meshvis.eval.reference`), a tenth of the caster's
-#: default.  A surface closer to a face than the push is jumped over: on the pandora level
-#: faces 7640 and 7772, with surfaces within about 1e-5 diagonals of their fronts, escaped
-#: 6 % of their front rays pushed by 1e-5, 0.5 % pushed by 1e-6 and 0.02 % by 1e-7, and
-#: kept their fronts, which the recount sees 7-8x less than their backs
-ORIGIN_OFFSET = 1e-6
 #: rays traced per batch (bounded memory)
 BATCH_RAYS = 1 << 20
 
@@ -253,12 +246,12 @@ def seen_counts(
             soup, caster, faces[none], FIRST_RAYS, rng, through=np.full(len(none), through)
         )
     cast[none] += 2 * FIRST_RAYS
-    other, own = escaped[k, 1 - shown], escaped[k, shown]
+    other, own = _other_own(escaped, shown, k)
     again = np.flatnonzero((other > 0) & (other >= own))
     if len(again):
         escaped[again] += escapes(soup, caster, faces[again], MORE_RAYS, rng)
         cast[again] += MORE_RAYS
-    other, own = escaped[k, 1 - shown], escaped[k, shown]
+    other, own = _other_own(escaped, shown, k)
     last = np.flatnonzero((other > 0) & (DOMINANCE * other > own) & ~decisive(escaped))
     more_rays(soup, caster, faces, escaped, cast, last, LAST_RAYS, LAST_SHARE, rng)
     return escaped, cast
@@ -348,7 +341,7 @@ def until_decisive(
 
     def keep(rows: np.ndarray) -> np.ndarray:
         total = escaped[rows].sum(axis=1)
-        other, own = escaped[rows, 1 - shown[rows]], escaped[rows, shown[rows]]
+        other, own = _other_own(escaped, shown, rows)
         untold = (total < MIN_ESCAPES) | ~significant(escaped[rows], SETTLE_LEVEL)
         return (total > 0) & untold & (other >= own)
 
@@ -371,9 +364,9 @@ def until_settled(
     rays (3.7x) and keep its side, and one seen 3x as often can pass 4x.  Every face of
     ``faces[which]`` whose side not shown escaped more often, and whose counts do not yet
     tell on which side of the line it is (:func:`near_the_line` at :data:`SETTLE_LEVEL`,
-    or at :data:`LEAVING_LEVEL` where they pass it), gets :data:`SETTLE_FIRST_RAYS` more rays, then twice as many per round (up to
-    :data:`RARE_MOST_RAYS`) while that still holds, within the budget of
-    :func:`until_decisive`, largest faces first.
+    or at :data:`LEAVING_LEVEL` where they pass it), gets :data:`SETTLE_FIRST_RAYS` more
+    rays, then twice as many per round (up to :data:`RARE_MOST_RAYS`) while that still
+    holds, within the budget of :func:`until_decisive`, largest faces first.
 
     Parameters
     ----------
@@ -382,7 +375,7 @@ def until_settled(
     shown = np.asarray(shown, np.int64)
 
     def keep(rows: np.ndarray) -> np.ndarray:
-        other, own = escaped[rows, 1 - shown[rows]], escaped[rows, shown[rows]]
+        other, own = _other_own(escaped, shown, rows)
         level = np.where(other >= DOMINANCE * own, LEAVING_LEVEL, SETTLE_LEVEL)
         return (other > own) & near_the_line(escaped[rows], level=level)
 
@@ -433,6 +426,11 @@ def near_the_line(
     above = hi * c_lo >= DOMINANCE * lo * c_hi
     chance = np.where(above, bdtrc(hi - 1, n, line), bdtr(hi, n, line))
     return (n > 0) & (chance >= level)
+
+
+def _other_own(escaped: np.ndarray, shown: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Escapes of ``rows`` through the side each does not show, and through the side it shows."""
+    return escaped[rows, 1 - shown[rows]], escaped[rows, shown[rows]]
 
 
 def _rounds(
