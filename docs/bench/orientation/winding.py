@@ -17,18 +17,13 @@ import os
 import numpy as np
 from meshvis_only import model_files
 
-from meshvis.geometry.adjacency import weld
+from meshvis.geometry.adjacency import edges, weld
 from meshvis.io import load
 
 
 def inconsistent_edges(faces: np.ndarray, turned: np.ndarray) -> int:
     """Manifold edges whose two faces, ``turned`` ones reversed, run along them the same way."""
-    f = np.where(turned[:, None], faces[:, ::-1], faces)
-    directed = np.concatenate([f[:, [0, 1]], f[:, [1, 2]], f[:, [2, 0]]])
-    _, at, count = np.unique(np.sort(directed, axis=1), axis=0, return_inverse=True, return_counts=True)
-    manifold = directed[count[at.ravel()] == 2]
-    _, twice = np.unique(manifold, axis=0, return_counts=True)
-    return int((twice == 2).sum())
+    return int((~edges(np.where(turned[:, None], faces[:, ::-1], faces)).consistent).sum())
 
 
 def main() -> None:
