@@ -210,13 +210,7 @@ def rare_faces(root=SHARED):
 
 def near_line(root=SHARED):
     """``van_gogh_near_line.png``: faces near the 4x line decided on their first rays (left) or settled."""
-    from meshvis.eval.reference import confirm
-
     soup = load(os.path.join(root, VAN_GOGH))
-    ref = reference(soup, seed=0, cache=os.path.join(CACHE, "van_gogh_room.seed0.npz"))
-    decisive, side = confirm(soup, ref, cache=os.path.join(CACHE, "van_gogh_room.confirm2048.npz")).judged(
-        soup.n_faces
-    )
     after = O.orient(soup, seed=0)
     settle = evidence.until_settled
     try:
@@ -224,30 +218,16 @@ def near_line(root=SHARED):
         before = O.orient(soup, classification=after.classification)
     finally:
         evidence.until_settled = settle
-    total = soup.areas[decisive].sum()
-    away = [decisive & (r.flipped.astype(np.int8) != side) for r in (before, after)]
-    for label, wrong in zip(("first rays", "settled"), away):
-        print(f"van_gogh_room, {label}: {100 * soup.areas[wrong].sum() / total:.4f} % turned away (recount)")
-    fixed = away[0] & ~away[1]
-    f = int(np.flatnonzero(fixed)[np.argmax(soup.areas[fixed])])
-    counts = _marked((before, after), away, "van_gogh_near_line.png", _seen_view(soup, f, int(side[f])))
-    print(
-        f"van_gogh_near_line.png: face {f}; (pixels of faces turned away, back-side pixels),"
-        " first rays / settled:",
-        *counts,
+    _van_gogh_pair(
+        soup, before, after, np.zeros(soup.n_faces, bool), ("first rays", "settled"), "van_gogh_near_line.png"
     )
 
 
 def pooled(root=SHARED):
     """``van_gogh_soup_pooled.png``: only consistently wound patches pooled (left), or every patch of several faces."""
     from meshvis.eval.bench.orientation import soup_of
-    from meshvis.eval.reference import confirm
 
     soup = load(os.path.join(root, VAN_GOGH))
-    ref = reference(soup, seed=0, cache=os.path.join(CACHE, "van_gogh_room.seed0.npz"))
-    decisive, side = confirm(soup, ref, cache=os.path.join(CACHE, "van_gogh_room.confirm2048.npz")).judged(
-        soup.n_faces
-    )
     s, turned = soup_of(soup, 0)
     after = O.orient(s, seed=0)
     pool = O._pooled_patches
@@ -262,18 +242,32 @@ def pooled(root=SHARED):
         before = O.orient(s, classification=after.classification)
     finally:
         O._pooled_patches = pool
+    labels = ("wound patches pooled", "every patch pooled")
+    _van_gogh_pair(soup, before, after, turned, labels, "van_gogh_soup_pooled.png")
+
+
+def _van_gogh_pair(soup, before, after, turned, labels, png):
+    """Draw ``before`` and ``after`` of the van Gogh room judged by the settled recount, as ``png``.
+
+    ``turned``: (m,) bool, the faces the input turned over relative to the file.  The view
+    is along a free line of sight to the largest face ``after`` turns to the side the
+    recount finds and ``before`` does not; prints both errors and the pixel counts.
+    """
+    from meshvis.eval.reference import confirm
+
+    ref = reference(soup, seed=0, cache=os.path.join(CACHE, "van_gogh_room.seed0.npz"))
+    recount = confirm(soup, ref, cache=os.path.join(CACHE, "van_gogh_room.confirm2048.npz"))
+    decisive, side = recount.judged(soup.n_faces)
     away = [decisive & ((r.flipped ^ turned).astype(np.int8) != side) for r in (before, after)]
     total = soup.areas[decisive].sum()
-    for label, wrong in zip(("wound patches pooled", "every patch pooled"), away):
-        print(
-            f"van_gogh_room soup, {label}: {100 * soup.areas[wrong].sum() / total:.4f} % turned away (recount)"
-        )
+    for label, wrong in zip(labels, away):
+        print(f"van_gogh_room, {label}: {100 * soup.areas[wrong].sum() / total:.4f} % turned away (recount)")
     fixed = away[0] & ~away[1]
     f = int(np.flatnonzero(fixed)[np.argmax(soup.areas[fixed])])
-    counts = _marked((before, after), away, "van_gogh_soup_pooled.png", _seen_view(soup, f, int(side[f])))
+    counts = _marked((before, after), away, png, _seen_view(soup, f, int(side[f])))
     print(
-        f"van_gogh_soup_pooled.png: face {f}; (pixels of faces turned away, back-side pixels),"
-        " wound patches / every patch:",
+        f"{png}: face {f}; (pixels of faces turned away, back-side pixels),",
+        " / ".join(labels) + ":",
         *counts,
     )
 
