@@ -25,12 +25,17 @@ the largest face the rounds turn to the side the settled recount of
 consistently wound patches given the side their faces' rays see, pooled (left: the rule
 before) and every open patch of several faces (right), at the largest face that the
 pooled side turns to the side the settled recount finds; red as above.
+``van_gogh_split.png``: the van Gogh room as it is, oriented by meshvis (left) and by
+MeshLab (right), seen along a free line of sight to the front of face 11036; red = faces
+turned away from the side their consistently wound patch (in the file) shows, by area
+(``docs/bench/orientation/split_patches.py``).
 
     python docs/img/orientation/pictures.py        (writes docs/img/orientation/*.png)
     python docs/img/orientation/pictures.py lone   (only pandora_lone.png)
     python docs/img/orientation/pictures.py rare   (only pandora_rare.png)
     python docs/img/orientation/pictures.py near   (only van_gogh_near_line.png)
     python docs/img/orientation/pictures.py pooled (only van_gogh_soup_pooled.png)
+    python docs/img/orientation/pictures.py split  (only van_gogh_split.png)
 """
 
 import os
@@ -246,6 +251,42 @@ def pooled(root=SHARED):
     _van_gogh_pair(soup, before, after, turned, labels, "van_gogh_soup_pooled.png")
 
 
+def split(root=SHARED):
+    """``van_gogh_split.png``: the faces meshvis (left) and MeshLab (right) turn away from their patch."""
+    import importlib.util
+    from types import SimpleNamespace
+
+    from meshvis.eval.baselines import pymeshlab_reorient
+    from meshvis.geometry.adjacency import weld
+
+    spec = importlib.util.spec_from_file_location(
+        "split_patches", os.path.join(HERE, "..", "..", "bench", "orientation", "split_patches.py")
+    )
+    sys.path.insert(0, os.path.dirname(spec.origin))  # split_patches imports its neighbours
+    sp = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(sp)
+    soup = load(os.path.join(root, VAN_GOGH))
+    patch, _ = sp.wound_patches(weld(soup.vertices, soup.faces)[1])
+    ours = O.orient(soup, seed=0)
+    theirs = pymeshlab_reorient(soup).values.astype(bool)
+    flipped = (np.asarray(ours.flipped, bool), theirs)
+    results = (ours, SimpleNamespace(soup=soup.flipped(theirs)))  # _marked draws r.soup
+    away = [sp.made_whole(f, patch, soup.areas)[1] for f in flipped]
+    near = _seen_view(soup, 11036, 0)
+    # twice as far and a wider angle than the close view: both 134-face patches in sight
+    target = np.asarray(near.target, float)
+    eye = target + 2.0 * (np.asarray(near.position, float) - target)
+    camera = Camera(eye, target, up=(0.0, 0.0, 1.0), fov=30.0)
+    counts = _marked(results, away, "van_gogh_split.png", camera)
+    print(
+        "van_gogh_split.png: faces turned away from their consistently wound patch,",
+        "meshvis / MeshLab:",
+        *(int(a.sum()) for a in away),
+        "; (pixels of them, back-side pixels):",
+        *counts,
+    )
+
+
 def _van_gogh_pair(soup, before, after, turned, labels, png):
     """Draw ``before`` and ``after`` of the van Gogh room judged by the settled recount, as ``png``.
 
@@ -354,5 +395,7 @@ if __name__ == "__main__":
         near_line(*sys.argv[2:])
     elif sys.argv[1:2] == ["pooled"]:
         pooled(*sys.argv[2:])
+    elif sys.argv[1:2] == ["split"]:
+        split(*sys.argv[2:])
     else:
         main(*sys.argv[1:])
