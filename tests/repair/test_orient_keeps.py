@@ -394,3 +394,29 @@ def test_a_hidden_wound_patch_no_face_votes_for_is_turned_as_a_whole():
     split = asked & (sides_per_patch(shows) > 1)
     assert asked.sum() >= 20
     assert not split.any(), f"{int(split.sum())} of {int(asked.sum())} hidden wound patches split"
+
+
+def test_a_wound_surface_crossed_by_a_sliver_is_one_patch():
+    """zdm2 as it is: degenerate slivers (written as they are) cut consistently wound
+    surfaces inside the level into two to six patches, each voted on its own, and 214
+    hidden faces came back showing the side that less of their surface shows.  A sliver's
+    edges still join its neighbours, so the surface is one patch and comes back whole."""
+    from meshvis.geometry.adjacency import collapsed, edges
+    from meshvis.graphcut.clusters import cluster_sides
+
+    r = orient(load(real_model("zdm2_level.glb")), seed=0)
+    c = r.classification
+    cl = cluster_sides(edges(c.pre.faces_welded), ~collapsed(c.pre.faces_welded))
+    patch = cl.cluster
+    ok = (patch >= 0) & ~c.degenerate  # slivers have no side to show
+    fronts = np.unique(np.stack([patch[ok], cl.side_node[ok, 0]], axis=1), axis=0)
+    size = np.bincount(patch[ok], minlength=cl.n_clusters)
+    wound = (np.bincount(fronts[:, 0], minlength=cl.n_clusters) == 1) & (size > 1)
+    # the side each face shows: its front's node, or its back's where it was turned
+    shows = cl.side_node[np.arange(len(patch)), r.flipped.astype(np.int64)]
+    shown_area = np.bincount(shows[ok], c.soup.areas[ok], cl.n_nodes)
+    minority = ok & wound[np.maximum(patch, 0)] & (shown_area[shows] < shown_area[cl.opposite[shows]])
+    hidden = r.status == STATUS_NAMES.index("hidden")
+    assert (hidden & minority).sum() == 0, (
+        f"{int((hidden & minority).sum())} hidden faces apart from their surface"
+    )
