@@ -12,7 +12,8 @@
    by ray parity against their own body where that body is closed, and keep their winding
    where it is open;
 3. **whole patches** — an orientable patch (faces joined by manifold edges after welding,
-   flagged faces and degenerate slivers included; a sliver itself is written as it is)
+   flagged faces and degenerate slivers included; a sliver, which has no side of its
+   own, shows the side its patch shows)
    is turned as a whole or not at all: every face of a patch with
    a clear area vote takes the patch's side.  What is seen from outside votes (one-sided
    faces; flagged faces whose sample points disagree, weighted by the margin); faces that
@@ -353,13 +354,27 @@ def patches(c: Classification) -> Patches:
     return Patches(cl, closed, np.where(patch >= 0, size[np.maximum(patch, 0)], 0))
 
 
+def _patch_shows_back(p: Patches, flip: np.ndarray, areas: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(k,) bool: most of the area of each face's patch shows that face's back.
+
+    ``flip`` says which faces are written turned over; a face shows its back's side node
+    where it is turned, its front's where not.  ``faces`` themselves do not vote (a
+    degenerate face has no area); where nothing else does, False.
+    """
+    node = p.clustering.side_node
+    voters = np.setdiff1d(np.flatnonzero(node[:, 0] >= 0), faces)
+    shown = node[voters, flip[voters].astype(np.int64)]
+    area = np.bincount(shown, areas[voters], p.clustering.n_nodes)
+    return area[node[faces, 1]] > area[node[faces, 0]]
+
+
 def _joining(c: Classification) -> np.ndarray:
     """(m,) bool: the faces that join their neighbours into a patch.
 
     Every face with three distinct welded corners, degenerate slivers included: a sliver
     has no side of its own, but its edges still tell how its neighbours are wound, and
     leaving it out cuts a consistently wound surface into patches voted on their own (on
-    zdm2, 215 hidden faces came back turned apart from the rest of their surface).
+    zdm2, 214 hidden faces came back turned apart from the rest of their surface).
     """
     from meshvis.geometry.adjacency import collapsed
 
@@ -756,9 +771,12 @@ def orient(
     if conflicts == "duplicate":
         dup |= status == CONFLICT
     # degenerate faces, and kept two-sided faces that neither their patch nor a viewer
-    # decided, are written untouched
+    # decided, are written untouched; but a sliver, whose edges join its patch, then
+    # shows the side its patch shows
     untouched = (status == TWO_SIDED) & (two_sided == "keep") & ~voted & ~seen
     flip[untouched | paired | (status == DEGENERATE)] = False
+    sliver = np.flatnonzero((status == DEGENERATE) & (p.clustering.cluster >= 0))
+    flip[sliver] = _patch_shows_back(p, flip, c.soup.areas, sliver)
     extra = np.flatnonzero(dup)
     source = np.concatenate([np.arange(m), extra])
     out = c.soup.subset(source).flipped(np.concatenate([flip, ~flip[extra]]))
