@@ -64,6 +64,7 @@ from meshvis import _validate
 from meshvis.errors import ParameterError
 from meshvis.geometry.duplicates import in_opposite_copy
 from meshvis.graphcut.classify import Classification, classify
+from meshvis.graphcut.clusters import Clustering
 from meshvis.rays.caster import VISIBILITY_OFFSET
 from meshvis.repair.layers import LayerResult, layers
 from meshvis.soup import Soup
@@ -224,26 +225,25 @@ def strongest_side(c: Classification) -> np.ndarray:
     return (c.face_labels_from(w)[:, 1] > c.face_labels_from(w)[:, 0]).astype(np.int8)
 
 
-def surface_vote(c: Classification, outer: np.ndarray, decided: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def surface_vote(
+    c: Classification, outer: np.ndarray, decided: np.ndarray, clustering: Clustering
+) -> tuple[np.ndarray, np.ndarray]:
     """Side that should face front for every face, voted over its orientable surface patch.
 
     Faces joined by manifold edges (after welding; flagged faces and degenerate slivers
     included, :func:`_joining`) form patches
     whose sides split into two consistent sets (the orientation double cover of
     :func:`meshvis.graphcut.clusters.cluster_sides`).  Each decided face votes with its area for the
-    set its outer side belongs to.
+    set its outer side belongs to.  ``clustering`` is those patches' clustering
+    (``patches(c).clustering``).
 
     Returns
     -------
     side : (m,) int8, the side of each face in the winning set (0 where there is no vote)
     decisive : (m,) bool, the face's patch has votes and they are not tied
     """
-    from meshvis.geometry.adjacency import edges
-    from meshvis.graphcut.clusters import cluster_sides
-
-    patches = cluster_sides(edges(c.pre.faces_welded), _joining(c))
-    node = patches.side_node
-    votes = np.zeros(patches.n_nodes)
+    node = clustering.side_node
+    votes = np.zeros(clustering.n_nodes)
     d = np.flatnonzero(decided & (node[:, 0] >= 0))
     np.add.at(votes, node[d, outer[d]], c.soup.areas[d])
     ok = node[:, 0] >= 0
@@ -323,13 +323,13 @@ class Patches:
     Attributes
     ----------
     clustering : the orientation double cover (:func:`meshvis.graphcut.clusters.cluster_sides`)
-        over every non-degenerate face
+        over every face with three distinct welded corners (:func:`_joining`)
     closed : (m,) bool, the face's patch is closed: every edge of every face of it is a
         manifold edge between two faces of the patch
     size : (m,) int64, faces in the face's patch (0 for a face in none)
     """
 
-    clustering: Any
+    clustering: Clustering
     closed: np.ndarray
     size: np.ndarray
 
@@ -420,7 +420,7 @@ def _own_sides(c: Classification, two_sided: str) -> tuple[np.ndarray, np.ndarra
 
 
 def _hidden_sides(
-    c: Classification, status: np.ndarray, outer: np.ndarray, semantics: str
+    c: Classification, p: Patches, status: np.ndarray, outer: np.ndarray, semantics: str
 ) -> tuple[LayerResult | None, np.ndarray, int]:
     """Sides of the hidden faces by layer semantics, patch vote and ray parity (in place).
 
@@ -438,7 +438,7 @@ def _hidden_sides(
     own = side >= 0  # one-sided at its own layer
     own_layer[np.flatnonzero(hidden)[own]] = True
     outer[hidden] = np.maximum(side, 0)
-    vote, decisive = surface_vote(c, outer, (status == ONE_SIDED) | own_layer)
+    vote, decisive = surface_vote(c, outer, (status == ONE_SIDED) | own_layer, p.clustering)
     # a shell faces outward as a whole: where the face's patch has a clear vote it wins
     # over the face's own side (contact faces between touching solids see both ways)
     outer[hidden] = np.where(decisive[hidden], vote[hidden], np.maximum(side, 0))
@@ -751,14 +751,14 @@ def orient(
     c = classification or classify(model, **classify_kw)
     m = c.soup.n_faces
     status, outer = _own_sides(c, two_sided)
-    lay, own_layer, n_parity = _hidden_sides(c, status, outer, semantics)
+    p = patches(c)
+    lay, own_layer, n_parity = _hidden_sides(c, p, status, outer, semantics)
     # kept two-sided faces follow their patch and what a viewer sees; the other options
     # decided them on purpose, and degenerate faces have no side
     movable = (status != DEGENERATE) & ((status != TWO_SIDED) | (two_sided == "keep"))
     # both copies of a sheet stored twice with opposite winding stay as they are
     paired = in_opposite_copy(c.pre.faces_welded)
     movable &= ~paired
-    p = patches(c)
     voted, n_patch = _whole_patches(c, p, status, outer, own_layer, movable)
     seed = int(c.params.get("seed", 0))
     seen, visibility = _visible_sides(c, p, status, outer, movable, seed)

@@ -65,7 +65,7 @@ VAN_GOGH = "real2/van_gogh_room.glb"
 def two_steps(soup, c):
     """The faces that steps 1-2 of ``meshvis.repair.orient`` alone turn over."""
     status, outer = O._own_sides(c, "keep")
-    O._hidden_sides(c, status, outer, "layer")
+    O._hidden_sides(c, O.patches(c), status, outer, "layer")
     flip = outer == 1
     flip[(status == O.TWO_SIDED) | (status == O.DEGENERATE)] = False
     return flip
