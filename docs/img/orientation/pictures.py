@@ -253,18 +253,14 @@ def pooled(root=SHARED):
 
 def split(root=SHARED):
     """``van_gogh_split.png``: the faces meshvis (left) and MeshLab (right) turn away from their patch."""
-    import importlib.util
     from types import SimpleNamespace
 
     from meshvis.eval.baselines import pymeshlab_reorient
     from meshvis.geometry.adjacency import weld
 
-    spec = importlib.util.spec_from_file_location(
-        "split_patches", os.path.join(HERE, "..", "..", "bench", "orientation", "split_patches.py")
-    )
-    sys.path.insert(0, os.path.dirname(spec.origin))  # split_patches imports its neighbours
-    sp = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(sp)
+    sys.path.insert(0, os.path.join(HERE, "..", "..", "bench", "orientation"))
+    import split_patches as sp  # the script of docs/benchmarks.md, "Which faces leave their patch"
+
     soup = load(os.path.join(root, VAN_GOGH))
     patch, _ = sp.wound_patches(weld(soup.vertices, soup.faces)[1])
     ours = O.orient(soup, seed=0)
