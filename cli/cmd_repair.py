@@ -10,7 +10,7 @@ from meshvis.errors import ParameterError
 from meshvis.graphcut.solvers import SOLVERS
 from meshvis.io.report import write_report
 from meshvis.repair.operation import CLASSIFY_DEFAULTS, OPERATION_DEFAULTS
-from meshvis.repair.remove_modes import LEVELS, VISIBILITY_MODES
+from meshvis.repair.remove_modes import LAYER_MODES, LEVELS, TRANSPARENT_MODES, VISIBILITY_MODES
 
 from .common import check_output, point, positive_int, say, staged_outputs
 
@@ -192,17 +192,18 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         "--visibility",
         choices=VISIBILITY_MODES,
         default=d["visibility"],
-        help="remove what the cut calls hidden (object), what no view from --from reaches (view), "
-        "or only what both call hidden (default both)",
+        help=f"remove what no view from --from reaches (view), what the cut calls hidden (object), "
+        f"or only what both call hidden (default {d['visibility']})",
     )
     region_option(p, d["from_region"], "where viewers are: outside (default)")
+    _budget_option(p, "stop the search for views (view and both)")
+    _transparent_option(p, d["transparent"])
     p.add_argument(
-        "--budget",
-        type=positive_int,
-        metavar="RAYS",
-        help="stop the search for views (view and both) after about this many rays (default: its stop "
-        "rule ends it); fewer rays are faster and delete more visible faces (docs/benchmarks.md, error "
-        "against time of the default removal)",
+        "--check-rays",
+        type=int,
+        default=d["check_rays"],
+        metavar="N",
+        help=f"self-check: fresh random rays from every removed face, reported (default {d['check_rays']}; 0: no check)",
     )
     p.add_argument(
         "--level",
@@ -217,6 +218,48 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="keep N rings of hidden faces next to kept ones (default 0)",
     )
+
+
+def _budget_option(p: argparse.ArgumentParser, what: str) -> None:
+    p.add_argument(
+        "--budget",
+        type=positive_int,
+        metavar="RAYS",
+        help=f"{what} after about this many rays (default: its stop rule ends it); fewer rays are faster "
+        "and delete more visible faces (docs/removal.md)",
+    )
+
+
+def _transparent_option(p: argparse.ArgumentParser, default: str) -> None:
+    p.add_argument(
+        "--transparent",
+        choices=TRANSPARENT_MODES,
+        default=default,
+        help="faces of see-through materials (glTF BLEND, MASK below its cutoff, transmission; MTL d < 1, "
+        f"Tr > 0) let sight through, or are walls (default {default})",
+    )
+
+
+def layer_options(p: argparse.ArgumentParser) -> None:
+    """Add the options of ``layers``: ``--max-layers``, ``--visibility``, ``--from``, ``--budget``, ``--transparent``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The parser to add them to.
+    """
+    d = OPERATION_DEFAULTS["layers"]
+    p.add_argument("--max-layers", type=positive_int, help="stop after K layers")
+    p.add_argument(
+        "--visibility",
+        choices=LAYER_MODES,
+        default=d["visibility"],
+        help="peel by sight from --from: layer k is what is seen once layers 1..k-1 are gone (view), or by "
+        f"the graph cut (object) (default {d['visibility']})",
+    )
+    region_option(p, d["from_region"], "where viewers are, for --visibility view: outside (default)")
+    _budget_option(p, "stop each layer's search for views")
+    _transparent_option(p, d["transparent"])
 
 
 def add_parser(sub) -> None:
@@ -270,7 +313,7 @@ def add_parser(sub) -> None:
 
     p = sub.add_parser("layers", help="peel the model into nested layers")
     _common(p)
-    p.add_argument("--max-layers", type=positive_int, help="stop after K layers")
+    layer_options(p)
     p.set_defaults(func=run, op="layers")
 
 

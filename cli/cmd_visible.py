@@ -4,6 +4,8 @@ from __future__ import annotations
 
 import argparse
 
+from meshvis.visibility.walls import DEFAULT_TRANSPARENT, TRANSPARENT_MODES
+
 from .common import check_output, positive_int, say, write_json
 
 
@@ -34,6 +36,12 @@ def add_parser(sub) -> None:
     )
     p.add_argument("--per-side", action="store_true", help="keep looking until both sides of a face are seen")
     p.add_argument(
+        "--transparent",
+        choices=TRANSPARENT_MODES,
+        default=DEFAULT_TRANSPARENT,
+        help=f"faces of see-through materials let sight through, or are walls (default {DEFAULT_TRANSPARENT})",
+    )
+    p.add_argument(
         "--up", choices=("auto", "x", "y", "z"), default="auto", help="up axis of upper-hemisphere"
     )
     p.add_argument("--seed", type=int, default=0)
@@ -58,7 +66,7 @@ def run(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         The parsed options: ``input``, ``from_region``, ``method``, ``budget``, ``per_side``,
-        ``up``, ``seed``, ``report``, ``preview``, ``force``, ``quiet``.
+        ``transparent``, ``up``, ``seed``, ``report``, ``preview``, ``force``, ``quiet``.
 
     Returns
     -------
@@ -92,12 +100,14 @@ def run(args: argparse.Namespace) -> int:
         method=args.method,
         up=up_axis(args.up, [args.input]),
         per_side=args.per_side,
+        transparent=args.transparent,
     )
     r = vis.report(per_face=bool(args.report))
     say(
         args,
         f"{args.input}: {r['seen_faces']} of {r['faces']} faces seen ({100 * r['seen_area_fraction']:.1f} % of the area) "
-        f"from {args.from_region}; {r['rays']['total']} rays, stopped: {r['stopped']}, {vis.seconds:.1f} s",
+        f"from {args.from_region}; {r['rays']['total']} rays, stopped: {r['stopped']}, {vis.seconds:.1f} s"
+        + (f"; {vis.see_through} see-through faces let sight through" if vis.see_through else ""),
     )
     if args.report:
         r["input"] = args.input

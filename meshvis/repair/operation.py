@@ -16,7 +16,13 @@ import numpy as np
 
 from meshvis.errors import ParameterError
 from meshvis.graphcut.solvers import DEFAULT_SOLVER
-from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, cut_rays_per_point
+from meshvis.repair.remove_modes import (
+    CHECK_RAYS,
+    DEFAULT_LAYER_VISIBILITY,
+    DEFAULT_TRANSPARENT,
+    DEFAULT_VISIBILITY,
+    cut_rays_per_point,
+)
 
 #: operations that classify a model and write a result
 OPERATIONS = ("classify", "orient", "remove-interior", "layers")
@@ -54,8 +60,17 @@ OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
         "keep_border": 0,
         "budget": None,  # rays of the from-region search (None: its stop rule ends it)
         "up": "auto",
+        "transparent": DEFAULT_TRANSPARENT,
+        "check_rays": CHECK_RAYS,
     },
-    "layers": {"max_layers": None},
+    "layers": {
+        "max_layers": None,
+        "visibility": DEFAULT_LAYER_VISIBILITY,
+        "from_region": "outside",
+        "budget": None,  # rays of each layer's search (None: its stop rule ends it)
+        "up": "auto",
+        "transparent": DEFAULT_TRANSPARENT,
+    },
 }
 #: where results go (None: not written)
 OUTPUT_KEYS = ("output", "report", "preview", "removed", "graphml")
@@ -172,10 +187,10 @@ def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     if wrote_removed:
         _save(r.removed, o["removed"], tell)
     report = r.report()
-    tell(
-        f"kept {report['kept_faces']}, removed {report['removed_faces']} of {report['input_faces']} faces; "
-        f"wrote {o['output']}" + (f" and {o['removed']}" if wrote_removed else "")
-    )
+    lines = r.summary()
+    lines[0] += f"; wrote {o['output']}" + (f" and {o['removed']}" if wrote_removed else "")
+    for line in lines:
+        tell(line)
     if o["removed"] and not wrote_removed:  # an empty model is no model: say so, write nothing
         tell(f"nothing was removed: {o['removed']} not written")
     if o["preview"]:
@@ -215,7 +230,7 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     from meshvis.rays.render import render_layers, save_png
     from meshvis.repair.layers import layers
 
-    r = layers(soup, classification=c, max_layers=o["max_layers"])
+    r = layers(soup, classification=c, **layer_kwargs(o, soup))
     n = int(r.layer.max())
     names = [f"layer{k}" for k in range(1, n + 1)]
     groups = dict(face_groups=r.layer - 1, group_names=names, face_values={"layer": r.layer})
@@ -228,7 +243,11 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
             _save(soup.subset(r.layer == k), path, tell)
             wrote.append(path)
         report["layer_files"] = wrote[1:]
-    tell(f"{r.n_layers} layers, faces per layer {report['faces_per_layer']}; wrote {', '.join(wrote)}")
+    clear = f", {r.see_through} see-through faces let sight through" if r.see_through else ""
+    tell(
+        f"{r.n_layers} layers (visibility {r.mode}{clear}), faces per layer {report['faces_per_layer']} "
+        f"(the last: {'never seen' if r.mode == 'view' else 'unreached'}); wrote {', '.join(wrote)}"
+    )
     if o["preview"]:
         save_png(render_layers(soup, r.layer, up=up), o["preview"])
     return report
@@ -267,7 +286,26 @@ def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
         budget=None if o["budget"] is None else int(o["budget"]),
         up=up_axis(o["up"], [soup.path] if soup.path else []),
         seed=int(o["seed"]),
+        transparent=o["transparent"],
+        check_rays=int(o["check_rays"]),
     )
+
+
+def layer_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
+    """Keyword arguments of :func:`meshvis.layers` from operation options (the cut's are separate)."""
+    from meshvis.rays.camera import up_axis
+
+    o = {**default_options("layers"), **_options(options)}
+    kw: dict[str, Any] = dict(max_layers=o["max_layers"], visibility=o["visibility"])
+    if o["visibility"] == "view":
+        kw.update(
+            region=o["from_region"],
+            budget=None if o["budget"] is None else int(o["budget"]),
+            up=up_axis(o["up"], [soup.path] if soup.path else []),
+            seed=int(o["seed"]),
+            transparent=o["transparent"],
+        )
+    return kw
 
 
 def run_operation(
@@ -310,8 +348,10 @@ def run_operation(
     tell = say or (lambda text: None)
     up = up_axis(o.get("up") or "auto", [soup.path] if soup.path else [])  # of the preview
     c = None
-    by_sight = (op == "remove-interior" and o["visibility"] == "view") or (
-        op == "orient" and o["from_region"]
+    by_sight = (
+        (op == "remove-interior" and o["visibility"] == "view")
+        or (op == "layers" and o["visibility"] == "view")
+        or (op == "orient" and o["from_region"])
     )
     if not by_sight:  # sight alone needs no cut
         kw = classify_kwargs(o)

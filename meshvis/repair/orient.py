@@ -432,7 +432,7 @@ def _hidden_sides(
     own_layer = np.zeros(m, bool)
     if not hidden.any():
         return None, own_layer, 0
-    lay = layers(c.soup, classification=c)
+    lay = layers(c.soup, classification=c, visibility="object")
     side = lay.outer_side[hidden]
     side = np.where(side == 2, -1, side)
     own = side >= 0  # one-sided at its own layer

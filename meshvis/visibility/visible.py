@@ -32,6 +32,7 @@ from meshvis.io import as_soup
 from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.visibility.regions import Region, parse_region
 from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling
+from meshvis.visibility.walls import DEFAULT_TRANSPARENT, walls
 
 #: seed rays per unseen face in successive rounds
 SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
@@ -112,6 +113,8 @@ class Visibility:
     seconds : float
     stopped : str
         Why sampling stopped: ``"all seen"``, ``"few new faces"``, ``"budget"``, ``"rounds done"``.
+    see_through : int
+        Faces that sight passed through (see-through materials, :mod:`meshvis.visibility.walls`).
     """
 
     seen_side: np.ndarray
@@ -127,6 +130,7 @@ class Visibility:
     seed: int
     seconds: float
     stopped: str = ""
+    see_through: int = 0
     extra: dict = field(default_factory=dict)
 
     @property
@@ -152,6 +156,7 @@ class Visibility:
             "rays": self.rays,
             "skipped": self.skipped,
             "stopped": self.stopped,
+            "see_through_faces": self.see_through,
             "seconds": self.seconds,
             "history": self.history,
         }
@@ -241,6 +246,7 @@ def visible_from(
     min_new: float = MIN_NEW_PER_MILLION,
     min_new_area: float = MIN_NEW_AREA_PER_MILLION,
     caster: RayCaster | None = None,
+    transparent: str = DEFAULT_TRANSPARENT,
 ) -> Visibility:
     """Which sides of the model's faces a viewer in ``region`` can see.
 
@@ -275,7 +281,10 @@ def visible_from(
         ... or less new seen area than this fraction of the model's area per million rays
         (0 for either: that rule never stops the search).
     caster : RayCaster, optional
-        A caster of the same model to reuse (its offset is not changed).
+        A caster of the same model to reuse (its offset and its walls are not changed).
+    transparent : {"see-through", "opaque"}
+        Whether faces of see-through materials let sight pass (:mod:`meshvis.visibility.walls`;
+        without ``caster``).
 
     Returns
     -------
@@ -306,7 +315,7 @@ def visible_from(
     budget = default_budget(int(asked.sum())) if budget is None else int(budget)
     if budget < 0:
         raise ParameterError(f"budget must be at least 0, got {budget}")
-    caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET)
+    caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET, walls=walls(soup, transparent))
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new, min_new_area)
     skipped = _presee(state, soup, region)
@@ -340,6 +349,7 @@ def visible_from(
         seed=int(seed),
         seconds=time.perf_counter() - state.start,
         stopped=stopped,
+        see_through=0 if caster.walls is None else int((~caster.walls).sum()),
     )
 
 
