@@ -31,7 +31,7 @@ from meshvis.geometry.adjacency import weld
 from meshvis.io import as_soup
 from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.visibility.regions import Region, parse_region
-from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling
+from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling, view_lines
 from meshvis.visibility.walls import DEFAULT_TRANSPARENT, walls
 
 #: seed rays per unseen face in successive rounds
@@ -80,6 +80,21 @@ DEFAULT_MIN_BUDGET = 1 << 22
 PROPAGATE_RINGS = 3
 #: sightings propagated in one batch (bounded memory: ~100 rays each)
 PROPAGATE_BATCH = 1 << 15
+#: view lines cast per seed ray of the rounds after the first (interleaved with the seeds)
+LINES_PER_SEED_RAY = 0.5
+#: view lines traced per batch (bounded memory)
+LINE_BATCH = 1 << 18
+#: the lines' stop rule is judged over windows of this many lines that hit the model, or on
+#: small models this many per face, whichever is fewer ...
+LINE_WINDOW = 1 << 20
+LINE_WINDOW_PER_FACE = 64
+#: ... and holds when fewer than this many of those lines per million first hit a face not seen
+#: yet (an estimate of the false pixels per million of removing the unseen faces)
+MAX_UNSEEN_PER_MILLION = 10.0
+#: seed rays after the first round and view lines: this share of them looks along a coordinate
+#: plane (:func:`meshvis.visibility.regions.view_directions`); on the cycloidal drive, faces in
+#: thin horizontal slots are seen by 3e-5 of uniform seed rays and by 6e-4 of plane ones
+PLANE_SHARE = 0.25
 METHODS = ("guided", "random")
 
 
@@ -183,7 +198,8 @@ class _State:
         self.rays_seen = np.zeros((m, 2), np.int64)
         self.seed_rays = np.zeros(m, np.int64)
         self.first_seen = np.full(m, -1, np.int64)
-        self.rays = {"random": 0, "border": 0, "reverse": 0}
+        self.rays = {"random": 0, "lines": 0, "border": 0, "reverse": 0}
+        self.round = 0  # the round of seed rays under way
         self.refused = 0
         self.budget = budget
         self.history: dict[str, list] = {"rays": [], "visible_area": [], "faces_seen": [], "seconds": []}
@@ -398,9 +414,11 @@ def _presee(state: _State, soup, region: Region) -> dict:
 
 
 def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool, asked: np.ndarray) -> str:
+    """The rounds of seed rays and, from the second round on, the view lines (module notes)."""
     m = len(state.area)
     usable = (state.area > 0) & asked
     window = min(STOP_WINDOW, STOP_WINDOW_PER_FACE * max(int(usable.sum()), 1))
+    lines = _Lines(state, caster, region, rng, asked, guided and LINES_PER_SEED_RAY > 0, int(usable.sum()))
 
     def unseen(faces):
         s = state.seen_side[faces]
@@ -412,9 +430,14 @@ def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool
         n = s.sum(axis=1) if per_side else s.any(axis=1)
         return int(n.sum()), float(state.area[asked] @ n)
 
-    mark = (*found(), state.cast)
-    held = ""  # the stop rule held at the end of the last round: confirm on this one's first window
+    def all_seen() -> bool:
+        return not (usable & unseen(np.arange(m))).any()
+
+    seeds = _SeedWindow(state, found)
+    held = ""  # the seeds' rule held: confirm on the first window of the next round
+    stop = ""
     for r, per_face in enumerate(SEED_ROUNDS):
+        state.round = r
         order = _round_order(state, rng, usable & unseen(np.arange(m)), r)
         if len(order) == 0:
             return "all seen"
@@ -428,46 +451,115 @@ def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool
             todo = todo[: max(0, state.left // per_face)]
             if len(todo) == 0:
                 return "budget"
-            _seed_chunk(state, caster, region, rng, np.sort(todo), per_face, guided, per_side)
+            cast = state.cast
+            seeds.run(
+                lambda: _seed_chunk(state, caster, region, rng, np.sort(todo), per_face, guided, per_side)
+            )
+            if r > 0:  # every face has had its first round before the lines start
+                lines.cast(int(LINES_PER_SEED_RAY * (state.cast - cast)))
+                if lines.held:
+                    return "few unseen pixels"
             if state.left <= 0:
                 return "budget"
-            # every face has had its first round before the rule may stop the search
-            if r > 0 and state.cast - mark[2] >= window:
-                stop = _few_new(state, mark, found())
-                mark = (*found(), state.cast)
+            if r > 0 and seeds.rays >= window:
+                stop = seeds.judge()
                 if stop and (held or not CONFIRM_NEXT_ROUND):
-                    return stop
-                held = stop
-                if stop:
-                    break  # leave out the round's smallest faces; confirm on the next round's largest
-        if not (usable & unseen(np.arange(m))).any():
-            return "all seen"
-    return held or "rounds done"
+                    break
+                held, stop = stop, ""
+                if held:
+                    break  # leave out the rest of the round; confirm on the next round's first window
+        if stop or all_seen():
+            break
+    # the seeds are done: the view lines go on until their own rule holds
+    while lines.active and state.left > 0 and not all_seen():
+        lines.cast(LINE_BATCH)
+    if all_seen():
+        return "all seen"
+    if state.left <= 0:
+        return "budget"
+    if lines.held:
+        return "few unseen pixels"
+    return stop or held or "rounds done"
+
+
+class _SeedWindow:
+    """The stop rule of the seed rays: new faces and area per million rays since the last look."""
+
+    def __init__(self, state: _State, found):
+        self.state = state
+        self.found = found
+        self.rays = 0  # seed rays and their propagation since the last look
+        self.mark = found()
+
+    def run(self, step) -> None:
+        """Run one seed chunk (and its propagation), counting its rays."""
+        before = self.state.cast
+        step()
+        self.rays += self.state.cast - before
+
+    def judge(self) -> str:
+        """The stop rule over the rays since the last look (a reason, or ''); start a new window."""
+        now = self.found()
+        per_million = 1e6 / max(self.rays, 1)
+        reason = ""
+        if (now[0] - self.mark[0]) * per_million < self.state.min_new:
+            reason = "few new faces"
+        elif (now[1] - self.mark[1]) * per_million < self.state.min_new_area:
+            reason = "little new area"
+        self.mark, self.rays = now, 0
+        return reason
+
+
+class _Lines:
+    """View lines (GVS §3.1): random lines of sight from the region, their first hits propagated.
+
+    A line whose first hit is a face not seen yet is a false pixel of removing the unseen
+    faces, seen from a random view: the share of such lines among the lines that hit the
+    model estimates the false pixels per million of the removal as it stands (before the
+    line's own sighting is propagated).  The lines stop when that share, over a window of
+    :data:`LINE_WINDOW` model hits, is below :data:`MAX_UNSEEN_PER_MILLION`.
+    """
+
+    def __init__(self, state: _State, caster, region, rng, asked: np.ndarray, active: bool, n_faces: int):
+        self.state, self.caster, self.region, self.rng, self.asked = state, caster, region, rng, asked
+        self.active = active
+        self.window = min(LINE_WINDOW, LINE_WINDOW_PER_FACE * max(n_faces, 1))
+        self.hits = 0  # lines that hit the model in the window
+        self.unseen = 0  # ... whose first hit was a face asked about and not seen yet
+        self.held = False  # the rule held on a window
+
+    def cast(self, n: int) -> None:
+        """Cast up to ``n`` lines (within the budget) and propagate what they find."""
+        n = min(n, self.state.left)
+        if not self.active or n <= 0:
+            return
+        for lo in range(0, n, LINE_BATCH):
+            k = min(LINE_BATCH, n - lo)
+            found, hits = view_lines(self.caster, self.region, k, self.rng, PLANE_SHARE)
+            self.state.rays["lines"] += k
+            self.hits += hits
+            fresh = self.state.record(found)
+            self.unseen += int(self.asked[fresh.face].sum())
+            self.state.snapshot()
+            _propagate(self.state, self.caster, self.region, fresh)
+            if self.hits >= self.window:
+                self.held = self.unseen * 1e6 / self.hits < MAX_UNSEEN_PER_MILLION
+                self.active = not self.held
+                self.hits = self.unseen = 0
+                if not self.active:
+                    return
 
 
 def _round_order(state: _State, rng, todo: np.ndarray, r: int) -> np.ndarray:
-    """The faces still to seed in round ``r``, in the order they get their seeds.
+    """The faces still to seed in round ``r``, in a random order.
 
-    The first round visits them in a random order (propagation from earlier chunks saves
-    later ones their seeds); later rounds go from the largest face to the smallest (ties in
-    a random order): a large face seen through a rare gap hides many pixels, and the stop
-    rule judges the area found, which then falls off along the round.
+    A random order makes every window of the stop rule a fair sample of the round: in an
+    order from large faces to small, the rule judged the first windows by the largest unseen
+    faces, which in CAD assemblies are hidden inner walls, and stopped before the smaller
+    faces seen through gaps had their seeds (docs/removal.md).
     """
     faces = np.flatnonzero(todo)
-    faces = faces[rng.permutation(len(faces))]
-    if r == 0:
-        return faces
-    return faces[np.argsort(-state.area[faces], kind="stable")]
-
-
-def _few_new(state: _State, mark: tuple[int, float, int], now: tuple[int, float]) -> str:
-    """The stop rule over the window since ``mark`` (faces, area, rays): a reason, or ''."""
-    per_million = 1e6 / max(state.cast - mark[2], 1)
-    if (now[0] - mark[0]) * per_million < state.min_new:
-        return "few new faces"
-    if (now[1] - mark[1]) * per_million < state.min_new_area:
-        return "little new area"
-    return ""
+    return faces[rng.permutation(len(faces))]
 
 
 def _seed_chunk(state: _State, caster, region, rng, todo, per_face: int, guided, per_side) -> None:
@@ -476,7 +568,8 @@ def _seed_chunk(state: _State, caster, region, rng, todo, per_face: int, guided,
     # the side still to find: -1 (either) unless exactly one side is seen already
     one = state.seen_side[faces]
     want = np.where(one.any(axis=1), np.argmin(one, axis=1), -1).astype(np.int8) if per_side else None
-    found, n_traced = random_seeds(caster, region, faces, rng, want)
+    share = PLANE_SHARE if (guided and state.round > 0) else 0.0
+    found, n_traced = random_seeds(caster, region, faces, rng, want, share)
     state.rays["random"] += n_traced
     state.seed_rays[todo] += per_face
     fresh = state.record(found)
