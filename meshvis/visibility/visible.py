@@ -199,6 +199,7 @@ class _State:
         self.seed_rays = np.zeros(m, np.int64)
         self.first_seen = np.full(m, -1, np.int64)
         self.rays = {"random": 0, "lines": 0, "border": 0, "reverse": 0}
+        self.max_unseen = MAX_UNSEEN_PER_MILLION
         self.round = 0  # the round of seed rays under way
         self.refused = 0
         self.budget = budget
@@ -263,6 +264,7 @@ def visible_from(
     min_new_area: float = MIN_NEW_AREA_PER_MILLION,
     caster: RayCaster | None = None,
     transparent: str = DEFAULT_TRANSPARENT,
+    max_unseen: float = MAX_UNSEEN_PER_MILLION,
 ) -> Visibility:
     """Which sides of the model's faces a viewer in ``region`` can see.
 
@@ -295,7 +297,10 @@ def visible_from(
         Stop when a window of rays finds fewer new faces than this per million rays ...
     min_new_area : float
         ... or less new seen area than this fraction of the model's area per million rays
-        (0 for either: that rule never stops the search).
+        (0 for either: that rule never stops the seed rays).
+    max_unseen : float
+        The view lines end the search when fewer than this many per million of those that hit
+        the model first hit an unseen face (0: they go on to the budget).
     caster : RayCaster, optional
         A caster of the same model to reuse (its offset and its walls are not changed).
     transparent : {"see-through", "opaque"}
@@ -334,6 +339,7 @@ def visible_from(
     caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET, walls=walls(soup, transparent))
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new, min_new_area)
+    state.max_unseen = float(max_unseen)
     skipped = _presee(state, soup, region)
     if faces is not None:
         state.spread = _rings(soup, asked, PROPAGATE_RINGS)
@@ -543,7 +549,7 @@ class _Lines:
             self.state.snapshot()
             _propagate(self.state, self.caster, self.region, fresh)
             if self.hits >= self.window:
-                self.held = self.unseen * 1e6 / self.hits < MAX_UNSEEN_PER_MILLION
+                self.held = self.unseen * 1e6 / self.hits < self.state.max_unseen
                 self.active = not self.held
                 self.hits = self.unseen = 0
                 if not self.active:

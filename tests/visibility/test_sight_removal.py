@@ -290,3 +290,24 @@ def test_a_budget_that_ends_the_search_shows_in_the_summary(scenes):
     assert r.visibility.stopped == "budget"
     assert any("stopped at its ray budget" in line for line in r.summary())
     assert not any("budget" in line for line in remove_interior(soup, seed=0).summary())
+
+
+@pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6), (1e-3, 1e5)])
+def test_removal_and_layers_by_sight_hold_at_extreme_scales_and_far_from_the_origin(scale, shift):
+    soup, piece, truth = glass_box()
+    moved = Soup(
+        soup.vertices * scale + shift, soup.faces, material_id=soup.material_id, materials=soup.materials
+    )
+    np.testing.assert_array_equal(remove_interior(moved, seed=0).keep, truth)
+    boxes, _, layer_truth = nested_boxes_with_a_window()
+    far = Soup(boxes.vertices * scale + shift, boxes.faces)
+    np.testing.assert_array_equal(layers(far, seed=0).layer, layer_truth)
+
+
+def test_removal_by_sight_of_one_triangle_and_of_nothing():
+    one = Soup(np.eye(3), np.array([[0, 1, 2]]))
+    r = remove_interior(one, seed=0)
+    assert r.keep.tolist() == [True] and r.check.faces == 0
+    flat = Soup(np.zeros((3, 3)), np.array([[0, 1, 2]]))  # zero area: nothing to see
+    r = remove_interior(flat, seed=0)
+    assert r.keep.tolist() == [False] and r.check.faces == 0 and r.check.seen_area_fraction == 0.0
