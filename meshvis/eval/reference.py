@@ -400,9 +400,10 @@ def _escape(caster: RayCaster, points: np.ndarray, face: np.ndarray, rng) -> tup
 #: the searches of the hidden estimate (:func:`hidden`): guided searches with every stop rule
 #: off and this many times the default ray cap (:func:`meshvis.visibility.visible.default_budget`) ...
 HIDDEN_BUDGET_FACTOR = 16
-#: ... but at most this many rays each (16 x the cap of a model of 100 k faces would be 1.6
-#: billion rays, an hour on two cores)
-HIDDEN_MAX_RAYS = 100_000_000
+#: ... but at most this many rays each: 16 x the cap of a model of 100 k faces would be 1.6
+#: billion rays, an hour on two cores; on the monastery and the cycloidal drive the rounds
+#: of seed rays end after 70-76 M rays, and the view lines go on to the cap
+HIDDEN_MAX_RAYS = 50_000_000
 #: searches, with the seeds ``seed + 1 .. seed + HIDDEN_SEARCHES``
 HIDDEN_SEARCHES = 3
 
@@ -448,6 +449,16 @@ class Hidden:
         total = float(self.area[self.hidden].sum())
         gone = float(self.area[self.hidden & ~np.asarray(keep, bool)].sum())
         return gone / total if total > 0 else 1.0
+
+
+def _search_params() -> str:
+    """The constants of the search by sight, so that a cached estimate of another search is not reused."""
+    from meshvis.visibility import regions, visible
+
+    names = [k for k in dir(visible) if k.isupper() and not k.startswith("_")]
+    return hashlib.sha256(
+        repr([(k, getattr(visible, k)) for k in names] + [regions.PLANE_TILT, regions.FAR_MARGIN]).encode()
+    ).hexdigest()[:16]
 
 
 def hidden(
@@ -499,7 +510,7 @@ def hidden(
     soup = as_soup(model)
     searches = max(int(searches), 1)
     budget = int(min(HIDDEN_BUDGET_FACTOR * default_budget(soup.n_faces), max_rays))
-    key = f"{_key(soup, seed)}:hidden:{searches}:{budget}:{hashlib.sha256(ref.seen.tobytes()).hexdigest()}"
+    key = f"{_key(soup, seed)}:hidden:{searches}:{budget}:{_search_params()}:{hashlib.sha256(ref.seen.tobytes()).hexdigest()}"
     if cache is not None and os.path.isfile(cache):
         with np.load(cache) as data:
             if str(data["key"]) == key:
