@@ -61,6 +61,9 @@ def place_boxes(
     spacing: Spacing | None = None,
     previous: np.ndarray | None = None,
     directions: tuple[int, ...] | None = None,
+    *,
+    centres: np.ndarray | None = None,
+    lines: np.ndarray | None = None,
 ) -> tuple[list[Placement | None], BoxStats]:
     """Lay out the boxes and leaders of all labels of one frame.
 
@@ -78,6 +81,11 @@ def place_boxes(
         NaN where it was not on that side), for :func:`coherent_order`
     directions : side codes of the layout (default: those in ``sides``); a label with no
         room on its side may move to another one of them
+    centres : (n, 2) float, optional: each label's box centre in the previous frame moved
+        with its anchor (NaN: none); silhouette boxes prefer places near it
+    lines : (4,) float, optional: the x of the west and east columns and the y of the north
+        and south rows in the previous frame (NaN: none); a column or row stays there while
+        that is still valid and not much farther out than needed
 
     Returns
     -------
@@ -98,6 +106,8 @@ def place_boxes(
         rank,
         previous,
         directions,
+        centres,
+        lines,
     )
     for side in (WEST, EAST):
         _place_column(ctx, np.flatnonzero(ctx.sides == side), side)

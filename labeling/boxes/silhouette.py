@@ -11,7 +11,7 @@ import numpy as np
 from ..geometry2d import boxes_overlap, polyline_length, segment_hits_box
 from .collisions import _boxes_free, _leaders_free, _outside_image, _place, _placed_arrays
 from .context import NEAR_REACH, Context
-from .costs import BEHIND_PORT_COS, BEHIND_PORT_COST, BLOCKED_RAY_COST, OUTSIDE_IMAGE_COST
+from .costs import BEHIND_PORT_COS, BEHIND_PORT_COST, BLOCKED_RAY_COST, COHERENCE_COST, OUTSIDE_IMAGE_COST
 from .stacking import pack_1d, uncross
 
 #: push-out tiers of a silhouette box are half a box height (plus the gap) apart: boxes of
@@ -100,6 +100,10 @@ def _radial_candidates(
     half = np.array([w / 2, h / 2])
     boxes = np.concatenate([c - half, c + half], axis=1)
     cost = cost[ie, it, ia] + OUTSIDE_IMAGE_COST * _outside_image(ctx, boxes)
+    if np.isfinite(ctx.centres[k, 0]):
+        # along a camera path: a pixel of distance from where the box was (moved with its
+        # anchor) costs as much as a pixel of leader
+        cost = cost + COHERENCE_COST * np.hypot(*(c - ctx.centres[k]).T)
     keep = cost < below
     lid = (ie * n_t + it)[keep]
     used, lid = np.unique(lid, return_inverse=True)

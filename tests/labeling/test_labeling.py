@@ -331,11 +331,43 @@ def test_greedy_order_priority_and_distance_terms():
     g = greedy_layout(area, ax, ay, eid, ends, static, 2, d_a=5.0, d_e=10.0)
     assert g.area_order.tolist() == [0, 1]
     assert g.pick.tolist() == [1, 4]  # candidate 3 shares the placed endpoint: f5 = 0
-    assert np.isclose(g.priority[0], (0.8 + 0.7 + 0.9))
+    assert np.isclose(g.priority[0], -(0.2 + 0.3 + 0.1))  # P = -sum F: few feasible candidates first
     assert np.isclose(g.feasibility[0], 0.3)
     # with d_e = 0 the shared-endpoint penalty disappears and area 1 takes its best
     g2 = greedy_layout(area, ax, ay, eid, ends, static, 2, d_a=5.0, d_e=0.0)
     assert g2.pick.tolist() == [1, 3]
+
+
+def test_greedy_places_the_area_with_fewest_feasible_candidates_first():
+    """A small area with few candidates goes before a large one, however good its few are.
+
+    Eq. 14 summed as written (sum of 1 - F) would rank the large area first: 40 candidates
+    of F = 0.5 give 20 against 0.2 for the small area's two of F = 0.9.
+    """
+    n_big = 40
+    area = np.array([0] * n_big + [1, 1])
+    ax = np.concatenate([np.arange(n_big, dtype=float), [100.0, 101.0]])
+    ay = np.zeros(n_big + 2)
+    eid = np.arange(n_big + 2)
+    ends = np.column_stack([np.zeros(n_big + 2), 10.0 * np.arange(n_big + 2)])
+    static = np.concatenate([np.full(n_big, 0.5), [0.9, 0.9]])
+    g = greedy_layout(area, ax, ay, eid, ends, static, 2, d_a=0.0, d_e=0.0)
+    assert g.area_order.tolist() == [1, 0]
+    assert np.allclose(g.priority, [-1.8, -20.0])
+
+
+def test_greedy_keeps_the_followed_anchor_unless_clearly_worse():
+    """Hysteresis: the best candidate near last frame's anchor wins unless one is > keep x better."""
+    area = np.zeros(3, np.int64)
+    ax, ay = np.array([0.0, 1.0, 50.0]), np.zeros(3)
+    eid, ends = np.arange(3), np.column_stack([np.zeros(3), 10.0 * np.arange(3)])
+    follow = np.array([[0.5, 0.0]])
+    kw = dict(d_a=0.0, d_e=0.0, follow=follow, drift=2.0, keep=2.0)
+    assert greedy_layout(area, ax, ay, eid, ends, np.array([0.3, 0.4, 0.7]), 1, **kw).pick.tolist() == [1]
+    assert greedy_layout(area, ax, ay, eid, ends, np.array([0.3, 0.4, 0.9]), 1, **kw).pick.tolist() == [2]
+    # without a followed anchor the best one wins
+    free = dict(kw, follow=np.full((1, 2), np.nan))
+    assert greedy_layout(area, ax, ay, eid, ends, np.array([0.3, 0.4, 0.7]), 1, **free).pick.tolist() == [2]
 
 
 def test_pack_1d_keeps_order_and_spacing():
@@ -740,6 +772,10 @@ def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
     """top-bottom at azimuth 270: the alternator's leader to the top crosses others; it goes down."""
     import meshvis.labeling.pipeline  # noqa: F401  (makes labeling.pipeline an attribute)
 
+    from meshvis.labeling import greedy
+
+    # the view needs the anchors of Eq. 14's literal order (largest areas first)
+    monkeypatch.setattr(greedy, "_priority", lambda S, f5w, count: count - S @ f5w)
     soup = load_models(os.path.join(ROOT, "models", "assembly.obj"))
     ib = id_buffer(soup, fit_camera(soup, azimuth=270.0, elevation=20.0, up=(0, 0, 1)), (512, 512))
     texts = label_texts(soup.part_names)
@@ -750,7 +786,9 @@ def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
     assert [lab.name for lab in moved] == ["alternator"]
     assert moved[0].leader[-1][1] > moved[0].anchor[1]  # its leader leaves downwards
     # kept on its own side, it has no room
-    monkeypatch.setattr(labeling.pipeline, "place_boxes", lambda *a: boxes.place_boxes(*a[:10], ()))
+    monkeypatch.setattr(
+        labeling.pipeline, "place_boxes", lambda *a, **kw: boxes.place_boxes(*a[:10], (), **kw)
+    )
     assert [name for _, name in solve(ib, texts, layout="top-bottom").unplaced] == ["alternator"]
 
 
