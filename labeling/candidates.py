@@ -232,6 +232,22 @@ def _shortest(
     return mask, best, ex, ey, side, key
 
 
+def _dense_ids(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(keys, return_index=True, return_inverse=True)[1:]`` for small non-negative keys.
+
+    The keys are pixel indices of a grid, so a lookup table replaces the sort.
+    """
+    if len(keys) == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    present = np.zeros(int(keys.max()) + 1, bool)
+    present[keys] = True
+    dense = np.cumsum(present) - 1
+    inv = dense[keys]
+    first = np.full(int(dense[-1]) + 1, len(keys), np.int64)
+    np.minimum.at(first, inv, np.arange(len(keys)))
+    return first, inv
+
+
 def leader_candidates(
     area: InternalArea, layout: str, prefer: np.ndarray | None = None, keep: float = 1.0
 ) -> Candidates:
@@ -278,7 +294,7 @@ def leader_candidates(
     exi, eyi, length = image(ex, np.nan), image(ey, np.nan), image(best, np.nan)
     side_img, key_img = image(side, -1), image(key, -1)
     inside = key_img >= 0
-    _, first, inv = np.unique(key_img[inside], return_index=True, return_inverse=True)
+    first, inv = _dense_ids(key_img[inside])
     eid = np.full(key_img.shape, -1, np.int64)
     eid[inside] = inv
     endpoints = np.column_stack([exi[inside][first], eyi[inside][first]])

@@ -9,7 +9,8 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry2d import boxes_overlap, polyline_length, segment_hits_box
-from .collisions import _boxes_free, _leaders_free, _outside_image, _place, _placed_arrays
+from ._kernels import first_free
+from .collisions import _outside_image, _place, _placed_arrays
 from .context import NEAR_REACH, Context
 from .costs import BEHIND_PORT_COS, BEHIND_PORT_COST, BLOCKED_RAY_COST, COHERENCE_COST, OUTSIDE_IMAGE_COST
 from .stacking import pack_1d, uncross
@@ -106,7 +107,10 @@ def _radial_candidates(
         cost = cost + COHERENCE_COST * np.hypot(*(c - ctx.centres[k]).T)
     keep = cost < below
     lid = (ie * n_t + it)[keep]
-    used, lid = np.unique(lid, return_inverse=True)
+    # np.nonzero walks (endpoint, tier, attach) in order, so lid is sorted: number its runs
+    new = np.ones(len(lid), bool)
+    new[1:] = lid[1:] != lid[:-1]
+    used, lid = lid[new], np.cumsum(new) - 1
     ue, ut = np.divmod(used, n_t)
     leaders = np.stack([np.broadcast_to(a, (len(used), 2)), E[ue], port[ut, ue]], axis=1)
     return boxes[keep], leaders, lid.ravel(), cost[keep], it[keep], moved[ie[keep]]
@@ -127,16 +131,23 @@ def _cheapest(
     """
     boxes, leaders, leader_of, cost = cands[:4]
     pboxes, psegs = _placed_arrays(ctx, k)
-    idx = np.argsort(cost, kind="stable")
-    idx = idx[_boxes_free(ctx, boxes[idx], pboxes, psegs)]
-    used, inverse = np.unique(leader_of[idx], return_inverse=True)
-    idx = idx[_leaders_free(leaders[used], pboxes, psegs, paths)[inverse.ravel()]]
-    if len(idx) == 0:
-        return None, None
-    blocks = segment_hits_box(rays, boxes[idx]).sum(axis=0) if len(rays) else np.zeros(len(idx))
-    if (blocks == 0).any():
-        return int(idx[np.argmax(blocks == 0)]), None
-    return None, int(idx[np.argmin(cost[idx] + BLOCKED_RAY_COST * blocks)])
+    order = np.argsort(cost, kind="stable")
+    free, fallback = first_free(
+        order,
+        np.ascontiguousarray(boxes, np.float64),
+        np.ascontiguousarray(leader_of, np.int64),
+        np.ascontiguousarray(leaders, np.float64),
+        np.ascontiguousarray(cost, np.float64),
+        ctx.area.integral,
+        int(ctx.area.pad),
+        np.ascontiguousarray(pboxes, np.float64),
+        np.ascontiguousarray(psegs, np.float64).reshape(-1, 2, 2),
+        np.zeros((0, 2, 2)) if paths is None else np.ascontiguousarray(paths, np.float64).reshape(-1, 2, 2),
+        np.ascontiguousarray(rays, np.float64).reshape(-1, 2, 2),
+        float(ctx.sp.gap),
+        float(BLOCKED_RAY_COST),
+    )
+    return (int(free) if free >= 0 else None), (int(fallback) if fallback >= 0 else None)
 
 
 def _search_radial(ctx: Context, k: int) -> bool:
