@@ -25,6 +25,7 @@ import io
 import json
 import os
 import threading
+import time
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
@@ -169,13 +170,16 @@ class ViewServer:
 
     def layout(self, header: dict, body: bytes) -> dict[str, Any]:
         """Answer one ``POST /layout``."""
+        t0 = time.perf_counter()
         width, height = int(header.get("width", 0)), int(header.get("height", 0))
         ids = ids_from_rgba(body, width, height)
         camera = _camera(header.get("camera"))
         with self._lock:
             result = self.live.frame(ids, camera, str(header.get("viewer", ""))[:64])
             self.frames += 1
-        return frame_json(result, int(header.get("seq", 0)))
+        answer = frame_json(result, int(header.get("seq", 0)))
+        answer["serverMs"] = round(1000.0 * (time.perf_counter() - t0), 3)
+        return answer
 
     def _handler(self) -> type[BaseHTTPRequestHandler]:
         server = self

@@ -10,7 +10,7 @@ import { OrbitControls } from 'three/addons/controls/OrbitControls.js';
 import { GLTFLoader } from 'three/addons/loaders/GLTFLoader.js';
 
 // the longest side of the ID buffer (pixels): the layout's cost grows with its area
-const MAX_ID_SIDE = 640;
+const MAX_ID_SIDE = 512;
 // the fraction of the way to its new place a box moves per animation frame
 const GLIDE = 0.3;
 // label style (the server measures the boxes with the same font)
@@ -23,7 +23,7 @@ const status = document.getElementById('status');
 const viewer = Math.random().toString(36).slice(2);
 
 const info = await (await fetch('scene.json')).json();
-const renderer = new THREE.WebGLRenderer({ antialias: true, preserveDrawingBuffer: true });
+const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1); // one canvas pixel per CSS pixel: the overlay's coordinates
 stage.appendChild(renderer.domElement);
 
@@ -101,12 +101,13 @@ function resize() {
   camera.aspect = w / h;
   camera.updateProjectionMatrix();
   dirty = true;
+  resized = true;
 }
 
 // ------------------------------------------------------------------ frames to the server
-let dirty = true, inFlight = false, seq = 0;
+let dirty = true, inFlight = false, resized = true, seq = 0;
 const state = { labels: new Map(), scale: 1, fontSize: 11, boxHeight: 16, layoutMs: 0 };
-const stats = { received: [], answers: [], sent: 0, errors: 0 };
+const stats = { received: [], answers: [], sent: 0, errors: 0, timing: [] };
 controls.addEventListener('change', () => { dirty = true; });
 
 function renderIds() {
@@ -125,7 +126,9 @@ function renderIds() {
 async function requestLayout() {
   dirty = false;
   inFlight = true;
+  const t0 = performance.now();
   const [iw, ih] = renderIds();
+  const t1 = performance.now();
   const header = {
     viewer, seq: ++seq, width: iw, height: ih,
     camera: {
@@ -142,6 +145,8 @@ async function requestLayout() {
     const answer = await res.json();
     if (!res.ok) throw new Error(answer.error);
     accept(answer, iw);
+    stats.timing.push({ ids: t1 - t0, answer: performance.now() - t1, layout: answer.layoutMs, server: answer.serverMs });
+    if (stats.timing.length > 200) stats.timing.shift();
   } catch (err) {
     stats.errors++;
     status.textContent = `error: ${err.message}`;
@@ -156,7 +161,7 @@ function accept(answer, iw) {
   stats.answers.push(now);
   stats.received.push({ seq: answer.seq, t: now, width: answer.width, height: answer.height,
     layoutMs: answer.layoutMs, labels: answer.labels.map(l => ({ part: l.part, box: l.box, side: l.side,
-      leader: l.leader })) });
+      leader: l.leader, anchor3d: l.anchor3d })) });
   if (stats.received.length > 500) stats.received.shift();
   state.scale = stage.clientWidth / iw;
   state.fontSize = answer.fontSize;
@@ -240,10 +245,16 @@ function showStatus() {
 }
 
 // ------------------------------------------------------------------ the loop
+// the display is drawn again only when the camera moved or the window changed size
+let drawn = null;
 function animate() {
   controls.update();
-  sun.position.copy(camera.position);
-  renderer.render(view, camera);
+  if (!drawn || !drawn.equals(camera.matrixWorld) || resized) {
+    sun.position.copy(camera.position);
+    renderer.render(view, camera);
+    drawn = camera.matrixWorld.clone();
+    resized = false;
+  }
   if (dirty && !inFlight) requestLayout();
   drawLabels();
   showStatus();
