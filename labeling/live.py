@@ -75,7 +75,9 @@ def ids_from_rgba(data: bytes | bytearray | memoryview, width: int, height: int)
         raise ParameterError(f"ID buffer size must be 1..{MAX_SIDE} pixels a side, got {width} x {height}")
     rgba = np.frombuffer(data, np.uint8)
     if rgba.size != width * height * 4:
-        raise ParameterError(f"ID buffer of {width} x {height} needs {width * height * 4} bytes, got {rgba.size}")
+        raise ParameterError(
+            f"ID buffer of {width} x {height} needs {width * height * 4} bytes, got {rgba.size}"
+        )
     px = rgba.reshape(height, width, 4)[::-1].astype(np.int64)
     return px[..., 0] + (px[..., 1] << 8) + (px[..., 2] << 16) - 1
 
@@ -117,7 +119,9 @@ class LiveLabeler:
         solve_check = id_buffer(self.soup, self.camera((16, 16)), (16, 16), caster=self.caster)
         solve(solve_check, self.texts, layout=layout, compute_metrics=False, **options)  # checks the options
 
-    def camera(self, size: tuple[int, int] = (512, 512), azimuth: float = 30.0, elevation: float = 20.0) -> Camera:
+    def camera(
+        self, size: tuple[int, int] = (512, 512), azimuth: float = 30.0, elevation: float = 20.0
+    ) -> Camera:
         """The first camera of a view of ``size`` = (width, height): :func:`fit_camera`."""
         return fit_camera(
             self.soup, azimuth=azimuth, elevation=elevation, up=self.up, margin=self.fit_margin, size=size

@@ -213,6 +213,17 @@ def is_clean(metrics: dict[str, Any]) -> bool:
 JUMP_PX = 50.0
 
 
+def _side_changed(a, b) -> bool:
+    """The label left on another side; a radial one: its box turned > 90 degrees about its anchor."""
+    if a.side != b.side:
+        return True
+    if a.side != "radial":
+        return False
+    da = (a.box[:2] + a.box[2:]) / 2 - a.anchor
+    db = (b.box[:2] + b.box[2:]) / 2 - b.anchor
+    return bool(np.dot(da, db) < 0)
+
+
 def orbit_coherence(results: Sequence[LayoutResult], jump: float = JUMP_PX) -> dict[str, Any]:
     """How well the labels of a frame sequence follow the model.
 
@@ -220,7 +231,8 @@ def orbit_coherence(results: Sequence[LayoutResult], jump: float = JUMP_PX) -> d
     motion* is how far the surface point under the earlier anchor moved on the screen
     (the point ``anchor_3d`` of the earlier frame projected with the later camera), and the
     *label motion* how far the box centre moved.  A transition is *jumpy* when one of its
-    labels moves more than ``jump`` pixels or changes side.
+    labels moves more than ``jump`` pixels or changes side (for the silhouette layout:
+    its box turns by more than 90 degrees around its anchor).
 
     Parameters
     ----------
@@ -258,7 +270,7 @@ def orbit_coherence(results: Sequence[LayoutResult], jump: float = JUMP_PX) -> d
             [[(b[p].box[:2] + b[p].box[2:]) / 2, (a[p].box[:2] + a[p].box[2:]) / 2] for p in common]
         )
         label = np.hypot(*(centre[:, 0] - centre[:, 1]).T)
-        flips = np.array([a[p].side != b[p].side for p in common])
+        flips = np.array([_side_changed(a[p], b[p]) for p in common])
         ok = np.isfinite(surface)
         label_motion.extend(label[ok])
         surface_motion.extend(surface[ok])

@@ -67,7 +67,7 @@ def model_glb(live: LiveLabeler, path: str | None) -> bytes:
 
     soup = live.soup
     scene = trimesh.Scene()
-    colours = (np.array([[0.62, 0.68, 0.76], [0.80, 0.70, 0.55], [0.60, 0.75, 0.62], [0.78, 0.60, 0.62]]) * 255)
+    colours = np.array([[0.62, 0.68, 0.76], [0.80, 0.70, 0.55], [0.60, 0.75, 0.62], [0.78, 0.60, 0.62]]) * 255
     for p, name in enumerate(soup.part_names):
         faces = soup.faces[soup.part_id == p]
         if len(faces) == 0:
@@ -132,7 +132,9 @@ class ViewServer:
     verbose : print every request on standard error
     """
 
-    def __init__(self, live: LiveLabeler, path: str | None = None, *, port: int = PORT, verbose: bool = False):
+    def __init__(
+        self, live: LiveLabeler, path: str | None = None, *, port: int = PORT, verbose: bool = False
+    ):
         self.live = live
         self.verbose = verbose
         self._files = {

@@ -115,7 +115,9 @@ def _leader_free(poly, pboxes, psegs, paths):
 
 
 @numba.njit(**_JIT)
-def first_free(order, boxes, leader_of, leaders, cost, integral, pad, pboxes, psegs, paths, rays, gap, blocked):
+def first_free(
+    order, boxes, leader_of, leaders, cost, integral, pad, pboxes, psegs, paths, rays, gap, blocked
+):
     """Walk the candidates in ``order`` (cheapest first) for :func:`.silhouette._cheapest`.
 
     Returns (the first valid candidate that blocks no ray, -1) or, when every valid one

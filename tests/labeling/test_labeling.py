@@ -802,3 +802,116 @@ def test_endpoint_towards_each_side_of_a_rectangle():
     )
     for side, want in ((WEST, (x0, 40.5)), (EAST, (x1, 40.5)), (NORTH, (50.5, y0)), (SOUTH, (50.5, y1))):
         assert np.allclose(box_search._endpoint_towards(ctx, 0, side), want, atol=1.0)
+
+
+# ---------------------------------------------------------------------------- metrics that can fail
+def _clean_frame(buffers):
+    soup, ib = buffers["scene"]
+    r = solve(ib, label_texts(soup.part_names), layout="left-right")
+    assert len(r.labels) >= 3 and is_clean(r.metrics)
+    assert r.metrics["leaders_through_labels"] == 0
+    return r
+
+
+def _plant_overlap(r):
+    a, b = r.labels[0], r.labels[1]
+    b.box = a.box + np.array([2.0, 1.0, 2.0, 1.0])  # shares all but a sliver of a's box
+    return frame_metrics(r)
+
+
+def _plant_crossing(r):
+    a, b = r.labels[0], r.labels[1]
+    mid = (a.anchor + b.box[:2]) / 2
+    a.leader = np.array([mid + (-40.0, -40.0), mid + (40.0, 40.0)])
+    b.leader = np.array([mid + (-40.0, 40.0), mid + (40.0, -40.0)])
+    return frame_metrics(r)
+
+
+def _plant_leader_through(r):
+    a, b = r.labels[0], r.labels[1]
+    c = (b.box[:2] + b.box[2:]) / 2
+    a.leader = np.array([a.anchor, c + (-200.0, 0.0), c + (200.0, 0.0)])
+    return frame_metrics(r)
+
+
+def _check_planted_defects(buffers):
+    m = _plant_overlap(_clean_frame(buffers))
+    assert m["overlaps"] == 1 and m["overlap_area"] > 0 and not is_clean(m)
+    m = _plant_crossing(_clean_frame(buffers))
+    assert m["crossings"] >= 1 and not is_clean(m)
+    m = _plant_leader_through(_clean_frame(buffers))
+    assert m["leaders_through_labels"] >= 1
+
+
+def test_metrics_detect_planted_defects(buffers):
+    """One planted overlap, crossing or leader through a box is counted (the clean frame has none)."""
+    _check_planted_defects(buffers)
+
+
+@pytest.mark.parametrize(
+    "broken",
+    ["overlap_area", "segments_intersect", "segment_hits_box"],
+    ids=["overlap", "crossing", "through"],
+)
+def test_planted_defect_checks_fail_on_a_blind_metric(buffers, monkeypatch, broken):
+    """Mutation check: the checks above fail when a metric's predicate sees nothing."""
+    from meshvis.labeling import metrics
+
+    real = getattr(metrics, broken)
+    monkeypatch.setattr(metrics, broken, lambda a, b, *k: np.zeros_like(real(a, b, *k)))
+    with pytest.raises(AssertionError):
+        _check_planted_defects(buffers)
+
+
+def _orbit_coherence(scene_soup, coherence):
+    from meshvis.labeling.metrics import orbit_coherence
+
+    cams = orbit(scene_soup, 72, up=(0, 0, 1))[:13]  # 12 steps of 5 degrees
+    return orbit_coherence(
+        layout_frames(scene_soup, cams, layout="left-right", size=(256, 256), coherence=coherence)
+    )
+
+
+@pytest.fixture(scope="module")
+def assembly_soup():
+    return load_models(os.path.join(ROOT, "models", "assembly.obj"))
+
+
+@pytest.mark.slow
+def test_coherence_halves_label_motion_along_an_orbit(assembly_soup):
+    """Coherent frames move their labels less than half as much, and change side less often.
+
+    Switched off (frames laid out alone), both numbers are those of the free run, so the
+    test fails; on this orbit coherence gives motion 2.9x the surface's, free frames 7.6x.
+    """
+    on = _orbit_coherence(assembly_soup, True)
+    off = _orbit_coherence(assembly_soup, False)
+    assert on["transitions"] == off["transitions"] == 12
+    assert on["motion_ratio"] < 0.5 * off["motion_ratio"]
+    assert on["side_changes"] < 0.5 * off["side_changes"]
+    assert on["jumpy_transitions"] < off["jumpy_transitions"]
+
+
+@pytest.mark.slow
+def test_coherence_test_fails_when_the_previous_frame_is_ignored(assembly_soup, monkeypatch):
+    """Mutation check: a pipeline that drops the previous frame fails the coherence test."""
+    from meshvis.labeling import pipeline
+
+    real = pipeline.solve
+    monkeypatch.setattr(pipeline, "solve", lambda ib, texts, previous=None, **kw: real(ib, texts, **kw))
+    with pytest.raises(AssertionError):
+        test_coherence_halves_label_motion_along_an_orbit(assembly_soup)
+
+
+def test_orbit_coherence_counts_jumps_and_side_changes(buffers):
+    from meshvis.labeling.metrics import orbit_coherence
+
+    soup, ib = buffers["scene"]
+    a = solve(ib, label_texts(soup.part_names), layout="left-right")
+    b = solve(ib, label_texts(soup.part_names), layout="left-right")
+    assert orbit_coherence([a, b])["jumpy_transitions"] == 0 and orbit_coherence([a, b])["motion_ratio"] == 0
+    lab = b.labels[0]
+    lab.box = lab.box + np.array([60.0, 0.0, 60.0, 0.0])
+    lab.side = "east" if lab.side == "west" else "west"
+    m = orbit_coherence([a, b])
+    assert m["jumps"] == 1 and m["side_changes"] == 1 and m["jumpy_transitions"] == 1

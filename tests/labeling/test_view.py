@@ -85,7 +85,12 @@ def test_live_frames_are_coherent_per_viewer(live):
 def _post(server, ids, cam, **extra):
     h, w = ids.shape
     header = {"viewer": "t", "seq": 7, "width": w, "height": h, **extra}
-    header["camera"] = {"position": cam.position.tolist(), "target": cam.target.tolist(), "up": cam.up.tolist(), "fov": cam.fov}
+    header["camera"] = {
+        "position": cam.position.tolist(),
+        "target": cam.target.tolist(),
+        "up": cam.up.tolist(),
+        "fov": cam.fov,
+    }
     req = urllib.request.Request(
         server.url + "layout", data=_rgba(ids), headers={"X-Meshvis-Frame": json.dumps(header)}, method="POST"
     )
@@ -122,7 +127,9 @@ def test_server_serves_the_page_the_model_and_layouts(server, live):
     assert not overlap.any()
 
 
-@pytest.mark.parametrize("path", ["/../pyproject.toml", "/vendor/../../server.py", "/%2e%2e/live.py", "/vendor/"])
+@pytest.mark.parametrize(
+    "path", ["/../pyproject.toml", "/vendor/../../server.py", "/%2e%2e/live.py", "/vendor/"]
+)
 def test_server_serves_nothing_outside_the_page(server, path):
     assert _static(path) is None
     with pytest.raises(urllib.error.HTTPError) as err:
@@ -159,7 +166,9 @@ def test_view_command_refuses_a_bad_port_and_a_missing_model(tmp_path, capsys):
 def test_a_converted_model_keeps_its_parts(tmp_path):
     a, b = trimesh.creation.box(), trimesh.creation.icosphere()
     b.apply_translation((2.0, 0, 0))
-    soup = Soup.concatenate([Soup(a.vertices, a.faces, part_names=["crate"]), Soup(b.vertices, b.faces, part_names=["ball"])])
+    soup = Soup.concatenate(
+        [Soup(a.vertices, a.faces, part_names=["crate"]), Soup(b.vertices, b.faces, part_names=["ball"])]
+    )
     from meshvis.labeling.server import model_glb
 
     live = LiveLabeler(soup)

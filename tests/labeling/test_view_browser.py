@@ -49,7 +49,10 @@ def page(tmp_path_factory):
     )
     try:
         line = proc.stdout.readline()
-        assert line.startswith("meshvis view: http://127.0.0.1:"), (line, proc.stderr.read() if proc.poll() else "")
+        assert line.startswith("meshvis view: http://127.0.0.1:"), (
+            line,
+            proc.stderr.read() if proc.poll() else "",
+        )
         url = line.split()[2]
         with playwright.sync_playwright() as pw:
             profile = tmp_path_factory.mktemp("chromium-profile")
