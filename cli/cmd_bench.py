@@ -45,6 +45,7 @@ def add_parser(sub) -> None:
         "stability",
         "labeling",
         "labeling-sweep",
+        "labeling-orbit",
         "compare",
         "scale",
         "orientation",

@@ -228,8 +228,15 @@ def _report(args: argparse.Namespace, results: list, paths: list[str]) -> None:
     )
     if first.invisible:
         say(args, f"not visible, not labelled: {', '.join(n for _, n in first.invisible)}")
-    if first.unplaced:
-        say(args, f"no room found for: {', '.join(n for _, n in first.unplaced)}")
+    outside = set(first.params.get("outside_image", []))
+    if outside:
+        say(
+            args,
+            f"left out, no room inside the image even at {first.font_size} px: {', '.join(sorted(outside))}",
+        )
+    rest = [n for _, n in first.unplaced if n not in outside]
+    if rest:
+        say(args, f"no room found for: {', '.join(rest)}")
     if len(results) > 1:
         s = sequence_metrics(results)
         say(

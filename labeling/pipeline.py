@@ -468,6 +468,42 @@ def _place_labels(
     return rank, anchors, endpoints, placements, stats
 
 
+#: the smallest font a label is shrunk to to keep the boxes inside the image (pixels)
+MIN_FONT_SIZE = 6
+#: a camera fitted by :func:`layout` moves back by this factor, at most this many times,
+#: while labels do not fit the image
+ZOOM_OUT = 1.3
+ZOOM_OUT_STEPS = 3
+
+
+def _off_image(placements: list, size: tuple[int, int]) -> list[int]:
+    """Indices of the placed boxes that reach beyond the image."""
+    w, h = size
+    return [
+        k
+        for k, p in enumerate(placements)
+        if p is not None and (p.box[0] < 0 or p.box[1] < 0 or p.box[2] > w or p.box[3] > h)
+    ]
+
+
+def _inside_image(place, style: TextStyle, size: tuple[int, int]) -> tuple:
+    """Place the boxes, shrinking the font while a box would leave the image.
+
+    ``place(style)`` returns what :func:`_place_labels` does.  Below
+    :data:`MIN_FONT_SIZE` the boxes still outside are left out (the labels become
+    ``unplaced``; ``params["outside_image"]`` names them).  Returns the style used, the
+    placement and the indices of the labels left out for this reason.
+    """
+    placed = place(style)
+    while _off_image(placed[3], size) and style.font_size > MIN_FONT_SIZE:
+        style = TextStyle(style.font_size - 1)
+        placed = place(style)
+    off = _off_image(placed[3], size)
+    for k in off:
+        placed[3][k] = None
+    return style, placed, off
+
+
 def _view_maps(
     idbuf: IdBuffer,
     area: str,
@@ -596,6 +632,7 @@ def solve(
     min_pixels: int = MIN_PIXELS,
     spacing: Spacing | None = None,
     compute_metrics: bool = True,
+    inside: bool = True,
 ) -> LayoutResult:
     """Lay out the labels of a view whose ID buffer is known.
 
@@ -620,6 +657,10 @@ def solve(
         :data:`MIN_PIXELS`)
     spacing : Spacing of the boxes
     compute_metrics : measure the result (:func:`labeling.metrics.frame_metrics`)
+    inside : keep every box inside the image: shrink the font (down to
+        :data:`MIN_FONT_SIZE`), then leave out the labels that still do not fit
+        (``unplaced``, named in ``params["outside_image"]``); False lets boxes reach beyond
+        the image (the pictures' canvas grows to hold them)
 
     Returns
     -------
@@ -650,14 +691,22 @@ def solve(
         order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t)
     else:
         order, t = _two_step_picks(px, len(labelled), clock, t)
-    rank, anchors, endpoints, placements, stats = _place_labels(
-        px, order, widths, style, ia, (w, h), spacing, prev, layout
-    )
+    label_texts_ = [texts[p] for p in labelled]
+
+    def place(st: TextStyle) -> tuple:
+        return _place_labels(px, order, st.box_widths(label_texts_), st, ia, (w, h), spacing, prev, layout)
+
+    if inside:
+        style, placed, off_image = _inside_image(place, style, (w, h))
+    else:
+        placed, off_image = place(style), []
+    rank, anchors, endpoints, placements, stats = placed
     t = clock.tick("boxes", t)
     labels, unplaced = _collect_labels(idbuf, texts, labelled, order, rank, anchors, endpoints, placements)
     clock.timings["layout_ms"] = 1000.0 * sum(clock.timings.get(k, 0.0) for k in LAYOUT_STAGES)
     thresholds = _thresholds(d_a, d_e, d_s, da_px, de_px, cand.d_max)
     params = _params(layout, area, ia.margin, method, weights, thresholds, min_pixels, stats)
+    params["outside_image"] = [names[int(labelled[k])] for k in off_image]
     found = dict(labels=labels, invisible=invisible, unplaced=unplaced, skipped=skipped)
     result = _layout_result(
         idbuf, ia, style, **found, layout=layout, method=method, params=params, clock=clock
@@ -735,12 +784,15 @@ def layout(
     caster : a RayCaster of the same model to reuse (frames, benchmarks)
     color_by : colouring of the shaded picture
     **options : passed to :func:`solve` (area, margin, weights, d_a, d_e, previous, method,
-        font_size, min_pixels, spacing)
+        font_size, min_pixels, spacing, inside)
 
     Returns
     -------
     LayoutResult
-        ``timings`` has ``setup`` and ``idbuffer`` besides the layout stages.
+        ``timings`` has ``setup`` and ``idbuffer`` besides the layout stages.  With the
+        camera fitted here (``camera`` None), a view whose boxes do not fit the image is
+        taken again from up to :data:`ZOOM_OUT_STEPS` times farther away (by
+        :data:`ZOOM_OUT` each), until every label fits.
 
     Examples
     --------
@@ -758,6 +810,7 @@ def layout(
     warm_up()
     soup = load_models(model)
     caster = caster or RayCaster(soup)
+    fitted = camera is None
     if camera is None:
         camera = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up, margin=fit_margin, size=size)
     if texts is None or isinstance(texts, Mapping):
@@ -768,5 +821,13 @@ def layout(
     idbuf = id_buffer(soup, camera, size, caster=caster, color_by=color_by)
     t2 = time.perf_counter()
     result = solve(idbuf, text_list, layout=layout, **options)
+    for _ in range(ZOOM_OUT_STEPS if fitted else 0):
+        if not result.params.get("outside_image"):
+            break
+        # a camera fitted here leaves more room around the model instead of dropping labels
+        fit_margin *= ZOOM_OUT
+        camera = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up, margin=fit_margin, size=size)
+        idbuf = id_buffer(soup, camera, size, caster=caster, color_by=color_by)
+        result = solve(idbuf, text_list, layout=layout, **options)
     result.timings = {"setup": t1 - t0, "idbuffer": t2 - t1, **result.timings}
     return result

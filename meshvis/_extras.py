@@ -17,6 +17,7 @@ EXTRA_OF = {
     "adjustText": "bench",
     "distributed": "dask",
     "networkx": "graphml",
+    "anywidget": "notebook",
 }
 
 

@@ -102,12 +102,21 @@ def back_buffers(models):
 
 
 # ---------------------------------------------------------------------------- the guarantees
+def _check_inside(r, where):
+    """Kept inside the image: clean, no box beyond it, and only labels with no room there left out."""
+    assert is_clean(r.metrics) and r.metrics["leaders_through_labels"] == 0, where
+    assert r.metrics["outside_image"] == 0, where
+    assert sorted(n for _, n in r.unplaced) == sorted(r.params["outside_image"]), where
+
+
 @pytest.mark.slow
 @pytest.mark.parametrize("layout", list(labeling.LAYOUTS))
 def test_layout_guarantees_on_all_models(buffers, layout):
     """Every layout on every model: no overlap, no crossing, no box over the model, valid anchors."""
     for name, (soup, ib) in buffers.items():
-        r = solve(ib, label_texts(soup.part_names), layout=layout)
+        _check_inside(solve(ib, label_texts(soup.part_names), layout=layout), (name, layout))
+        # the box stage itself places every label when boxes may leave the image
+        r = solve(ib, label_texts(soup.part_names), layout=layout, inside=False)
         m = r.metrics
         assert m["overlaps"] == 0, (name, layout)
         assert m["crossings"] == 0, (name, layout)
@@ -131,7 +140,8 @@ def test_layout_guarantees_on_all_models(buffers, layout):
 def test_layout_guarantees_second_view(back_buffers, layout, method):
     """The hard guarantees hold in a second, smaller view and for the baseline too."""
     for name, (soup, ib) in back_buffers.items():
-        r = solve(ib, label_texts(soup.part_names), layout=layout, method=method)
+        _check_inside(solve(ib, label_texts(soup.part_names), layout=layout, method=method), (name, layout))
+        r = solve(ib, label_texts(soup.part_names), layout=layout, method=method, inside=False)
         assert is_clean(r.metrics), (name, layout, method, r.metrics)
         assert r.metrics["leaders_through_labels"] == 0, (name, layout, method)
         assert r.metrics["labelling_rate"] == 1.0, (name, layout, method, r.unplaced)
@@ -143,7 +153,7 @@ def test_invisible_parts_reported(buffers):
     assert (1, "hidden core") in r.invisible
     assert 1 not in {lab.part for lab in r.labels}
     dog_soup, dog_ib = buffers["dog"]
-    rd = solve(dog_ib, label_texts(dog_soup.part_names))
+    rd = solve(dog_ib, label_texts(dog_soup.part_names), inside=False)  # its long name needs the canvas
     # the rib cage lies inside the skin: never labelled
     assert "dm_control__BONERibcage" in {n for _, n in rd.invisible}
     assert "dm_control__SKINbody" in {lab.name for lab in rd.labels}
@@ -623,8 +633,8 @@ def test_rotated_leaders_shorten_the_silhouette_layout(request, which):
     """Rotating a leader to free space instead of pushing its box out: clean, and shorter in total."""
     soup, ib = request.getfixturevalue(which)["assembly"]
     texts = label_texts(soup.part_names)
-    plain = solve(ib, texts, layout="silhouette", spacing=boxes.Spacing(rotate=0.0))
-    rotated = solve(ib, texts, layout="silhouette")
+    plain = solve(ib, texts, layout="silhouette", spacing=boxes.Spacing(rotate=0.0), inside=False)
+    rotated = solve(ib, texts, layout="silhouette", inside=False)
     assert is_clean(plain.metrics) and is_clean(rotated.metrics)
     assert rotated.metrics["invalid_anchors"] == 0
     turned = [lab for lab in rotated.labels if lab.shift > 0.5]
@@ -760,7 +770,7 @@ def test_silhouette_crowded_small_views_place_every_label_near(azimuth, elevatio
     cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=(0, 0, 1))
     ib = id_buffer(soup, cam, (192, 192))
     for method in ("fuzzy", "two-step"):
-        r = solve(ib, label_texts(soup.part_names), layout="silhouette", method=method)
+        r = solve(ib, label_texts(soup.part_names), layout="silhouette", method=method, inside=False)
         assert is_clean(r.metrics) and r.metrics["leaders_through_labels"] == 0
         assert r.metrics["labelling_rate"] == 1.0, (method, r.unplaced)
         if method == "fuzzy":
@@ -779,7 +789,7 @@ def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
     soup = load_models(os.path.join(ROOT, "models", "assembly.obj"))
     ib = id_buffer(soup, fit_camera(soup, azimuth=270.0, elevation=20.0, up=(0, 0, 1)), (512, 512))
     texts = label_texts(soup.part_names)
-    r = solve(ib, texts, layout="top-bottom")
+    r = solve(ib, texts, layout="top-bottom", inside=False)
     assert is_clean(r.metrics) and r.metrics["leaders_through_labels"] == 0
     assert r.metrics["labelling_rate"] == 1.0, r.unplaced
     moved = [lab for lab in r.labels if (lab.side == "south") != (lab.endpoint[1] > lab.anchor[1])]
@@ -789,7 +799,9 @@ def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
     monkeypatch.setattr(
         labeling.pipeline, "place_boxes", lambda *a, **kw: boxes.place_boxes(*a[:10], (), **kw)
     )
-    assert [name for _, name in solve(ib, texts, layout="top-bottom").unplaced] == ["alternator"]
+    assert [name for _, name in solve(ib, texts, layout="top-bottom", inside=False).unplaced] == [
+        "alternator"
+    ]
 
 
 def test_endpoint_towards_each_side_of_a_rectangle():
@@ -915,3 +927,45 @@ def test_orbit_coherence_counts_jumps_and_side_changes(buffers):
     lab.side = "east" if lab.side == "west" else "west"
     m = orbit_coherence([a, b])
     assert m["jumps"] == 1 and m["side_changes"] == 1 and m["jumpy_transitions"] == 1
+
+
+def _long_names() -> Soup:
+    parts = []
+    for i in range(8):
+        m = trimesh.creation.box(extents=(0.5, 0.5, 0.5))
+        m.apply_translation((i * 0.6 - 2.1, 0, 0))
+        parts.append(Soup(m.vertices, m.faces, part_names=[f"a rather long part name number {i}"]))
+    return Soup.concatenate(parts)
+
+
+@pytest.mark.parametrize("layout", ["left-right", "top-bottom", "silhouette"])
+def test_boxes_stay_inside_the_image(layout, monkeypatch):
+    """Long names in a small image: the font shrinks, then labels are left out, never off the image."""
+    from meshvis.labeling import pipeline
+
+    soup = _long_names()
+    cam = fit_camera(soup, up=(0, 0, 1), size=(320, 160))
+    r = labeling.layout(soup, cam, size=(320, 160), layout=layout)
+    assert r.metrics["outside_image"] == 0 and is_clean(r.metrics)
+    assert r.font_size < labeling.pipeline.default_font_size(160)
+    left_out = r.params["outside_image"]
+    assert left_out and sorted(left_out) == sorted(n for _, n in r.unplaced)
+    assert len(r.labels) + len(left_out) == 8
+    # with the camera fitted by layout(), it moves back and leaves out fewer labels
+    zoomed = labeling.layout(soup, size=(320, 160), layout=layout, up=(0, 0, 1))
+    assert zoomed.metrics["outside_image"] == 0 and len(zoomed.params["outside_image"]) <= len(left_out)
+    if layout != "top-bottom":  # a row of flags is as wide whatever the distance
+        assert len(zoomed.params["outside_image"]) < len(left_out)
+    # without the rule the same layout puts boxes off the image
+    monkeypatch.setattr(pipeline, "_inside_image", lambda place, style, size: (style, place(style), []))
+    assert labeling.layout(soup, cam, size=(320, 160), layout=layout).metrics["outside_image"] > 0
+
+
+def test_portrait_images_fit_the_model_across(scene):
+    """The camera fits the horizontal field of view of a portrait image: no model pixel on its sides."""
+    r = labeling.layout(scene, size=(120, 360), up=(0, 0, 1))
+    ids = r.ids
+    assert (ids[:, 0] < 0).all() and (ids[:, -1] < 0).all()
+    wide = fit_camera(scene, size=(360, 120), up=(0, 0, 1))
+    tall = fit_camera(scene, size=(120, 360), up=(0, 0, 1))
+    assert np.linalg.norm(tall.position - tall.target) > 2.5 * np.linalg.norm(wide.position - wide.target)

@@ -174,3 +174,17 @@ def test_a_converted_model_keeps_its_parts(tmp_path):
     live = LiveLabeler(soup)
     scene = trimesh.load(trimesh.util.wrap_as_stream(model_glb(live, None)), file_type="glb")
     assert sorted(scene.geometry) == ["ball", "crate"]
+
+
+def test_notebook_widget_frames_the_page():
+    pytest.importorskip("anywidget")
+    from meshvis.labeling.widget import view
+
+    w = view(ASSEMBLY, layout="silhouette", width=640, height=400, up=(0, 0, 1))
+    try:
+        assert w.url == w.server.url and (w.width, w.height) == (640, 400)
+        assert "iframe" in w._esm
+        with urllib.request.urlopen(w.url + "scene.json", timeout=10) as res:
+            assert json.loads(res.read())["layout"] == "silhouette"
+    finally:
+        w.server.shutdown()
