@@ -46,6 +46,7 @@ def add_parser(sub) -> None:
         "labeling",
         "labeling-sweep",
         "labeling-orbit",
+        "labeling-page",
         "compare",
         "scale",
         "orientation",

@@ -115,7 +115,7 @@ def _fit_font(
 #: hysteresis along a camera path: a label keeps last frame's anchor (followed on the
 #: surface) unless a candidate is more than ANCHOR_KEEP times as feasible, and keeps its
 #: side unless the other side's leader is shorter by more than the factor SIDE_KEEP
-ANCHOR_KEEP = 2.0
+ANCHOR_KEEP = 4.0
 SIDE_KEEP = 3.0
 #: how far an anchor may slide over its part from one frame to the next, as a fraction of
 #: ``d_S`` (and at least ANCHOR_DRIFT_PX): it creeps towards better places instead of jumping

@@ -18,6 +18,7 @@ EXTRA_OF = {
     "distributed": "dask",
     "networkx": "graphml",
     "anywidget": "notebook",
+    "playwright.sync_api": "browser",
 }
 
 

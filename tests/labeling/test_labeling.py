@@ -781,7 +781,6 @@ def test_silhouette_crowded_small_views_place_every_label_near(azimuth, elevatio
 def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
     """top-bottom at azimuth 270: the alternator's leader to the top crosses others; it goes down."""
     import meshvis.labeling.pipeline  # noqa: F401  (makes labeling.pipeline an attribute)
-
     from meshvis.labeling import greedy
 
     # the view needs the anchors of Eq. 14's literal order (largest areas first)
