@@ -9,7 +9,7 @@ from ..geometry2d import boxes_overlap, segment_hits_box, segments_intersect
 from ..internal_area import InternalArea
 from .context import Context
 from .search import _search
-from .silhouette import _place_ring
+from .silhouette import _keep_previous, _place_ring
 from .spacing import BoxStats, Placement, Spacing
 from .stacking import _place_column, _place_row
 
@@ -47,6 +47,25 @@ def _conflicting(ctx: Context) -> list[int]:
         i, j = ids[a], ids[b]
         redo.add(i if ctx.rank[i] > ctx.rank[j] else j)
     return sorted(redo, key=lambda i: (ctx.rank[i], i))
+
+
+def _place_radial(ctx: Context, ring: np.ndarray, endpoints_in: np.ndarray) -> None:
+    """Silhouette boxes: keep last frame's valid boxes (hysteresis), search places for the others.
+
+    When that leaves a label without room, every box of the ring is searched for afresh
+    (the search still prefers the places the boxes had, :data:`~.costs.COHERENCE_COST`).
+    """
+    state = (ctx.stats.shifted, ctx.stats.swaps, len(ctx.stats.unplaced))
+    kept = _keep_previous(ctx, ring)
+    _place_ring(ctx, ring[~np.isin(ring, kept)])
+    if kept and len(ctx.stats.unplaced) > state[2]:
+        ctx.stats.shifted, ctx.stats.swaps = state[:2]
+        del ctx.stats.unplaced[state[2] :]
+        for k in ring:
+            ctx.placed[k] = None
+        ctx.endpoints[ring] = endpoints_in[ring]
+        ctx._rays = None
+        _place_ring(ctx, ring)
 
 
 def place_boxes(
@@ -109,11 +128,12 @@ def place_boxes(
         centres,
         lines,
     )
+    endpoints_in = ctx.endpoints.copy()
     for side in (WEST, EAST):
         _place_column(ctx, np.flatnonzero(ctx.sides == side), side)
     for side in (NORTH, SOUTH):
         _place_row(ctx, np.flatnonzero(ctx.sides == side), side)
-    _place_ring(ctx, np.flatnonzero(ctx.sides == RADIAL))
+    _place_radial(ctx, np.flatnonzero(ctx.sides == RADIAL), endpoints_in)
     for _ in range(REPAIR_ROUNDS):
         redo = _conflicting(ctx)
         if not redo:

@@ -10,7 +10,7 @@ import numpy as np
 
 from ..geometry2d import boxes_overlap, polyline_length, segment_hits_box
 from ._kernels import first_free
-from .collisions import _outside_image, _place, _placed_arrays
+from .collisions import _boxes_free, _leaders_free, _outside_image, _place, _placed_arrays
 from .context import NEAR_REACH, Context
 from .costs import BEHIND_PORT_COS, BEHIND_PORT_COST, BLOCKED_RAY_COST, COHERENCE_COST, OUTSIDE_IMAGE_COST
 from .stacking import pack_1d, uncross
@@ -295,6 +295,51 @@ def _run_order(ctx: Context, ring: np.ndarray) -> list[int]:
             order.extend(int(k) for k in dict.fromkeys((run[lo], run[hi])))
             lo, hi = lo + 1, hi - 1
     return order
+
+
+#: a box kept from the previous frame must hang off its leader within this angle of the
+#: boundary's outward normal at the leader's endpoint (cosine): not behind the leader
+KEEP_COS = 0.5
+
+
+def _keep_previous(ctx: Context, idx: np.ndarray) -> list[int]:
+    """Hysteresis of the silhouette layout: keep last frame's boxes where they are still valid.
+
+    Each label (in greedy order) whose box moved with its anchor (``ctx.centres``) still
+    covers no model pixel, no placed box or leader, stays inside the image, and can be
+    reached from this frame's endpoint through one of its attach points without crossing
+    a placed leader or the path of another label, is placed there.  Returns the labels
+    placed; the others go through the search.
+    """
+    known = [int(k) for k in idx if np.isfinite(ctx.centres[k, 0])]
+    if not known:
+        return []
+    kept: list[int] = []
+    insides = np.stack([ctx.anchors[idx], ctx.endpoints[idx]], axis=1)
+    for k in sorted(known, key=lambda k: (ctx.rank[k], k)):
+        half = np.array([ctx.widths[k] / 2, ctx.height / 2])
+        c = ctx.centres[k]
+        box = np.concatenate([c - half, c + half])[None]
+        if _outside_image(ctx, box)[0]:
+            continue
+        e, n = ctx.endpoints[k], ctx.ray_direction(k)
+        ports = c - _ATTACH * half  # the attach points of the box
+        d = ports - e
+        length = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-9)
+        facing = (d @ n) / length >= KEEP_COS
+        if not facing.any():
+            continue
+        port = ports[np.flatnonzero(facing)[np.argmin(length[facing])]]
+        leader = np.array([ctx.anchors[k], e, port])
+        pboxes, psegs = _placed_arrays(ctx, k)
+        if not _boxes_free(ctx, box, pboxes, psegs)[0]:
+            continue
+        others = insides[idx != k]
+        if not _leaders_free(leader[None], pboxes, psegs, others)[0]:
+            continue
+        _place(ctx, k, leader, box[0], 0, float(np.hypot(*(e - ctx.endpoints[k]))))
+        kept.append(k)
+    return kept
 
 
 def _place_in_order(ctx: Context, order: list[int]) -> list[int]:

@@ -968,3 +968,16 @@ def test_portrait_images_fit_the_model_across(scene):
     wide = fit_camera(scene, size=(360, 120), up=(0, 0, 1))
     tall = fit_camera(scene, size=(120, 360), up=(0, 0, 1))
     assert np.linalg.norm(tall.position - tall.target) > 2.5 * np.linalg.norm(wide.position - wide.target)
+
+
+@pytest.mark.parametrize("layout", list(labeling.LAYOUTS))
+def test_a_still_camera_keeps_its_layout(buffers, layout):
+    """Hysteresis: laid out again with itself as the previous frame, no label moves more than a pixel."""
+    soup, ib = buffers["assembly"]
+    texts = label_texts(soup.part_names)
+    first = solve(ib, texts, layout=layout)
+    again = solve(ib, texts, layout=layout, previous=first).by_part()
+    assert set(again) == {lab.part for lab in first.labels}
+    for lab in first.labels:
+        assert lab.side == again[lab.part].side, (layout, lab.name)
+        assert np.abs(lab.box - again[lab.part].box).max() <= 1.0, (layout, lab.name)
