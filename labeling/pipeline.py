@@ -139,6 +139,7 @@ class _Previous:
         west/east, x for north/south; NaN on the other sides)
     side : (n,) int, side code (-1: absent)
     centre : (n, 2) float, the box centre
+    leader : n polylines (k, 2) (None: absent), the leader without its anchor point
     lines : (4,) float, the x of the west and east columns, the y of the north and south
         rows (NaN: no label there); not moved
     """
@@ -149,6 +150,7 @@ class _Previous:
     side: np.ndarray
     centre: np.ndarray
     lines: np.ndarray
+    leader: list
 
 
 def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n: int) -> _Previous:
@@ -156,6 +158,7 @@ def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n
     anchor, endpoint, box = np.full((n, 2), np.nan), np.full((n, 2), np.nan), np.full((n, 4), np.nan)
     side = np.full(n, -1, np.int64)
     centre = np.full((n, 2), np.nan)
+    leader: list = [None] * n
     lines = np.full(4, np.nan)
     for lab in previous.labels:
         code = SIDE_NAMES.index(lab.side)
@@ -166,7 +169,7 @@ def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n
             )
     labs = [lab for lab in previous.labels if lab.part < len(slot) and slot[lab.part] >= 0]
     if not labs:
-        return _Previous(anchor, endpoint, box, side, centre, lines)
+        return _Previous(anchor, endpoint, box, side, centre, lines, leader)
     h, w = idbuf.shape
     moved, _ = idbuf.camera.project(np.array([lab.anchor_3d for lab in labs], np.float64), w, h)
     for lab, now in zip(labs, moved):
@@ -176,10 +179,11 @@ def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n
         code = SIDE_NAMES.index(lab.side)
         side[s] = code
         centre[s] = 0.5 * (lab.box[:2] + lab.box[2:]) + delta
+        leader[s] = lab.leader[1:] + delta
         if code < 4:
             axis = 1 if code < 2 else 0
             box[s, code] = 0.5 * (lab.box[axis] + lab.box[axis + 2]) + delta[axis]
-    return _Previous(anchor, endpoint, box, side, centre, lines)
+    return _Previous(anchor, endpoint, box, side, centre, lines, leader)
 
 
 def _preferred_sides(idbuf: IdBuffer, labelled: np.ndarray, prev: _Previous | None) -> np.ndarray | None:
@@ -463,6 +467,7 @@ def _place_labels(
         prev_box,
         LAYOUTS[layout],
         centres=None if previous is None else previous.centre,
+        leaders=None if previous is None else previous.leader,
         lines=None if previous is None else previous.lines,
     )
     return rank, anchors, endpoints, placements, stats

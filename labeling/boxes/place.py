@@ -49,14 +49,14 @@ def _conflicting(ctx: Context) -> list[int]:
     return sorted(redo, key=lambda i: (ctx.rank[i], i))
 
 
-def _place_radial(ctx: Context, ring: np.ndarray, endpoints_in: np.ndarray) -> None:
+def _place_radial(ctx: Context, ring: np.ndarray, endpoints_in: np.ndarray, leaders: list | None) -> None:
     """Silhouette boxes: keep last frame's valid boxes (hysteresis), search places for the others.
 
     When that leaves a label without room, every box of the ring is searched for afresh
     (the search still prefers the places the boxes had, :data:`~.costs.COHERENCE_COST`).
     """
     state = (ctx.stats.shifted, ctx.stats.swaps, len(ctx.stats.unplaced))
-    kept = _keep_previous(ctx, ring)
+    kept = _keep_previous(ctx, ring, leaders)
     _place_ring(ctx, ring[~np.isin(ring, kept)])
     if kept and len(ctx.stats.unplaced) > state[2]:
         ctx.stats.shifted, ctx.stats.swaps = state[:2]
@@ -82,6 +82,7 @@ def place_boxes(
     directions: tuple[int, ...] | None = None,
     *,
     centres: np.ndarray | None = None,
+    leaders: list | None = None,
     lines: np.ndarray | None = None,
 ) -> tuple[list[Placement | None], BoxStats]:
     """Lay out the boxes and leaders of all labels of one frame.
@@ -102,6 +103,8 @@ def place_boxes(
         room on its side may move to another one of them
     centres : (n, 2) float, optional: each label's box centre in the previous frame moved
         with its anchor (NaN: none); silhouette boxes prefer places near it
+    leaders : n polylines or None, optional: each label's leader in the previous frame
+        moved with its anchor, without the anchor point; a silhouette box is kept with it
     lines : (4,) float, optional: the x of the west and east columns and the y of the north
         and south rows in the previous frame (NaN: none); a column or row stays there while
         that is still valid and not much farther out than needed
@@ -133,7 +136,7 @@ def place_boxes(
         _place_column(ctx, np.flatnonzero(ctx.sides == side), side)
     for side in (NORTH, SOUTH):
         _place_row(ctx, np.flatnonzero(ctx.sides == side), side)
-    _place_radial(ctx, np.flatnonzero(ctx.sides == RADIAL), endpoints_in)
+    _place_radial(ctx, np.flatnonzero(ctx.sides == RADIAL), endpoints_in, leaders)
     for _ in range(REPAIR_ROUNDS):
         redo = _conflicting(ctx)
         if not redo:

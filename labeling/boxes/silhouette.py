@@ -302,7 +302,22 @@ def _run_order(ctx: Context, ring: np.ndarray) -> list[int]:
 KEEP_COS = 0.5
 
 
-def _keep_previous(ctx: Context, idx: np.ndarray) -> list[int]:
+def _kept_leaders(ctx: Context, k: int, c: np.ndarray, half: np.ndarray, before: np.ndarray | None) -> list:
+    """Leaders a kept box may hang off: last frame's moved with the anchor, then one from this frame's endpoint."""
+    out = []
+    if before is not None:
+        out.append(np.vstack([ctx.anchors[k][None], before]))
+    e, n = ctx.endpoints[k], ctx.ray_direction(k)
+    ports = c - _ATTACH * half  # the attach points of the box
+    d = ports - e
+    length = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-9)
+    facing = (d @ n) / length >= KEEP_COS
+    if facing.any():
+        out.append(np.array([ctx.anchors[k], e, ports[np.flatnonzero(facing)[np.argmin(length[facing])]]]))
+    return out
+
+
+def _keep_previous(ctx: Context, idx: np.ndarray, leaders: list | None = None) -> list[int]:
     """Hysteresis of the silhouette layout: keep last frame's boxes where they are still valid.
 
     Each label (in greedy order) whose box moved with its anchor (``ctx.centres``) still
@@ -322,23 +337,16 @@ def _keep_previous(ctx: Context, idx: np.ndarray) -> list[int]:
         box = np.concatenate([c - half, c + half])[None]
         if _outside_image(ctx, box)[0]:
             continue
-        e, n = ctx.endpoints[k], ctx.ray_direction(k)
-        ports = c - _ATTACH * half  # the attach points of the box
-        d = ports - e
-        length = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-9)
-        facing = (d @ n) / length >= KEEP_COS
-        if not facing.any():
-            continue
-        port = ports[np.flatnonzero(facing)[np.argmin(length[facing])]]
-        leader = np.array([ctx.anchors[k], e, port])
         pboxes, psegs = _placed_arrays(ctx, k)
         if not _boxes_free(ctx, box, pboxes, psegs)[0]:
             continue
         others = insides[idx != k]
-        if not _leaders_free(leader[None], pboxes, psegs, others)[0]:
-            continue
-        _place(ctx, k, leader, box[0], 0, float(np.hypot(*(e - ctx.endpoints[k]))))
-        kept.append(k)
+        before = None if leaders is None else leaders[k]
+        for leader in _kept_leaders(ctx, k, c, half, before):
+            if _leaders_free(leader[None], pboxes, psegs, others)[0]:
+                _place(ctx, k, leader, box[0], 0, float(np.hypot(*(leader[1] - ctx.endpoints[k]))))
+                kept.append(k)
+                break
     return kept
 
 
