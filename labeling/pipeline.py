@@ -491,22 +491,42 @@ def _off_image(placements: list, size: tuple[int, int]) -> list[int]:
     ]
 
 
-def _inside_image(place, style: TextStyle, size: tuple[int, int]) -> tuple:
-    """Place the boxes, shrinking the font while a box would leave the image.
+def _inside_image(place, style: TextStyle, size: tuple[int, int], start: int | None = None) -> tuple:
+    """Place the boxes with the largest font (down to :data:`MIN_FONT_SIZE`) that keeps them in the image.
 
-    ``place(style)`` returns what :func:`_place_labels` does.  Below
-    :data:`MIN_FONT_SIZE` the boxes still outside are left out (the labels become
-    ``unplaced``; ``params["outside_image"]`` names them).  Returns the style used, the
-    placement and the indices of the labels left out for this reason.
+    ``place(style)`` returns what :func:`_place_labels` does.  The sizes are searched by
+    bisection (a smaller font never needs more room), starting from ``start`` (the previous
+    frame's size along a camera path, so that it stays while it fits).  The boxes still
+    outside at the smallest size are left out (the labels become ``unplaced``;
+    ``params["outside_image"]`` names them).  Returns the style used, the placement and
+    the indices of the labels left out for this reason.
     """
-    placed = place(style)
-    while _off_image(placed[3], size) and style.font_size > MIN_FONT_SIZE:
-        style = TextStyle(style.font_size - 1)
-        placed = place(style)
+    tried: dict[int, tuple] = {}
+
+    def fits(font: int) -> bool:
+        if font not in tried:
+            tried[font] = place(TextStyle(font))
+        return not _off_image(tried[font][3], size)
+
+    hi = style.font_size
+    lo = MIN_FONT_SIZE
+    if start is not None and lo <= start < hi and fits(start):
+        best = start
+    elif hi <= lo or fits(hi):
+        best = hi
+    elif not fits(lo):
+        best = lo
+    else:  # lo fits, hi does not
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            lo, hi = (mid, hi) if fits(mid) else (lo, mid)
+        best = lo
+    fits(best)
+    placed = tried[best]
     off = _off_image(placed[3], size)
     for k in off:
         placed[3][k] = None
-    return style, placed, off
+    return TextStyle(best), placed, off
 
 
 def _view_maps(
@@ -702,7 +722,8 @@ def solve(
         return _place_labels(px, order, st.box_widths(label_texts_), st, ia, (w, h), spacing, prev, layout)
 
     if inside:
-        style, placed, off_image = _inside_image(place, style, (w, h))
+        start = None if previous is None else int(previous.font_size)
+        style, placed, off_image = _inside_image(place, style, (w, h), start)
     else:
         placed, off_image = place(style), []
     rank, anchors, endpoints, placements, stats = placed

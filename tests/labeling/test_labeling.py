@@ -956,7 +956,9 @@ def test_boxes_stay_inside_the_image(layout, monkeypatch):
     if layout != "top-bottom":  # a row of flags is as wide whatever the distance
         assert len(zoomed.params["outside_image"]) < len(left_out)
     # without the rule the same layout puts boxes off the image
-    monkeypatch.setattr(pipeline, "_inside_image", lambda place, style, size: (style, place(style), []))
+    monkeypatch.setattr(
+        pipeline, "_inside_image", lambda place, style, size, start=None: (style, place(style), [])
+    )
     assert labeling.layout(soup, cam, size=(320, 160), layout=layout).metrics["outside_image"] > 0
 
 
