@@ -7,7 +7,8 @@ result, so that every layout is coherent with the one before it (appendix I, Eq.
 and the hysteresis of :mod:`meshvis.labeling.pipeline`).
 
 The ID buffer arrives as RGBA bytes: part ``i`` is the colour ``i + 1`` written as a
-24-bit number (red the low byte), background is black; WebGL reads rows bottom-up.
+24-bit number (red the low byte), background is black; WebGL reads rows bottom-up.  The
+page packs it to two bytes a pixel (``i + 1``) when the model has fewer than 65535 parts.
 
 >>> import trimesh
 >>> from meshvis.soup import Soup
@@ -44,7 +45,7 @@ MAX_VIEWERS = 16
 #: the largest ID buffer a frame may send (pixels per side)
 MAX_SIDE = 2048
 
-__all__ = ["LiveLabeler", "ids_from_rgba", "MAX_SIDE", "id_buffer"]
+__all__ = ["LiveLabeler", "ids_from_rgba", "ids_from_u16", "MAX_SIDE", "id_buffer"]
 
 
 def ids_from_rgba(data: bytes | bytearray | memoryview, width: int, height: int) -> np.ndarray:
@@ -80,6 +81,39 @@ def ids_from_rgba(data: bytes | bytearray | memoryview, width: int, height: int)
         )
     px = rgba.reshape(height, width, 4)[::-1].astype(np.int64)
     return px[..., 0] + (px[..., 1] << 8) + (px[..., 2] << 16) - 1
+
+
+def ids_from_u16(data: bytes | bytearray | memoryview, width: int, height: int) -> np.ndarray:
+    """Decode a part-ID buffer packed two bytes a pixel (part + 1, 0 = background), rows bottom-up.
+
+    Parameters
+    ----------
+    data : bytes, ``width * height * 2``, little-endian
+    width, height : int
+
+    Returns
+    -------
+    (height, width) int64, part id per pixel (top row first), -1 for background
+
+    Raises
+    ------
+    ParameterError
+        The size is out of range or does not match the data.
+
+    Examples
+    --------
+    >>> ids_from_u16(bytes([0, 0, 3, 0]), 2, 1).tolist()
+    [[-1, 2]]
+    """
+    width, height = int(width), int(height)
+    if not (1 <= width <= MAX_SIDE and 1 <= height <= MAX_SIDE):
+        raise ParameterError(f"ID buffer size must be 1..{MAX_SIDE} pixels a side, got {width} x {height}")
+    if len(data) != width * height * 2:
+        raise ParameterError(
+            f"ID buffer of {width} x {height} needs {width * height * 2} bytes, got {len(data)}"
+        )
+    v = np.frombuffer(data, "<u2")
+    return v.reshape(height, width)[::-1].astype(np.int64) - 1
 
 
 class LiveLabeler:

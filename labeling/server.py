@@ -11,8 +11,9 @@ Routes (all on 127.0.0.1 only):
                       coordinates: ``uint32`` vertex and face counts, ``float32`` vertices,
                       ``uint32`` faces, ``uint32`` part id per face
 ``POST /layout``      one frame: header ``X-Meshvis-Frame`` = JSON ``{"viewer", "seq", "width",
-                      "height", "camera": {"position", "target", "up", "fov"}}``, body = the
-                      ID buffer as RGBA bytes (:func:`meshvis.labeling.live.ids_from_rgba`);
+                      "height", "format", "camera": {"position", "target", "up", "fov"}}``, body =
+                      the ID buffer, ``"rgba"`` bytes (:func:`meshvis.labeling.live.ids_from_rgba`)
+                      or ``"u16"`` (:func:`meshvis.labeling.live.ids_from_u16`);
                       answers :func:`meshvis.labeling.live.frame_json`
 
 Requests are answered one at a time (one lock around the layout): a frame takes a few
@@ -35,7 +36,7 @@ import numpy as np
 from meshvis.errors import MeshvisError, ParameterError
 from meshvis.rays.camera import Camera
 
-from .live import MAX_SIDE, LiveLabeler, frame_json, ids_from_rgba
+from .live import MAX_SIDE, LiveLabeler, frame_json, ids_from_rgba, ids_from_u16
 
 #: the page and its scripts, inside the installed package
 WEB = Path(__file__).resolve().parent / "web"
@@ -174,7 +175,10 @@ class ViewServer:
         """Answer one ``POST /layout``."""
         t0 = time.perf_counter()
         width, height = int(header.get("width", 0)), int(header.get("height", 0))
-        ids = ids_from_rgba(body, width, height)
+        fmt = header.get("format", "rgba")
+        if fmt not in ("rgba", "u16"):
+            raise ParameterError(f"unknown ID buffer format {fmt!r}")
+        ids = (ids_from_u16 if fmt == "u16" else ids_from_rgba)(body, width, height)
         camera = _camera(header.get("camera"))
         with self._lock:
             result = self.live.frame(ids, camera, str(header.get("viewer", ""))[:64])
@@ -187,6 +191,9 @@ class ViewServer:
         server = self
 
         class Handler(BaseHTTPRequestHandler):
+            # keep-alive: the page's frames reuse one connection
+            protocol_version = "HTTP/1.1"
+
             def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - the base class's name
                 if server.verbose:
                     super().log_message(format, *args)
@@ -196,6 +203,9 @@ class ViewServer:
                 self.send_header("Content-Type", ctype)
                 self.send_header("Content-Length", str(len(data)))
                 self.send_header("Cache-Control", "no-store")
+                if status >= 400:  # the request's body may be unread: do not reuse the connection
+                    self.send_header("Connection", "close")
+                    self.close_connection = True
                 self.end_headers()
                 self.wfile.write(data)
 

@@ -23,6 +23,8 @@ const status = document.getElementById('status');
 const viewer = Math.random().toString(36).slice(2);
 
 const info = await (await fetch('scene.json')).json();
+// more parts than two bytes can number: send the RGBA read-out as it is
+const wide = info.parts.length >= 65535;
 const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1); // one canvas pixel per CSS pixel: the overlay's coordinates
 stage.appendChild(renderer.domElement);
@@ -49,6 +51,7 @@ idScene.background = new THREE.Color(0x000000);
 idScene.add(await idMesh());
 const idTarget = new THREE.WebGLRenderTarget(8, 8, { depthBuffer: true });
 let idPixels = new Uint8Array(0);
+let idPacked = new Uint16Array(0);
 
 async function idMesh() {
   const buf = await (await fetch('idmesh.bin')).arrayBuffer();
@@ -120,6 +123,9 @@ function renderIds() {
   renderer.render(idScene, camera);
   renderer.readRenderTargetPixels(idTarget, 0, 0, iw, ih, idPixels);
   renderer.setRenderTarget(null);
+  // two bytes a pixel (part + 1, 0 = background) instead of four: half the data to send
+  if (idPacked.length !== iw * ih) idPacked = new Uint16Array(iw * ih);
+  for (let i = 0, j = 0; i < idPacked.length; i++, j += 4) idPacked[i] = idPixels[j] | (idPixels[j + 1] << 8);
   return [iw, ih];
 }
 
@@ -130,7 +136,7 @@ async function requestLayout() {
   const [iw, ih] = renderIds();
   const t1 = performance.now();
   const header = {
-    viewer, seq: ++seq, width: iw, height: ih,
+    viewer, seq: ++seq, width: iw, height: ih, format: wide ? 'rgba' : 'u16',
     camera: {
       position: camera.position.toArray(), target: controls.target.toArray(),
       up: camera.up.toArray(), fov: camera.fov,
@@ -140,7 +146,7 @@ async function requestLayout() {
   stats.sent++;
   try {
     const res = await fetch('layout', {
-      method: 'POST', body: idPixels, headers: { 'X-Meshvis-Frame': JSON.stringify(header) },
+      method: 'POST', body: wide ? idPixels : idPacked, headers: { 'X-Meshvis-Frame': JSON.stringify(header) },
     });
     const answer = await res.json();
     if (!res.ok) throw new Error(answer.error);

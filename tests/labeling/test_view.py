@@ -14,7 +14,7 @@ import trimesh
 from meshvis.errors import ParameterError
 from meshvis.labeling.geometry2d import boxes_overlap
 from meshvis.labeling.idbuffer import id_buffer
-from meshvis.labeling.live import LiveLabeler, ids_from_rgba
+from meshvis.labeling.live import LiveLabeler, ids_from_rgba, ids_from_u16
 from meshvis.labeling.server import ViewServer, _static
 from meshvis.soup import Soup
 
@@ -44,6 +44,10 @@ def server(live):
 def test_rgba_round_trip():
     ids = np.array([[-1, 0, 1], [300, 70000, -1]])
     assert ids_from_rgba(_rgba(ids), 3, 2).tolist() == ids.tolist()
+    small = np.array([[-1, 0, 1], [300, 65000, -1]])
+    assert ids_from_u16(_u16(small), 3, 2).tolist() == small.tolist()
+    with pytest.raises(ParameterError):
+        ids_from_u16(b"\0" * 5, 3, 1)
     with pytest.raises(ParameterError):
         ids_from_rgba(b"\0" * 12, 3, 2)
     with pytest.raises(ParameterError):
@@ -82,9 +86,14 @@ def test_live_frames_are_coherent_per_viewer(live):
     live.forget("w")
 
 
-def _post(server, ids, cam, **extra):
+def _u16(ids: np.ndarray) -> bytes:
+    """The page's packed ID buffer: part + 1 in two bytes, rows bottom-up."""
+    return (ids + 1)[::-1].astype("<u2").tobytes()
+
+
+def _post(server, ids, cam, fmt="rgba", **extra):
     h, w = ids.shape
-    header = {"viewer": "t", "seq": 7, "width": w, "height": h, **extra}
+    header = {"viewer": "t", "seq": 7, "width": w, "height": h, "format": fmt, **extra}
     header["camera"] = {
         "position": cam.position.tolist(),
         "target": cam.target.tolist(),
@@ -92,7 +101,10 @@ def _post(server, ids, cam, **extra):
         "fov": cam.fov,
     }
     req = urllib.request.Request(
-        server.url + "layout", data=_rgba(ids), headers={"X-Meshvis-Frame": json.dumps(header)}, method="POST"
+        server.url + "layout",
+        data=_rgba(ids) if fmt == "rgba" else _u16(ids),
+        headers={"X-Meshvis-Frame": json.dumps(header)},
+        method="POST",
     )
     with urllib.request.urlopen(req, timeout=30) as res:
         return json.loads(res.read())
@@ -125,6 +137,8 @@ def test_server_serves_the_page_the_model_and_layouts(server, live):
     overlap = boxes_overlap(boxes, boxes)
     np.fill_diagonal(overlap, False)
     assert not overlap.any()
+    packed = _post(server, ids, cam, fmt="u16", viewer="packed")
+    assert [lab["box"] for lab in packed["labels"]] == [lab["box"] for lab in answer["labels"]]
 
 
 @pytest.mark.parametrize(
