@@ -202,3 +202,25 @@ def test_notebook_widget_frames_the_page():
             assert json.loads(res.read())["layout"] == "silhouette"
     finally:
         w.server.shutdown()
+
+
+@pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6)])
+def test_live_frames_do_not_change_under_scale_and_translation(scale, shift):
+    """The same view of the model scaled by 1e-6 or 1e6, or moved 1e6 away: the same labels."""
+    a, b = trimesh.creation.box(extents=(2.0, 1.0, 1.0)), trimesh.creation.icosphere(radius=0.6)
+    b.apply_translation((1.6, 0.0, 0.3))
+    parts = [Soup(a.vertices, a.faces, part_names=["crate"]), Soup(b.vertices, b.faces, part_names=["ball"])]
+    base = Soup.concatenate(parts)
+    moved = Soup.concatenate(
+        [Soup(p.vertices * scale + shift, p.faces, part_names=p.part_names) for p in parts]
+    )
+    out = []
+    for soup in (base, moved):
+        live = LiveLabeler(soup, up=(0, 0, 1))
+        cam = live.camera((160, 120))
+        r = live.frame(id_buffer(soup, cam, (160, 120)).ids, cam)
+        assert all(np.isfinite(lab.anchor_3d).all() for lab in r.labels)
+        out.append({lab.text: lab.box for lab in r.labels})
+    assert out[0].keys() == out[1].keys() == {"crate", "ball"}
+    for k in out[0]:
+        assert np.allclose(out[0][k], out[1][k], atol=1.0)
