@@ -25,7 +25,58 @@ The public API below is imported lazily, so that ``import meshvis`` stays fast.
 from __future__ import annotations
 
 import importlib
+import importlib.abc
+import importlib.util
+import os
+import sys
+from pathlib import Path
 from typing import Any
+
+
+def _set_numba_cache() -> None:
+    """Keep the compiled kernels in the user's cache folder, not next to the sources.
+
+    numba reads ``NUMBA_CACHE_DIR`` when it is imported (and again before each
+    compilation), so it is set here, before any kernel module imports numba.  A cache
+    beside the sources would be left behind in site-packages by ``pip uninstall`` and
+    shadow a later install.  A value the user set is kept.
+    """
+    if "NUMBA_CACHE_DIR" not in os.environ:
+        import platformdirs
+
+        os.environ["NUMBA_CACHE_DIR"] = os.path.join(platformdirs.user_cache_dir("meshvis"), "numba")
+
+
+class _SourceFolders(importlib.abc.MetaPathFinder):
+    """Find ``meshvis.cli`` and ``meshvis.labeling`` in a source checkout run without installing.
+
+    The repository keeps ``cli/`` and ``labeling/`` beside ``meshvis/``; an install maps
+    them into the package (pyproject's ``package-dir``).  Run from the checkout itself
+    (``python -m meshvis`` in its root), this finder does the same mapping.  It is asked
+    last, so an installed package always wins.
+    """
+
+    def __init__(self, root: Path):
+        self.folders = {f"meshvis.{name}": root / name for name in ("cli", "labeling")}
+
+    def find_spec(self, name, path=None, target=None):
+        folder = self.folders.get(name)
+        if folder is None:
+            return None
+        return importlib.util.spec_from_file_location(
+            name, folder / "__init__.py", submodule_search_locations=[str(folder)]
+        )
+
+
+def _map_source_folders() -> None:
+    root = Path(__file__).resolve().parent.parent
+    is_checkout = (root / "pyproject.toml").is_file() and (root / "cli" / "main.py").is_file()
+    if is_checkout and not any(isinstance(f, _SourceFolders) for f in sys.meta_path):
+        sys.meta_path.append(_SourceFolders(root))
+
+
+_set_numba_cache()
+_map_source_folders()
 
 from meshvis._version import __version__  # noqa: E402
 from meshvis.errors import (  # noqa: E402
