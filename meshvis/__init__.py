@@ -14,7 +14,8 @@ The package is layered; each subpackage uses only the ones above it in this list
 * :mod:`meshvis.eval` -- generated models with known answers, baselines, benchmarks;
 * :mod:`meshvis.cli` -- the ``meshvis`` command.
 
-The public API below is imported lazily, so that ``import meshvis`` stays fast.
+The public API below is imported lazily, so that ``import meshvis`` stays fast (it does not
+import numpy).
 
 >>> import meshvis
 >>> soup = meshvis.as_soup(([[0, 0, 0], [1, 0, 0], [0, 1, 0]], [[0, 1, 2]]))
@@ -29,7 +30,6 @@ import importlib.abc
 import importlib.util
 import os
 import sys
-from pathlib import Path
 from typing import Any
 
 
@@ -56,21 +56,23 @@ class _SourceFolders(importlib.abc.MetaPathFinder):
     last, so an installed package always wins.
     """
 
-    def __init__(self, root: Path):
-        self.folders = {f"meshvis.{name}": root / name for name in ("cli", "labeling")}
+    def __init__(self, root: str):
+        self.folders = {f"meshvis.{name}": os.path.join(root, name) for name in ("cli", "labeling")}
 
     def find_spec(self, name, path=None, target=None):
         folder = self.folders.get(name)
         if folder is None:
             return None
         return importlib.util.spec_from_file_location(
-            name, folder / "__init__.py", submodule_search_locations=[str(folder)]
+            name, os.path.join(folder, "__init__.py"), submodule_search_locations=[folder]
         )
 
 
 def _map_source_folders() -> None:
-    root = Path(__file__).resolve().parent.parent
-    is_checkout = (root / "pyproject.toml").is_file() and (root / "cli" / "main.py").is_file()
+    root = os.path.dirname(os.path.dirname(os.path.abspath(__file__)))
+    is_checkout = os.path.isfile(os.path.join(root, "pyproject.toml")) and os.path.isfile(
+        os.path.join(root, "cli", "main.py")
+    )
     if is_checkout and not any(isinstance(f, _SourceFolders) for f in sys.meta_path):
         sys.meta_path.append(_SourceFolders(root))
 
@@ -86,10 +88,10 @@ from meshvis.errors import (  # noqa: E402
     OutputError,
     ParameterError,
 )
-from meshvis.soup import Soup  # noqa: E402
 
 #: public name -> module that defines it
 _LAZY = {
+    "Soup": "meshvis.soup",
     "load": "meshvis.io",
     "save": "meshvis.io",
     "as_soup": "meshvis.io",
@@ -116,7 +118,6 @@ __all__ = [
     "ModelFormatError",
     "OutputError",
     "ParameterError",
-    "Soup",
     *_LAZY,
 ]
 

@@ -2,7 +2,8 @@
 
 Each command runs in a fresh process, the commands taking turns so that a change of the
 machine's load touches them alike; the table gives the median and the best of
-``--repeat`` runs of each, and the median's excess over bare ``python -c pass``.  The
+``--repeat`` runs of each, the median's excess over bare ``python -c pass``, and the
+median CPU time (user + system), which a busy machine inflates less than wall time.  The
 default model (100 triangles) makes the work itself negligible: what is left is the
 fixed cost of starting the interpreter, importing and setting up the compiled kernels.
 """
@@ -10,6 +11,7 @@ fixed cost of starting the interpreter, importing and setting up the compiled ke
 from __future__ import annotations
 
 import os
+import resource
 import statistics
 import subprocess
 import sys
@@ -70,11 +72,14 @@ def run(model: str, repeat: int = 5) -> dict:
         subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, check=True)
     load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
     seconds: dict[str, list[float]] = {name: [] for name in cmds}
+    cpu: dict[str, list[float]] = {name: [] for name in cmds}
     for _ in range(repeat):
         for name, cmd in cmds.items():
+            before = _children_cpu()
             t0 = time.perf_counter()
             subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, check=True)
             seconds[name].append(time.perf_counter() - t0)
+            cpu[name].append(_children_cpu() - before)
     median = {k: statistics.median(v) for k, v in seconds.items()}
     base = median["python -c pass"]
     return {
@@ -85,8 +90,15 @@ def run(model: str, repeat: int = 5) -> dict:
         "median": median,
         "best": {k: min(v) for k, v in seconds.items()},
         "over_python": {k: v - base for k, v in median.items()},
+        "cpu_median": {k: statistics.median(v) for k, v in cpu.items()},
         "target": TARGET_SECONDS,
     }
+
+
+def _children_cpu() -> float:
+    """User + system CPU seconds of the finished child processes (less sensitive to load than wall time)."""
+    use = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return use.ru_utime + use.ru_stime
 
 
 def format(r: dict) -> str:
@@ -94,11 +106,12 @@ def format(r: dict) -> str:
     load = "" if r["load"] is None else f", load average {r['load']:.2f}"
     lines = [
         f"start-up: {r['model']}, median of {r['repeat']} runs each{load}",
-        f"{'command':<22} {'median s':>9} {'best s':>8} {'over python s':>14}",
+        f"{'command':<22} {'median s':>9} {'best s':>8} {'over python s':>14} {'CPU s':>7}",
     ]
     for name in r["median"]:
         lines.append(
             f"{name:<22} {r['median'][name]:9.3f} {r['best'][name]:8.3f} {r['over_python'][name]:14.3f}"
+            f" {r['cpu_median'][name]:7.3f}"
         )
     over = r["over_python"]["meshvis info MODEL"]
     verdict = "met" if over <= r["target"] else "missed"
