@@ -137,3 +137,19 @@ def test_every_help_text_shows_its_default():
         if not flag and "default" not in text.lower()
     ]
     assert not missing
+
+
+def test_a_reused_classification_with_another_budget_says_so(recwarn):
+    """A classification made for orient gives the cut's sample points more rays than
+    remove_interior's own cut: the faces kept can differ, and a warning says why."""
+    from meshvis.eval import generators as g
+
+    soup = g.overlapping_solids(subdivisions=2, cell=0.4).soup  # intersecting: sample points
+    c = meshvis.classify(soup, seed=0)
+    with pytest.warns(UserWarning, match="rays_per_point=8"):
+        meshvis.remove_interior(soup, classification=c, seed=0)
+    same = meshvis.classify(soup, seed=0, rays_per_point=8)  # the budget of the removal's own cut
+    recwarn.clear()
+    kept = meshvis.remove_interior(soup, classification=same, seed=0).keep
+    assert not [w for w in recwarn if "rays_per_point" in str(w.message)]
+    np.testing.assert_array_equal(kept, meshvis.remove_interior(soup, seed=0).keep)
