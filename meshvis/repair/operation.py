@@ -175,10 +175,10 @@ def classify_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
 def check_options(op: str, options: Mapping[str, Any] | Any) -> None:
     """Refuse, before any work, the options and output paths that ``op`` would refuse later.
 
-    Checks the numbers of the classification, the regions (``from_region``), the up axis
-    and the formats of the outputs: a model output the writers know (one that can hold
-    layers for ``layers``), a picture format for ``preview``.  The file system is not
-    touched except to read a camera path file.
+    Checks the numbers of the classification, the regions (``from_region``), the up axis,
+    the formats of the outputs (a model output the writers know, one that can hold layers
+    for ``layers``, a picture format for ``preview``) and the extra that ``graphml`` needs.
+    The file system is not touched except to read a camera path file.
 
     Parameters
     ----------
@@ -193,6 +193,8 @@ def check_options(op: str, options: Mapping[str, Any] | Any) -> None:
         A bad number, region or up axis.
     OutputError
         An output whose extension names no format that can hold the result.
+    MissingExtraError
+        ``graphml`` without networkx installed.
     """
     from meshvis import _validate
     from meshvis.io.up_axis import up_vector
@@ -215,6 +217,10 @@ def check_options(op: str, options: Mapping[str, Any] | Any) -> None:
         check_format(o["removed"])
     if o["preview"]:
         check_image_format(o["preview"])
+    if op == "classify" and o["graphml"]:  # GraphML needs an extra: missing, it fails here
+        from meshvis._extras import import_extra
+
+        import_extra("networkx", "GraphML export (--graphml)")
 
 
 def _classify_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[dict, str]:
@@ -450,10 +456,6 @@ def run_operation(
     t0 = time.perf_counter()
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
     check_options(op, o)
-    if op == "classify" and o["graphml"]:  # fail before the classification, not after
-        from meshvis._extras import import_extra
-
-        import_extra("networkx", "GraphML export (--graphml)")
     tell = say or (lambda text: None)
     more = detail or (lambda text: None)
     up = up_vector(_up(o.get("up")), soup)  # of the preview
