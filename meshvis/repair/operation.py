@@ -129,12 +129,10 @@ def default_options(op: str) -> dict[str, Any]:
 def __getattr__(name: str) -> Any:
     # the two tables of defaults, built on first use (reading them imports the library)
     if name == "CLASSIFY_DEFAULTS":
-        return {k: v for k, v in default_options("classify").items()}
+        return default_options("classify")
     if name == "OPERATION_DEFAULTS":
-        return {
-            op: {k: v for k, v in default_options(op).items() if k not in default_options("classify")}
-            for op in OPERATIONS
-        }
+        shared = default_options("classify")
+        return {op: {k: v for k, v in default_options(op).items() if k not in shared} for op in OPERATIONS}
     raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
 
 
