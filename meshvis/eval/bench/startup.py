@@ -3,7 +3,8 @@
 Each command runs in a fresh process, the commands taking turns so that a change of the
 machine's load touches them alike; the table gives the median and the best of
 ``--repeat`` runs of each, the median's excess over bare ``python -c pass``, and the
-median CPU time (user + system), which a busy machine inflates less than wall time.  The
+median CPU time (user + system), which a busy machine inflates less than wall time.
+Then the steps of the start are timed one by one (CPU seconds) in fresh processes.  The
 default model (100 triangles) makes the work itself negligible: what is left is the
 fixed cost of starting the interpreter, importing and setting up the compiled kernels.
 """
@@ -49,6 +50,41 @@ def commands(model: str) -> dict[str, list[str]]:
     }
 
 
+#: the steps of a computing command's start, timed in CPU seconds inside one fresh process
+STEPS_CODE = """
+import json, sys, time
+steps, t = {}, time.process_time()
+def mark(name):
+    global t
+    now = time.process_time(); steps[name] = now - t; t = now
+import numpy; mark("numpy")
+import scipy.sparse.csgraph, scipy.spatial; mark("scipy (sparse graphs, k-d tree)")
+import numba; mark("numba, imported")
+import meshvis.cli.main, meshvis.geometry.diagnostics, meshvis.io; mark("meshvis modules")
+from meshvis.geometry._kernels import exact_groups
+exact_groups(numpy.zeros((1, 3), numpy.uint64), numpy.zeros(1, numpy.uint64))
+mark("numba, first compiled kernel called")
+from meshvis.geometry.diagnostics import diagnose
+diagnose(meshvis.io.load(sys.argv[1])); mark("the work of meshvis info")
+print(json.dumps(steps))
+"""
+
+
+def steps(model: str, repeat: int = 3) -> dict[str, float]:
+    """Median CPU seconds of each step of :data:`STEPS_CODE` over ``repeat`` fresh processes."""
+    import json
+
+    runs = [
+        json.loads(
+            subprocess.run(
+                [sys.executable, "-c", STEPS_CODE, model], capture_output=True, text=True, check=True
+            ).stdout
+        )
+        for _ in range(repeat)
+    ]
+    return {k: statistics.median(r[k] for r in runs) for k in runs[0]}
+
+
 def run(model: str, repeat: int = 5) -> dict:
     """Time every command of :func:`commands` ``repeat`` times, taking turns.
 
@@ -91,6 +127,7 @@ def run(model: str, repeat: int = 5) -> dict:
         "best": {k: min(v) for k, v in seconds.items()},
         "over_python": {k: v - base for k, v in median.items()},
         "cpu_median": {k: statistics.median(v) for k, v in cpu.items()},
+        "steps_cpu": steps(model),
         "target": TARGET_SECONDS,
     }
 
@@ -116,6 +153,8 @@ def format(r: dict) -> str:
     over = r["over_python"]["meshvis info MODEL"]
     verdict = "met" if over <= r["target"] else "missed"
     lines.append(f"meshvis info over python -c pass: {over:.3f} s (target <= {r['target']} s: {verdict})")
+    lines.append("steps of a computing command's start (CPU s, median of 3 fresh processes):")
+    lines += [f"  {name:<40} {sec:6.3f}" for name, sec in r["steps_cpu"].items()]
     return "\n".join(lines)
 
 
