@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import argparse
 
-from .common import positive_int, say
+from .common import positive_int, say, verbosity_options
 
 
 def add_parser(sub) -> None:
@@ -48,8 +48,7 @@ def add_parser(sub) -> None:
         help=f"parts with fewer visible pixels are not labelled (default {MIN_PIXELS})",
     )
     p.add_argument("--no-browser", action="store_true", help="do not open the page in a browser")
-    p.add_argument("--verbose", action="store_true", help="print every request")
-    p.add_argument("--quiet", "-q", action="store_true")
+    verbosity_options(p)  # --verbose prints every request
     p.set_defaults(func=run)
 
 

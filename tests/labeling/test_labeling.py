@@ -69,7 +69,7 @@ def models(scene):
     out = [("scene", scene, (0, 0, 1))]
     assembly = os.path.join(ROOT, "models", "assembly.obj")
     if os.path.exists(assembly):
-        out.append(("assembly", load_models(assembly), (0, 0, 1)))
+        out.append(("assembly", load_models(assembly), (0, 1, 0)))  # the bundled files are y-up
     else:  # the generator is the source of the file
         from meshvis.eval.generators import assembly as make_assembly
 
@@ -767,7 +767,7 @@ def test_silhouette_crowded_small_views_place_every_label_near(azimuth, elevatio
     """~30 labels around a model 60 px wide: all placed, none sent far off (once up to 7 d_S)."""
     path = os.path.join(ROOT, "models", "assembly.obj")
     soup = load_models(path)
-    cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=(0, 0, 1))
+    cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=(0, 1, 0))  # the bundled files are y-up
     ib = id_buffer(soup, cam, (192, 192))
     for method in ("fuzzy", "two-step"):
         r = solve(ib, label_texts(soup.part_names), layout="silhouette", method=method, inside=False)
@@ -786,7 +786,7 @@ def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
     # the view needs the anchors of Eq. 14's literal order (largest areas first)
     monkeypatch.setattr(greedy, "_priority", lambda S, f5w, count: count - S @ f5w)
     soup = load_models(os.path.join(ROOT, "models", "assembly.obj"))
-    ib = id_buffer(soup, fit_camera(soup, azimuth=270.0, elevation=20.0, up=(0, 0, 1)), (512, 512))
+    ib = id_buffer(soup, fit_camera(soup, azimuth=270.0, elevation=20.0, up=(0, 1, 0)), (512, 512))
     texts = label_texts(soup.part_names)
     r = solve(ib, texts, layout="top-bottom", inside=False)
     assert is_clean(r.metrics) and r.metrics["leaders_through_labels"] == 0
@@ -877,7 +877,7 @@ def test_planted_defect_checks_fail_on_a_blind_metric(buffers, monkeypatch, brok
 def _orbit_coherence(scene_soup, coherence):
     from meshvis.labeling.metrics import orbit_coherence
 
-    cams = orbit(scene_soup, 72, up=(0, 0, 1))[:13]  # 12 steps of 5 degrees
+    cams = orbit(scene_soup, 72, up=(0, 1, 0))[:13]  # 12 steps of 5 degrees; the bundled files are y-up
     return orbit_coherence(
         layout_frames(scene_soup, cams, layout="left-right", size=(256, 256), coherence=coherence)
     )

@@ -31,7 +31,7 @@ def _rgba(ids: np.ndarray) -> bytes:
 
 @pytest.fixture(scope="module")
 def live():
-    return LiveLabeler(ASSEMBLY, layout="left-right", up=(0, 0, 1))
+    return LiveLabeler(ASSEMBLY, layout="left-right")  # the model's own up axis (y: an OBJ file)
 
 
 @pytest.fixture(scope="module")
@@ -194,7 +194,7 @@ def test_notebook_widget_frames_the_page():
     pytest.importorskip("anywidget")
     from meshvis.labeling.widget import view
 
-    w = view(ASSEMBLY, layout="silhouette", width=640, height=400, up=(0, 0, 1))
+    w = view(ASSEMBLY, layout="silhouette", width=640, height=400)
     try:
         assert w.url == w.server.url and (w.width, w.height) == (640, 400)
         assert "iframe" in w._esm

@@ -42,7 +42,7 @@ def page(tmp_path_factory):
     playwright = pytest.importorskip("playwright.sync_api")
     assert shutil.which(CHROMIUM) or os.path.exists(CHROMIUM), f"{CHROMIUM} not installed"
     proc = subprocess.Popen(
-        [sys.executable, "-m", "meshvis", "view", ASSEMBLY, "--port", "0", "--no-browser", "--up", "z"],
+        [sys.executable, "-m", "meshvis", "view", ASSEMBLY, "--port", "0", "--no-browser"],
         stdout=subprocess.PIPE,
         stderr=subprocess.PIPE,
         text=True,

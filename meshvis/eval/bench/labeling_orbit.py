@@ -32,6 +32,7 @@ from meshvis.labeling.idbuffer import id_buffer
 from meshvis.labeling.inputs import label_texts, load_models
 from meshvis.labeling.metrics import orbit_coherence
 from meshvis.labeling.pipeline import fit_camera, solve, warm_up
+from meshvis.rays.camera import model_up
 from meshvis.rays.caster import RayCaster
 
 from .cases import machine, machine_lines
@@ -165,7 +166,7 @@ def run(
             )
     if timing_layouts:
         soup, path = default_model()
-        ib, azimuth = _busiest_view(soup, size, (0.0, 0.0, 1.0))
+        ib, azimuth = _busiest_view(soup, size, model_up(soup))
         result["timing_view"] = {"model": path, "azimuth": azimuth, "elevation": 20.0}
         result["timing"] = _timing(soup, ib, timing_layouts, counts, repeat)
         say(f"timing done on {path} at azimuth {azimuth}")

@@ -213,7 +213,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     """
     parser.add_argument("model", nargs="?", default=os.path.join("models", "assembly.obj"))
     parser.add_argument("--layout", choices=tuple(LAYOUTS), default="left-right")
-    parser.add_argument("--up", choices=("auto", "x", "y", "z"), default="z")
+    parser.add_argument("--up", choices=("auto", "x", "y", "z"), default="auto")
     parser.add_argument("--seconds", type=float, default=10.0, help="how long to turn (default 10)")
     parser.add_argument("--step", type=float, default=1.0, help="degrees per step (default 1)")
     parser.add_argument("--gif", metavar="FILE", help="also record the page while it turns")
