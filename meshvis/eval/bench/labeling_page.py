@@ -61,7 +61,7 @@ def run(
     interval: float = 33.0,
     viewport: tuple[int, int] = (800, 600),
     gif: str | None = None,
-    gif_frames: int = 72,
+    gif_frames: int = 36,
     chromium: str = CHROMIUM,
     profile: str | None = None,
 ) -> dict[str, Any]:
@@ -166,18 +166,25 @@ def _stats(values: list) -> list[float]:
 
 
 def _write_gif(frames: list[bytes], path: str) -> None:
-    """The screenshots as an animated GIF at half size, written atomically."""
-    from PIL import Image
+    """The screenshots as an animated GIF, cropped to what is drawn (48 colours), written atomically."""
+    from PIL import Image, ImageChops
 
     from meshvis.io import atomic_write
 
-    images = []
-    for png in frames:
-        im = Image.open(io.BytesIO(png)).convert("RGB")
-        im = im.resize((im.width * 3 // 4, im.height * 3 // 4), Image.Resampling.LANCZOS)
-        images.append(im.convert("P", palette=Image.Palette.ADAPTIVE))
+    images = [Image.open(io.BytesIO(png)).convert("RGB") for png in frames]
+    white = Image.new("RGB", images[0].size, (255, 255, 255))
+    boxes = [ImageChops.difference(im, white).getbbox() for im in images]
+    boxes = [b for b in boxes if b]
+    if boxes:  # the union of the drawn parts, plus a margin (the status line included)
+        pad = 8
+        x0, y0 = min(b[0] for b in boxes) - pad, min(b[1] for b in boxes) - pad
+        x1, y1 = max(b[2] for b in boxes) + pad, max(b[3] for b in boxes) + pad
+        images = [im.crop((max(x0, 0), max(y0, 0), min(x1, im.width), min(y1, im.height))) for im in images]
+    pal = [im.convert("P", palette=Image.Palette.ADAPTIVE, colors=48) for im in images]
     with atomic_write(path, "wb") as fh:
-        images[0].save(fh, format="GIF", save_all=True, append_images=images[1:], duration=120, loop=0)
+        pal[0].save(
+            fh, format="GIF", save_all=True, append_images=pal[1:], duration=150, loop=0, optimize=True
+        )
 
 
 def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' common name
@@ -216,7 +223,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--up", choices=("auto", "x", "y", "z"), default="auto")
     parser.add_argument("--seconds", type=float, default=10.0, help="how long to turn (default 10)")
     parser.add_argument("--step", type=float, default=1.0, help="degrees per step (default 1)")
-    parser.add_argument("--gif", metavar="FILE", help="also record the page while it turns")
+    parser.add_argument("--gif", metavar="FILE", help="also record a full turn of the page")
+    parser.add_argument("--gif-frames", type=int, default=36, help="steps of the recorded turn (default 36)")
     parser.add_argument("--chromium", default=CHROMIUM, help=f"the browser (default {CHROMIUM})")
     parser.add_argument("--json", metavar="FILE", help="also write the numbers as JSON")
 
@@ -241,6 +249,7 @@ def main(args: argparse.Namespace) -> int:
         seconds=args.seconds,
         step=args.step,
         gif=args.gif,
+        gif_frames=args.gif_frames,
         chromium=args.chromium,
     )
     return report(result, format(result), args.json)
