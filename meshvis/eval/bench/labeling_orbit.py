@@ -188,6 +188,8 @@ def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' co
         f"{'model':11s} {'layout':11s} {'labels':>6s} {'motion':>7s} {'free':>6s} {'jumpy':>9s} {'free':>9s} "
         f"{'jumps':>5s} {'sides':>5s} {'overl':>5s} {'cross':>5s} {'out':>4s} {'ms med':>7s} {'ms max':>7s}",
     ]
+    if not result["orbits"]:
+        lines = lines[:-3]
     for name, per in result["orbits"].items():
         for layout, e in per.items():
             c, f = e["coherent"], e["free"]
