@@ -135,7 +135,7 @@ def layers(
     visibility: str = DEFAULT_LAYER_VISIBILITY,
     region="outside",
     budget: int | None = None,
-    up=(0.0, 0.0, 1.0),
+    up=None,
     transparent: str = DEFAULT_TRANSPARENT,
     classification: Classification | None = None,
     progress=None,
@@ -156,8 +156,8 @@ def layers(
         Where viewers may be (by sight; see :func:`meshvis.parse_region`).
     budget : int, optional
         Ray budget of each layer's search (by sight; default :func:`meshvis.visible_from`'s).
-    up : (3,) float
-        Up direction of an ``"upper-hemisphere"`` region.
+    up : None, "x", "y", "z" or (3,) float
+        Up direction of an ``"upper-hemisphere"`` region; None: the model's own (``Soup.up``).
     transparent : {"see-through", "opaque"}
         Whether faces of see-through materials let sight through (by sight).
     classification : Classification, optional

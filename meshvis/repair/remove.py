@@ -34,6 +34,7 @@ around kept ones.  Every input face ends up in exactly one of the two outputs, w
 from __future__ import annotations
 
 import inspect
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -53,6 +54,7 @@ from meshvis.repair.remove_modes import (
     LEVELS,
     VISIBILITY_MODES,
     cut_rays_per_point,
+    reuse_note,
 )
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, parse_region, visible_from
@@ -137,14 +139,19 @@ class RemovalResult:
 
     def summary(self) -> list[str]:
         """The console lines: what was kept and removed, how the search stopped, the self-check."""
-        lines = [f"kept {int(self.keep.sum())}, removed {int((~self.keep).sum())} of {len(self.keep)} faces"]
+        clear = (
+            f"; {self.see_through} faces of see-through materials let sight through"
+            if self.see_through
+            else ""
+        )
+        lines = [
+            f"kept {int(self.keep.sum())}, removed {int((~self.keep).sum())} of {len(self.keep)} faces{clear}"
+        ]
         if self.visibility is not None and self.visibility.stopped == "budget":
             lines.append(
                 f"the search for views stopped at its ray budget ({self.visibility.rays['total']} rays) "
                 "before its stop rule: some removed faces may be visible (raise --budget)"
             )
-        if self.see_through:
-            lines.append(f"{self.see_through} faces of see-through materials let sight through")
         if self.check is not None:
             lines.append(self.check.summary())
         return lines
@@ -159,7 +166,7 @@ def remove_interior(
     level: str = "face",
     keep_border: int = 0,
     budget: int | None = None,
-    up=(0.0, 0.0, 1.0),
+    up=None,
     view: Visibility | None = None,
     transparent: str = DEFAULT_TRANSPARENT,
     check_rays: int = CHECK_RAYS,
@@ -170,7 +177,9 @@ def remove_interior(
     Parameters
     ----------
     model : anything :func:`meshvis.classify` accepts
-    classification : reuse an existing classification of the same model (``"object"``, ``"both"``)
+    classification : reuse an existing classification of the same model (``"object"``,
+        ``"both"``; in ``"both"``, one whose sample points got another ray budget than this
+        function's own cut gives them is used as it is, with a warning: the faces kept can differ)
     visibility : {"view", "object", "both"}
         Sight from ``region`` alone (default
         :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`), the graph cut alone, or
@@ -184,8 +193,9 @@ def remove_interior(
     budget : int, optional
         Ray budget of the from-region search (default: :func:`meshvis.visible_from`'s cap;
         its stop rule ends it).  A search stopped by the budget says so in the report.
-    up : (3,) float
-        Up direction of an ``"upper-hemisphere"`` region.
+    up : None, "x", "y", "z" or (3,) float
+        Up direction of an ``"upper-hemisphere"`` region; None: the model's own
+        (``Soup.up``: y for glTF and OBJ files, z otherwise).
     view : Visibility, optional
         Reuse a from-region search of the same model (``"view"`` only).
     transparent : {"see-through", "opaque"}
@@ -240,6 +250,9 @@ def remove_interior(
         code = np.where(keep, _KEPT_SEEN, _GONE_VIEW)
     else:
         c = classification or classify(model, **_cut_keywords(visibility, classify_kw))
+        note = reuse_note(c.params, visibility) if classification is not None else None
+        if note:
+            warnings.warn(note, stacklevel=2)
         soup = c.soup
         caster = _sight_caster(c, transparent)
         by_cut = _kept_by_cut(c)

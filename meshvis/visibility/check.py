@@ -20,9 +20,9 @@ import time
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
-import numpy as np
-
 if TYPE_CHECKING:
+    import numpy as np
+
     from meshvis.visibility.regions import Region
 
 #: random rays from each removed face
@@ -113,6 +113,8 @@ def self_check(
     >>> check.faces, int(check.seen.sum())
     (1, 1)
     """
+    import numpy as np
+
     from meshvis.visibility.sampling import random_seeds  # the ray tracer: not for the defaults
 
     start = time.perf_counter()

@@ -6,8 +6,8 @@ blended or cut-out materials) does not hide what lies behind it: with ``transpar
 rays are traced against, so sight passes it, and it is still seen itself (seed rays start
 on it).  ``"opaque"`` treats it as a wall like any other face.
 
-Kept apart from :mod:`.visible` so that the command line reads the choices without
-loading the ray tracer.
+Kept apart from :mod:`.visible`, and free of numpy at import, so that the command line
+reads the choices without loading numerical modules.
 
 >>> import numpy as np
 >>> from meshvis.soup import Material, Soup
@@ -18,9 +18,12 @@ loading the ray tracer.
 
 from __future__ import annotations
 
-import numpy as np
+from typing import TYPE_CHECKING
 
 from meshvis.errors import ParameterError
+
+if TYPE_CHECKING:
+    import numpy as np
 
 #: how see-through materials are treated by sight: they let it through, or they are walls
 TRANSPARENT_MODES = ("see-through", "opaque")
