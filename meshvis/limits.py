@@ -23,6 +23,12 @@ MAX_INSTANCED_FACES = 50_000_000
 #: of the graph cut grow with the square of the corners (a 4,000-corner fan: 0.8 GB, 23 s);
 #: real n-gons (cylinder caps, CAD outlines) stay in the hundreds
 MAX_POLYGON_CORNERS = 4_096
+#: face pairs the intersection tests compare (pairs whose boxes overlap, the copies of a
+#: face set aside), per face: real models have tens (a 1.3 M-face city of the shared real
+#: models 43); distinct faces stacked in one place make the pairs grow with their square
+MAX_FACE_PAIRS_PER_FACE = 2_048
+#: ... or this many, whatever the faces (a few seconds of work)
+MIN_FACE_PAIRS = 1 << 26
 #: rays per node of the graph cut (default 32); memory grows with nodes x rays
 MAX_RAYS_PER_NODE = 65_536
 #: rays of one classification (all rounds; each ray takes about 110 bytes while its round

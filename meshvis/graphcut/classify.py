@@ -459,6 +459,7 @@ def _nodes(
         scheme=scheme,
         offset=off_abs,
         proximity=2 * off_abs,
+        duplicate_first=pre.analysis.duplicate_first,
     )
     point_note = (
         f"{nodes.n_points} sample points" if nodes.n_points else "skipped point nodes: no flagged faces"
