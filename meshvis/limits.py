@@ -31,8 +31,17 @@ MAX_FACE_PAIRS_PER_FACE = 2_048
 MIN_FACE_PAIRS = 1 << 26
 #: rays per node of the graph cut (default 32); memory grows with nodes x rays
 MAX_RAYS_PER_NODE = 65_536
-#: rays of one classification (all rounds; each ray takes about 110 bytes while its round
-#: runs): the monastery (125 k faces) casts 4 M at the defaults
+#: rays a classification may ask for, per byte of its input (the file, or the arrays of a
+#: model given in memory).  What it asks for is bounded before any work: every face flagged,
+#: 2 sides x ``samples_per_face`` x ``rays_per_point`` rays and as many reverse rays, or
+#: 2 x ``rays_per_node``, whichever is more (512 per face at the defaults).  A 47 MB binary
+#: PLY of a 1.34 M-face city of real models may ask for 3 G rays, asks for at most 686 M,
+#: and casts 38 M; a 1 KB glTF that places a million faces is refused before its analysis
+RAYS_PER_INPUT_BYTE = 64
+#: ... or this many, whatever the input (about 20 s of rays on two cores)
+MIN_RAY_CAP = 1 << 24
+#: most rays of the default budget of the from-region search
+#: (:func:`meshvis.visibility.visible.default_budget`); an explicit budget may be larger
 MAX_RAYS = 100_000_000
 #: sample points per intersecting or coplanar face (default 4)
 MAX_SAMPLES_PER_FACE = 1_024

@@ -348,6 +348,10 @@ def classify(
         raise ParameterError("tolerance must be in [0, 1)")
     hints = Hints.coerce(hints)
     soup = as_soup(model)
+    if rays_per_point is None:
+        rays_per_point = rays_per_node
+    # what the options may ask of this input is bounded before the analysis runs
+    _validate.ray_budget(soup, rays_per_node, rays_per_point, samples_per_face)
     rng = np.random.default_rng(seed)
     stages: list[Stage] = []
     report = progress or (lambda stage, frac: None)
@@ -359,8 +363,6 @@ def classify(
     loop = _Sampling(
         caster, nodes, soup, pre.degenerate, rng, hint_out, hint_in, use_filter, opening, solver, report
     )
-    if rays_per_point is None:
-        rays_per_point = rays_per_node
     loop.run(rays_per_node, rays_per_point, progressive, tolerance)
     stages += loop.stages(use_filter)
     report("done", 1.0)
@@ -498,7 +500,6 @@ class _Sampling:
         """Cast rounds of rays and cut after each until the labels settle (module notes)."""
         nodes = self.nodes
         budget = ray_allocation(nodes, rays_per_node, rays_per_point)
-        _validate.ray_budget(int(budget.sum()), nodes.n, rays_per_node)
         cast = np.zeros(nodes.n, np.int64)
         if progressive:
             give = ray_allocation(

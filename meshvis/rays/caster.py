@@ -24,6 +24,7 @@ slower.  ``meshvis bench rays`` measures all three side by side.
 from __future__ import annotations
 
 import copy
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -49,6 +50,9 @@ VISIBILITY_OFFSET = 1e-6
 #: threads pay (the monastery's from-region search traces 114 batches of 4-32 k rays;
 #: docs/performance.md, "Ray backend")
 CHUNK = 1 << 11
+#: rays traced by every caster of this process and the seconds Embree took (read by the
+#: benchmarks: ``meshvis bench scale --real`` reports them per command)
+RAYS = {"rays": 0, "seconds": 0.0}
 
 
 def _used_bounds(soup, firsts: np.ndarray) -> np.ndarray:
@@ -210,7 +214,10 @@ class RayCaster:
                 np.ascontiguousarray(o32[a:b]), np.ascontiguousarray(d32[a:b]), query=query, **kw
             )
 
+        t = time.perf_counter()
         parts = in_threads(call, n, threads=self.threads, rows=CHUNK)
+        RAYS["rays"] += n
+        RAYS["seconds"] += time.perf_counter() - t
         if len(parts) == 1:
             return parts[0]
         if query == "INTERSECT":

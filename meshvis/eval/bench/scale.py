@@ -1,5 +1,7 @@
 """``meshvis bench scale``: time, peak memory and per-stage times of classify from 20 k to 5 M faces.
 
+With ``--real``, the commands on cities of real models instead (:mod:`meshvis.eval.bench.scale_real`).
+
 The generated models are an icosphere subdivided ``5 .. 9`` times (20,480 .. 5,242,880 faces,
 4x per step), made into a soup by :func:`meshvis.eval.generators.soupify` (30 % of the faces
 turned over, every face its own corners, shuffled).  Real models are the largest of
@@ -43,6 +45,9 @@ def add_arguments(p) -> None:
     add_models_argument(p)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", metavar="FILE")
+    from meshvis.eval.bench import scale_real
+
+    scale_real.add_arguments(p)
 
 
 def generated(subdivisions: int, seed: int = 0):
@@ -213,9 +218,13 @@ def format(results: list[dict], header: bool = True) -> str:
 
 
 def main(args) -> int:
-    """CLI entry of ``meshvis bench scale``."""
+    """CLI entry of ``meshvis bench scale`` (``--real``: :func:`meshvis.eval.bench.scale_real.main`)."""
     from meshvis.eval.bench.real_models import models_folder
 
+    if args.real:
+        from meshvis.eval.bench import scale_real
+
+        return scale_real.main(args)
     specs = [f"ico:{n}" for n in args.sizes]
     if not args.no_real:
         base = os.path.dirname(os.path.abspath(models_folder(args.models_dir)))

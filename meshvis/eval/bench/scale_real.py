@@ -1,0 +1,308 @@
+"""``meshvis bench scale --real``: the commands on cities of real models, 1 M to 10 M faces.
+
+A *city* is a grid of the shared real models (:data:`CITY_MODELS`, from ``real/`` and
+``real2/``), each scaled to unit diagonal and turned at random, one model per grid cell
+(1.2 diagonals apart), in turn until the faces reach the size asked for: intersecting and
+coincident parts, hidden interiors, open sheets and twin faces, as real assets have them.
+The city is written as a binary PLY; every command then runs on it in a fresh process
+(``python -m meshvis ...``, its defaults), so that each time is end to end (start-up,
+reading, analysis, rays, writing) and each peak memory (``VmHWM``) is that command's alone.
+
+Next to each command, the *floor*: raw Embree (``embreex``, no meshvis code) builds the
+same scene in float32 and casts as many random rays from the faces as the command cast
+(:data:`meshvis.rays.caster.RAYS`), from a random side of random faces in cosine-distributed
+directions; above :data:`FLOOR_RAYS` rays the cast is timed on that many and scaled.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+
+#: the models a city is built of (relative to the shared models' folder ``..``), in turn
+CITY_MODELS = (
+    "real/pybullet__samurai_monastry.obj",
+    "real2/so101_arm_assembly.ply",
+    "real2/zdm2_level.glb",
+    "real2/pandora_level.obj",
+    "real2/dutch_ship.glb",
+    "real2/van_gogh_room.glb",
+    "real2/mannequiny.glb",
+    "real/dm_control__BONERibcage.stl",
+    "real2/ferrari348_lowpoly.glb",
+    "real/CesiumMilkTruck.glb",
+)
+#: faces of the default cities
+SIZES = (1_000_000, 5_000_000, 10_000_000)
+#: the commands run on every city, with their arguments after the input (OUT: an output file)
+COMMANDS = {
+    "info": [],
+    "orient": ["-o", "OUT.ply"],
+    "remove-interior": ["-o", "OUT.ply"],
+    "layers": ["-o", "OUT.ply"],
+    "visible": ["--report", "OUT.json"],
+}
+#: grid spacing of the city, in model diagonals
+SPACING = 1.2
+#: rays of the floor's timed cast at most (the rest is scaled from it)
+FLOOR_RAYS = 1 << 24
+
+
+def add_arguments(p) -> None:
+    """Add the options of ``meshvis bench scale --real`` to ``p`` (``meshvis bench scale``'s parser)."""
+    p.add_argument("--real", action="store_true", help="the commands on cities of the real models")
+    p.add_argument(
+        "--faces",
+        type=float,
+        nargs="*",
+        default=[float(s) for s in SIZES],
+        help="with --real: faces of each city (default 1e6 5e6 1e7)",
+    )
+    p.add_argument(
+        "--commands", nargs="*", default=list(COMMANDS), help="with --real: the commands to run (default all)"
+    )
+
+
+def city(faces: int, folder: str, seed: int = 0):
+    """A city of about ``faces`` faces (at least that many) of the real models in ``folder``.
+
+    Parameters
+    ----------
+    faces : int
+        Faces to reach; the last model placed may pass it.
+    folder : str
+        The shared models' folder (holding ``real/`` and ``real2/``).
+    seed : int
+        Seed of the turns.
+
+    Returns
+    -------
+    Soup
+        One part per placed model, named after it.
+
+    Examples
+    --------
+    >>> import os
+    >>> if os.path.isdir("../shared/models/real2"):
+    ...     assert city(10_000, "../shared/models").n_faces >= 10_000
+    """
+    import numpy as np
+    from scipy.spatial.transform import Rotation
+
+    from meshvis.io import load
+    from meshvis.soup import Soup
+
+    rng = np.random.default_rng(seed)
+    models, vertices, faces_list, parts, names = [], [], [], [], []
+    n = placed = n_vertices = 0
+    while n < faces:
+        k = placed % len(CITY_MODELS)
+        if k == len(models):
+            s = load(os.path.join(folder, CITY_MODELS[k]))
+            lo, hi = s.bounds
+            models.append(((s.vertices - 0.5 * (lo + hi)) / np.linalg.norm(hi - lo), s.faces))
+        v, f = models[k]
+        turn = Rotation.random(random_state=int(rng.integers(1 << 31))).as_matrix()
+        per_row = max(2, int(np.ceil(np.sqrt(faces / 100_000))))
+        at = SPACING * np.array([placed % per_row, placed // per_row, 0.0])
+        vertices.append(v @ turn.T + at)
+        faces_list.append(f + n_vertices)
+        parts.append(np.full(len(f), placed))
+        names.append(f"{os.path.splitext(os.path.basename(CITY_MODELS[k]))[0]}_{placed}")
+        n_vertices += len(v)
+        n += len(f)
+        placed += 1
+    return Soup(
+        np.concatenate(vertices), np.concatenate(faces_list), part_id=np.concatenate(parts), part_names=names
+    )
+
+
+def stage(argv: list[str], out: str) -> None:
+    """Run ``meshvis ARGV`` in this process and write its exit status, peak memory and rays to ``out``.
+
+    Run as a child of :func:`run` (``python -c``): the child's start-up and imports count in
+    the parent's time, the peak memory is the child's own.
+    """
+    from meshvis.cli.main import main
+    from meshvis.eval.bench.scale import peak_mb
+    from meshvis.rays import caster
+
+    t = time.perf_counter()
+    status = main(argv)
+    record = {
+        "status": status,
+        "seconds_in_process": time.perf_counter() - t,
+        "peak_mb": peak_mb(),
+        "rays": caster.RAYS["rays"],
+        "embree_seconds": caster.RAYS["seconds"],
+    }
+    with open(out, "w") as fh:
+        json.dump(record, fh)
+
+
+def floor(path: str, rays: list[int], seed: int = 0) -> dict:
+    """Raw Embree on the model at ``path``: seconds to build its scene and to cast each ray count.
+
+    The scene is the model's triangles in float32 (centred and scaled like meshvis' scene);
+    the rays start just off a random side of random faces, cosine-distributed about its
+    normal (as the classification's), in batches of 2**20, in threads like meshvis'.  Returns ``build_seconds`` and ``cast_seconds``
+    (one per entry of ``rays``; counts above :data:`FLOOR_RAYS` are timed on that many and
+    scaled).
+    """
+    import embreex.mesh_construction as mc
+    import embreex.rtcore_scene as rs
+    import numpy as np
+
+    from meshvis._threads import in_threads
+    from meshvis.io import load
+
+    soup = load(path)
+    lo, hi = soup.bounds
+    t = time.perf_counter()
+    v = ((soup.vertices - 0.5 * (lo + hi)) / np.linalg.norm(hi - lo)).astype(np.float32)
+    scene = rs.EmbreeScene()
+    mc.TriangleMesh(scene, v, soup.faces.astype(np.int32))
+    scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))  # builds the BVH
+    build = time.perf_counter() - t
+    normals = soup.normals
+    rng = np.random.default_rng(seed)
+    batch = 1 << 20
+    out = []
+    for count in rays:
+        timed = min(count, FLOOR_RAYS)
+        spent = 0.0
+        for start in range(0, timed, batch):
+            k = min(batch, timed - start)
+            f = rng.integers(0, soup.n_faces, k)
+            w = rng.random((k, 2))
+            w = np.where(w.sum(axis=1, keepdims=True) > 1, 1 - w, w)
+            tri = v[soup.faces[f]]
+            up = normals[f] * rng.choice([-1.0, 1.0], (k, 1))  # a random side of the face
+            o = tri[:, 0] + w[:, :1] * (tri[:, 1] - tri[:, 0]) + w[:, 1:] * (tri[:, 2] - tri[:, 0])
+            o = (o + 1e-5 * up).astype(np.float32)
+            # cosine-distributed about the side's normal, like the rays of the classification
+            d = rng.normal(size=(k, 3))
+            d = up + d / np.linalg.norm(d, axis=1, keepdims=True)
+            d = (d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)).astype(np.float32)
+            t = time.perf_counter()
+            in_threads(lambda a, b, o=o, d=d: scene.run(o[a:b], d[a:b], output=1), k, rows=1 << 11)
+            spent += time.perf_counter() - t
+        out.append(spent * count / timed if timed else 0.0)
+    return {"build_seconds": build, "cast_seconds": out, "faces": soup.n_faces}
+
+
+def run(sizes: list[int], commands: list[str], folder: str, seed: int = 0) -> list[dict]:
+    """Build each city, run each command on it in a fresh process, and measure the floor.
+
+    Returns one dict per (city, command): ``faces``, ``command``, ``seconds`` (end to end),
+    ``peak_mb``, ``rays``, ``embree_seconds``, ``status``, the floor's ``floor_seconds``
+    (build + cast of as many rays) and the machine's ``load_average`` at the end.
+    """
+    from meshvis.io import save
+
+    results = []
+    with tempfile.TemporaryDirectory() as tmp:
+        for faces in sizes:
+            path = os.path.join(tmp, f"city{faces}.ply")
+            soup = city(int(faces), folder, seed)
+            n_faces = soup.n_faces
+            save(soup, path)
+            del soup
+            rows = []
+            for name in commands:
+                args = [a.replace("OUT", os.path.join(tmp, "out")) for a in COMMANDS[name]]
+                record = os.path.join(tmp, "stage.json")
+                argv = [name, path, *args, "--force", "--quiet"] if name != "info" else [name, path]
+                code = (
+                    "import sys; from meshvis.eval.bench.scale_real import stage; "
+                    f"stage({argv!r}, {record!r})"
+                )
+                t = time.perf_counter()
+                p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
+                seconds = time.perf_counter() - t
+                row = {"faces": n_faces, "command": name, "seconds": seconds}
+                if p.returncode or not os.path.exists(record):
+                    row["error"] = (p.stderr.strip().splitlines() or ["?"])[-1]
+                else:
+                    with open(record) as fh:
+                        row.update(json.load(fh))
+                    os.remove(record)
+                row["load_average"] = os.getloadavg()[0]
+                rows.append(row)
+                print(format([row], header=len(results) + len(rows) == 1), file=sys.stderr, flush=True)
+            fl = floor(path, [r.get("rays", 0) for r in rows], seed)
+            for r, cast in zip(rows, fl["cast_seconds"]):
+                r["floor_build_seconds"] = fl["build_seconds"]
+                r["floor_seconds"] = fl["build_seconds"] + cast
+            results += rows
+    return results
+
+
+def growth(results: list[dict]) -> dict[tuple[str, int], float]:
+    """Time growth per 4x faces of each command, from each city to the next larger one.
+
+    ``(t2 / t1) ** (log 4 / log(f2 / f1))``: the factor the time grows by when the faces
+    grow 4 times, at the rate measured between the two cities.
+    """
+    import math
+
+    out = {}
+    by_command: dict[str, list[dict]] = {}
+    for r in results:
+        if "error" not in r:
+            by_command.setdefault(r["command"], []).append(r)
+    for name, rows in by_command.items():
+        rows.sort(key=lambda r: r["faces"])
+        for a, b in zip(rows, rows[1:]):
+            if b["faces"] > a["faces"] and a["seconds"] > 0:
+                out[(name, b["faces"])] = (b["seconds"] / a["seconds"]) ** (
+                    math.log(4) / math.log(b["faces"] / a["faces"])
+                )
+    return out
+
+
+def format(results: list[dict], header: bool = True) -> str:
+    """A table: faces, command, seconds, growth per 4x faces, peak MB, rays, Embree seconds, floor."""
+    lines = []
+    if header:
+        lines.append(
+            f"{'faces':>10} {'command':<16} {'seconds':>8} {'x4':>5} {'peak MB':>8} {'rays':>11} "
+            f"{'embree s':>8} {'floor s':>8} {'load':>5}"
+        )
+    grow = growth(results)
+    for r in results:
+        if "error" in r:
+            lines.append(f"{r['faces']:>10} {r['command']:<16} failed: {r['error']}")
+            continue
+        g = grow.get((r["command"], r["faces"]))
+        fl = r.get("floor_seconds")
+        lines.append(
+            f"{r['faces']:>10} {r['command']:<16} {r['seconds']:>8.1f} {'' if g is None else f'{g:.2f}':>5} "
+            f"{r['peak_mb']:>8.0f} {r['rays']:>11} {r['embree_seconds']:>8.1f} "
+            f"{'' if fl is None else f'{fl:.1f}':>8} {r['load_average']:>5.1f}"
+        )
+    return "\n".join(lines)
+
+
+def main(args) -> int:
+    """CLI entry of ``meshvis bench scale --real``."""
+    from meshvis.eval.bench.real_models import models_folder
+
+    folder = os.path.dirname(os.path.abspath(models_folder(args.models_dir)))
+    unknown = [c for c in args.commands if c not in COMMANDS]
+    if unknown:
+        print(
+            f"meshvis: error: unknown command {unknown[0]!r}; choose from {', '.join(COMMANDS)}",
+            file=sys.stderr,
+        )
+        return 2
+    results = run([int(f) for f in args.faces], args.commands, folder, seed=args.seed)
+    print(format(results))
+    if args.json:
+        with open(args.json, "w") as fh:
+            json.dump(results, fh, indent=1)
+    return 0
