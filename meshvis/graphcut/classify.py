@@ -553,8 +553,14 @@ class _Sampling:
 
     def _sample(self, give: np.ndarray, cast: np.ndarray, budget: np.ndarray) -> None:
         t = time.perf_counter()
-        self.report("sampling", float(cast.sum()) / max(float(budget.sum()), 1.0))
-        sample_round(self.caster, self.nodes, give, self.rng, self.counts)
+        stage, total, done = f"sampling {len(self.rounds) + 1}", max(float(give.sum()), 1.0), [0]
+        self.report(stage, 0.0)
+
+        def step(rays: int) -> None:  # the progress of this round, batch by batch
+            done[0] += rays
+            self.report(stage, done[0] / total)
+
+        sample_round(self.caster, self.nodes, give, self.rng, self.counts, progress=step)
         self.t_sample += time.perf_counter() - t
 
     def _cut(self) -> None:
