@@ -8,10 +8,11 @@ The city is written as a binary PLY; every command then runs on it in a fresh pr
 (``python -m meshvis ...``, its defaults), so that each time is end to end (start-up,
 reading, analysis, rays, writing) and each peak memory (``VmHWM``) is that command's alone.
 
-Next to each command, the *floor*: raw Embree (``embreex``, no meshvis code) builds the
-same scene in float32 and casts as many random rays from the faces as the command cast
-(:data:`meshvis.rays.caster.RAYS`), from a random side of random faces in cosine-distributed
-directions; above :data:`FLOOR_RAYS` rays the cast is timed on that many and scaled.
+Next to each command, the *floor*: the seconds raw Embree (``embreex``, no meshvis code)
+takes to build the same scene in float32, plus the seconds Embree spent casting the
+command's own rays (:data:`meshvis.rays.caster.RAYS`, timed around each query).  Random rays
+are no substitute: rays cast from random faces of a city in cosine directions took 4-6
+times as long per ray as the commands' own.
 """
 
 from __future__ import annotations
@@ -48,8 +49,6 @@ COMMANDS = {
 }
 #: grid spacing of the city, in model diagonals
 SPACING = 1.2
-#: rays of the floor's timed cast at most (the rest is scaled from it)
-FLOOR_RAYS = 1 << 24
 
 
 def add_arguments(p) -> None:
@@ -144,20 +143,16 @@ def stage(argv: list[str], out: str) -> None:
         json.dump(record, fh)
 
 
-def floor(path: str, rays: list[int], seed: int = 0) -> dict:
-    """Raw Embree on the model at ``path``: seconds to build its scene and to cast each ray count.
+def floor_build_seconds(path: str) -> float:
+    """Seconds raw Embree takes to build the scene of the model at ``path`` (no meshvis code).
 
-    The scene is the model's triangles in float32 (centred and scaled like meshvis' scene);
-    the rays start just off a random side of random faces, cosine-distributed about its
-    normal (as the classification's), in batches of 2**20, in threads like meshvis'.  Returns ``build_seconds`` and ``cast_seconds``
-    (one per entry of ``rays``; counts above :data:`FLOOR_RAYS` are timed on that many and
-    scaled).
+    The triangles in float32, centred and scaled like meshvis' scene, one empty query to
+    build the BVH.
     """
     import embreex.mesh_construction as mc
     import embreex.rtcore_scene as rs
     import numpy as np
 
-    from meshvis._threads import in_threads
     from meshvis.io import load
 
     soup = load(path)
@@ -166,41 +161,16 @@ def floor(path: str, rays: list[int], seed: int = 0) -> dict:
     v = ((soup.vertices - 0.5 * (lo + hi)) / np.linalg.norm(hi - lo)).astype(np.float32)
     scene = rs.EmbreeScene()
     mc.TriangleMesh(scene, v, soup.faces.astype(np.int32))
-    scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))  # builds the BVH
-    build = time.perf_counter() - t
-    normals = soup.normals
-    rng = np.random.default_rng(seed)
-    batch = 1 << 20
-    out = []
-    for count in rays:
-        timed = min(count, FLOOR_RAYS)
-        spent = 0.0
-        for start in range(0, timed, batch):
-            k = min(batch, timed - start)
-            f = rng.integers(0, soup.n_faces, k)
-            w = rng.random((k, 2))
-            w = np.where(w.sum(axis=1, keepdims=True) > 1, 1 - w, w)
-            tri = v[soup.faces[f]]
-            up = normals[f] * rng.choice([-1.0, 1.0], (k, 1))  # a random side of the face
-            o = tri[:, 0] + w[:, :1] * (tri[:, 1] - tri[:, 0]) + w[:, 1:] * (tri[:, 2] - tri[:, 0])
-            o = (o + 1e-5 * up).astype(np.float32)
-            # cosine-distributed about the side's normal, like the rays of the classification
-            d = rng.normal(size=(k, 3))
-            d = up + d / np.linalg.norm(d, axis=1, keepdims=True)
-            d = (d / np.maximum(np.linalg.norm(d, axis=1, keepdims=True), 1e-12)).astype(np.float32)
-            t = time.perf_counter()
-            in_threads(lambda a, b, o=o, d=d: scene.run(o[a:b], d[a:b], output=1), k, rows=1 << 11)
-            spent += time.perf_counter() - t
-        out.append(spent * count / timed if timed else 0.0)
-    return {"build_seconds": build, "cast_seconds": out, "faces": soup.n_faces}
+    scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))
+    return time.perf_counter() - t
 
 
 def run(sizes: list[int], commands: list[str], folder: str, seed: int = 0) -> list[dict]:
     """Build each city, run each command on it in a fresh process, and measure the floor.
 
     Returns one dict per (city, command): ``faces``, ``command``, ``seconds`` (end to end),
-    ``peak_mb``, ``rays``, ``embree_seconds``, ``status``, the floor's ``floor_seconds``
-    (build + cast of as many rays) and the machine's ``load_average`` at the end.
+    ``peak_mb``, ``rays``, ``embree_seconds``, ``status``, ``floor_seconds`` (raw Embree's
+    build of the scene + ``embree_seconds``) and the machine's ``load_average`` at the end.
     """
     from meshvis.io import save
 
@@ -234,10 +204,10 @@ def run(sizes: list[int], commands: list[str], folder: str, seed: int = 0) -> li
                 row["load_average"] = os.getloadavg()[0]
                 rows.append(row)
                 print(format([row], header=len(results) + len(rows) == 1), file=sys.stderr, flush=True)
-            fl = floor(path, [r.get("rays", 0) for r in rows], seed)
-            for r, cast in zip(rows, fl["cast_seconds"]):
-                r["floor_build_seconds"] = fl["build_seconds"]
-                r["floor_seconds"] = fl["build_seconds"] + cast
+            build = floor_build_seconds(path)
+            for r in rows:
+                r["floor_build_seconds"] = build
+                r["floor_seconds"] = build + r.get("embree_seconds", 0.0)
             results += rows
     return results
 
