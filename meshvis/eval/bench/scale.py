@@ -22,6 +22,7 @@ import tempfile
 import time
 
 from meshvis.eval.bench.real_models import add_models_argument
+from meshvis.eval.bench.scale_real import peak_mb
 
 #: icosphere subdivisions of the generated sizes (20 k ... 5 M faces)
 SUBDIVISIONS = (5, 6, 7, 8, 9)
@@ -76,26 +77,6 @@ def raw_embree_seconds(soup) -> float:
     mc.TriangleMesh(scene, v, soup.faces.astype(np.int32))
     scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))
     return time.perf_counter() - t
-
-
-def peak_mb() -> float:
-    """Peak resident memory of this process, in MB.
-
-    ``VmHWM`` of ``/proc/self/status`` where there is one: Linux carries the parent's
-    resident size at the fork into the child's ``ru_maxrss`` across the ``exec``, so a child
-    started by a parent that had just built a 5 M-face soup reported the parent's peak.
-    ``VmHWM`` belongs to the child's own address space.  Elsewhere ``ru_maxrss``.
-    """
-    import resource
-
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) / 1024
-    except OSError:
-        pass
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def one(spec: str, seed: int) -> dict:

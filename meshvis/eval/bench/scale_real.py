@@ -120,27 +120,56 @@ def city(faces: int, folder: str, seed: int = 0):
     )
 
 
-def stage(argv: list[str], out: str) -> None:
-    """Run ``meshvis ARGV`` in this process and write its exit status, peak memory and rays to ``out``.
+def peak_mb() -> float:
+    """Peak resident memory of this process, in MB.
 
-    Run as a child of :func:`run` (``python -c``): the child's start-up and imports count in
-    the parent's time, the peak memory is the child's own.
+    ``VmHWM`` of ``/proc/self/status`` where there is one: Linux carries the parent's
+    resident size at the fork into the child's ``ru_maxrss`` across the ``exec``, so a child
+    started by a parent that had just built a 5 M-face soup reported the parent's peak.
+    ``VmHWM`` belongs to the child's own address space.  Elsewhere ``ru_maxrss``.
     """
-    from meshvis.cli.main import main
-    from meshvis.eval.bench.scale import peak_mb
+    import resource
+
+    try:
+        with open("/proc/self/status") as fh:
+            for line in fh:
+                if line.startswith("VmHWM:"):
+                    return int(line.split()[1]) / 1024
+    except OSError:
+        pass
+    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+
+
+def record(status: int, seconds: float, out: str) -> None:
+    """Write a finished command's exit status, seconds, peak memory and rays to ``out`` (JSON).
+
+    Called in the child process that ran the command (:data:`STAGE`), so that the peak
+    memory is the command's own and the rays those of its casters.
+    """
     from meshvis.rays import caster
 
-    t = time.perf_counter()
-    status = main(argv)
-    record = {
-        "status": status,
-        "seconds_in_process": time.perf_counter() - t,
-        "peak_mb": peak_mb(),
-        "rays": caster.RAYS["rays"],
-        "embree_seconds": caster.RAYS["seconds"],
-    }
     with open(out, "w") as fh:
-        json.dump(record, fh)
+        json.dump(
+            {
+                "status": status,
+                "seconds_in_process": seconds,
+                "peak_mb": peak_mb(),
+                "rays": caster.RAYS["rays"],
+                "embree_seconds": caster.RAYS["seconds"],
+            },
+            fh,
+        )
+
+
+#: the child process of one command: its start-up and imports count in the parent's time
+STAGE = (
+    "import sys, time\n"
+    "from meshvis.cli.main import main\n"
+    "from meshvis.eval.bench.scale_real import record\n"
+    "t = time.perf_counter()\n"
+    "status = main({argv!r})\n"
+    "record(status, time.perf_counter() - t, {out!r})\n"
+)
 
 
 def floor_build_seconds(path: str) -> float:
@@ -187,10 +216,7 @@ def run(sizes: list[int], commands: list[str], folder: str, seed: int = 0) -> li
                 args = [a.replace("OUT", os.path.join(tmp, "out")) for a in COMMANDS[name]]
                 record = os.path.join(tmp, "stage.json")
                 argv = [name, path, *args, "--force", "--quiet"] if name != "info" else [name, path]
-                code = (
-                    "import sys; from meshvis.eval.bench.scale_real import stage; "
-                    f"stage({argv!r}, {record!r})"
-                )
+                code = STAGE.format(argv=argv, out=record)
                 t = time.perf_counter()
                 p = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True)
                 seconds = time.perf_counter() - t
