@@ -32,6 +32,7 @@ import numpy as np
 
 from meshvis import _validate
 from meshvis._threads import default_threads, in_threads
+from meshvis.errors import ModelError
 from meshvis.geometry.adjacency import VertexGroups, group_vertices
 from meshvis.io import as_soup
 from meshvis.rays import _kernels
@@ -67,6 +68,32 @@ def _used_bounds(soup, firsts: np.ndarray) -> np.ndarray:
     if (lo == 0).any() or (hi == 0).any():
         return soup.bounds
     return np.stack([lo, hi])
+
+
+def _check_copies(corners: np.ndarray, n_groups: int, path: str | None) -> None:
+    """Refuse more than :data:`meshvis.limits.MAX_FACE_COPIES` copies of one triangle.
+
+    ``corners`` (m, 3) are the faces' vertex groups (bit-identical corners); a ray through a
+    stack of copies tests every one of them, so the work of every ray grows with the stack.
+    """
+    from meshvis import limits
+
+    if len(corners) <= limits.MAX_FACE_COPIES:
+        return
+    c = np.sort(corners.astype(np.int64), axis=1)
+    if n_groups < 2**21:  # one int64 key per sorted corner triple
+        key = (c[:, 0] * n_groups + c[:, 1]) * n_groups + c[:, 2]
+        key.sort()
+        starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1], True])
+        most = int(np.diff(starts).max())
+    else:
+        most = int(np.unique(c, axis=0, return_counts=True)[1].max())
+    if most > limits.MAX_FACE_COPIES:
+        raise ModelError(
+            f"{most} faces lie exactly on top of each other: a ray through them tests every one; "
+            f"more than the cap MAX_FACE_COPIES of meshvis.limits ({limits.MAX_FACE_COPIES})",
+            path,
+        )
 
 
 @dataclass
@@ -158,6 +185,7 @@ class RayCaster:
         # an extent beyond the float64 range (infinite diagonal) gives NaN: clamp it harmlessly
         v32[~np.isfinite(v32).all(axis=1)] = 0
         corners = groups.corner_groups(soup.faces, soup.n_vertices).astype(np.int32, copy=False)
+        _check_copies(corners, len(groups.first), soup.path)
         self._scene = rs.EmbreeScene()
         self._mesh = mc.TriangleMesh(self._scene, v32, corners)
 

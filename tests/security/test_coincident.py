@@ -129,6 +129,22 @@ def test_a_doubling_node_graph_of_coincident_cubes_in_bounded_memory(tmp_path):
     r = _limited_run(["info", path])
     assert r.returncode == 0, r.stderr
     assert f"{12 * 8192 - 12:,}" in r.stdout  # every cube but the first is a copy
+    # the commands that cast rays: one line at the scene, before the analysis (each ray
+    # through the stack would test all 8,192 copies: remove-interior took 10 minutes)
+    r = _limited_run(["remove-interior", path, "-o", str(tmp_path / "o.glb")])
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert "8192 faces lie exactly on top of each other" in r.stderr and "MAX_FACE_COPIES" in r.stderr
+    assert not (tmp_path / "o.glb").exists()
+
+
+def test_a_few_copies_of_a_face_are_cast_against():
+    import trimesh
+
+    ball = trimesh.creation.icosphere(1)
+    f = np.concatenate([ball.faces] * limits.MAX_FACE_COPIES)
+    assert meshvis.classify((ball.vertices, f), seed=0).hidden.sum() == 0
+    with pytest.raises(ModelError, match=f"{limits.MAX_FACE_COPIES + 1} faces lie exactly on top"):
+        meshvis.classify((ball.vertices, np.concatenate([f, ball.faces])), seed=0)
 
 
 def test_distinct_faces_stacked_in_one_place_are_refused(monkeypatch):
