@@ -5,14 +5,16 @@ random seed rays (more per face in every round); ``method="guided"`` then propag
 new sighting by adaptive border sampling and reverse sampling (GVS §3.4) until no new face
 turns up, ``method="random"`` does not (the baseline).  The first round visits the faces in
 a random order in chunks, so that faces found by propagation from an earlier chunk need no
-seed rays at all; later rounds go from the largest unseen face to the smallest in chunks of
-about a million rays.  After every chunk of the later rounds the stop rule looks at the rays
-since its last look (at least a million): they found fewer than ``min_new`` new faces per
-million rays (GVS §3.5) or less than ``min_new_area`` of the model's area per million rays.
-When it holds, the rest of the round (its smallest faces) is left out and the next round
-starts at the largest unseen faces with more rays each; the search stops when the rule holds
-again on that round's first window (:data:`CONFIRM_NEXT_ROUND`).  It also stops when every
-face is seen, or at the ray budget (by default only a cap: :func:`default_budget`).
+seed rays at all; later rounds visit the unseen faces in a random order in chunks of about a
+million rays, with view lines (GVS §3.1) cast between the chunks.  Two rules end the
+search.  The view lines' rule: fewer than ``max_unseen`` per million of the lines that hit
+the model first hit an unseen face (an estimate of the false pixels per million of removing
+the unseen faces).  The seed rays' rule (GVS §3.5): after a chunk, the rays since its last
+look (at least a million) found fewer than ``min_new`` new faces per million rays or less
+than ``min_new_area`` of the model's area per million rays; when it holds, the rest of the
+round is left out and it must hold again on the next round's first window
+(:data:`CONFIRM_NEXT_ROUND`), after which only the view lines go on.  The search also stops
+when every face is seen, or at the ray budget (by default only a cap: :func:`default_budget`).
 
 A seen side is certain (a free line of sight was traced); an unseen one is an upper bound on
 "hidden".
@@ -42,26 +44,20 @@ FIRST_ROUND_CHUNKS = 16
 MIN_NEW_PER_MILLION = 50.0
 #: ... or less new visible area than this fraction of the model's area per million rays.  What
 #: a viewer misses is area, not a face count: on finely tessellated models the faces found
-#: late are small and keep the count up after the area found has dried up, while faces seen
-#: through a rare gap are mostly large ones (zdm2_level), which the later rounds reach first
-#: (:func:`_round_order`).  At 1e-4 the search on the so101 assembly stopped with 77 false
-#: pixels per million (worst view 1,546); at 1e-5 it meets 30 / 300 (docs/benchmarks.md)
+#: late are small and keep the count up after the area found has dried up.  At 1e-4 the
+#: search on the so101 assembly stopped with 77 false pixels per million (worst view 1,546)
 MIN_NEW_AREA_PER_MILLION = 1e-5
 #: the stop rule must hold twice: at the end of a window, and again on the first window of the
-#: next round, which gives the largest unseen faces 4 x the seed rays (the rest of the round,
-#: its smallest faces, is left out).  A round goes from large faces to small ones, so the rule
-#: first holds part-way through a round, among its smaller faces, while large faces seen
-#: through rare gaps have had only that round's seeds: on the so101 assembly, the rule holding once, seed 0 stopped at 9.1 false
-#: pixels per million (16 of its 21 missed visible faces 165 to 1,504 x the median face area,
-#: after 256 seeds each) and seed 3 at 43.3; holding twice, seeds 0 to 3 end at 2.0 to 2.5
-#: with 1.03 to 1.41 x the rays (docs/benchmarks.md, "Seed spread of the default search")
+#: next round, which gives the faces still unseen 4 x the seed rays (the rest of the round is
+#: left out).  Holding once, on the so101 assembly seed 0 stopped at 9.1 false pixels per
+#: million and seed 3 at 43.3: large faces seen through rare gaps had had only that round's seeds
 CONFIRM_NEXT_ROUND = True
 #: the stop rule is judged over at least this many rays (GVS counts new faces per million
 #: rays) or, on small models, this many rays per face, whichever is fewer
 STOP_WINDOW = 1_000_000
 STOP_WINDOW_PER_FACE = 64
-#: seed rounds after the first are cast in chunks of about this many rays, largest faces
-#: first, and the stop rule is judged after every chunk: a round of 1,024 or 4,096 rays per
+#: seed rounds after the first are cast in chunks of about this many rays, in a random
+#: order, and the stop rule is judged after every chunk: a round of 1,024 or 4,096 rays per
 #: face would otherwise run to its end (tens of millions of rays) before the rule is asked,
 #: and a budget would cut it off at the faces of the lowest indices
 ROUND_CHUNK_RAYS = 1 << 20

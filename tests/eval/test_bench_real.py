@@ -65,7 +65,12 @@ def test_bench_real_judges_the_default_removal_at_every_seed_and_the_layers(tmp_
     assert r["default_over_object_time"] > 0 and curve.stat().st_size > 1000
     printed = capsys.readouterr().out
     assert "pins" in printed and "models meet every target" in printed
-    # a second run reads the cached estimate: same numbers
-    assert main(argv + ["--json", str(out)]) == 0
+    # a second run reads the cached estimate: same numbers; --default-only leaves out the rest
+    assert main(argv + ["--json", str(out), "--default-only"]) == 0
     again = json.loads(out.read_text())["results"][0]
     assert again["hidden_area"] == r["hidden_area"] and again["hidden_rays"] == r["hidden_rays"]
+    assert [x["false_pixels_mean"] for x in again["default"]] == [
+        x["false_pixels_mean"] for x in r["default"]
+    ]
+    assert not {"layers", "rows", "default_over_object_time"} & set(again)
+    assert "models meet every target" in capsys.readouterr().out
