@@ -12,7 +12,7 @@ from meshvis.io.report import write_report
 from meshvis.repair.operation import CLASSIFY_DEFAULTS, OPERATION_DEFAULTS
 from meshvis.repair.remove_modes import LEVELS, VISIBILITY_MODES
 
-from .common import check_output, point, positive_int, say, staged_outputs
+from .common import check_outputs, point, positive_int, say, staged_outputs
 
 
 def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
@@ -296,14 +296,15 @@ def run(args: argparse.Namespace) -> int:
     Raises
     ------
     ParameterError
-        Two outputs share one path, ``--per-face`` without ``--report``, or an option out of
-        its range.
+        ``--per-face`` without ``--report``, or an option out of its range.
     OutputError
-        An output path is refused (see :func:`meshvis.io.check_output`).
+        An output path is refused (see :func:`meshvis.io.check_outputs`): two outputs share
+        one path, or one would replace an input, its MTL or one of its textures.
     ModelError
         The model cannot be read (see :func:`meshvis.load`).
     """
     from meshvis.io import load
+    from meshvis.io.writing import check_not_read
 
     from .progress import stage_progress
 
@@ -319,16 +320,15 @@ def run(args: argparse.Namespace) -> int:
         )
         if x
     ]
-    if len(set(map(os.path.abspath, outputs))) != len(outputs):
-        raise ParameterError("two outputs share one path")
-    for path in outputs:
-        check_output(path, [args.input], args.force)
+    check_outputs(outputs, [args.input], args.force)
     if args.per_face and not args.report:
         raise ParameterError("--per-face needs --report")
     if args.report == "-":
         args.quiet = True  # standard output carries the report alone
     t0 = time.perf_counter()
     soup = load(args.input)
+    for path in outputs:  # nor over the MTL or a texture the model reads
+        check_not_read(path, soup)
     say(args, f"{args.input}: {soup.n_faces} faces, {soup.n_parts} parts")
     removed = getattr(args, "removed", None)
     # every output appears at the end, together, or none does (an error, Ctrl-C, SIGTERM)

@@ -4,7 +4,9 @@ from __future__ import annotations
 
 import argparse
 
-from .common import check_output, positive_int, say, write_json
+from meshvis.io.jsonfile import STDOUT
+
+from .common import check_outputs, positive_int, say, staged_outputs, write_json
 
 
 def add_parser(sub) -> None:
@@ -37,7 +39,11 @@ def add_parser(sub) -> None:
         "--up", choices=("auto", "x", "y", "z"), default="auto", help="up axis of upper-hemisphere"
     )
     p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--report", metavar="REPORT.json", help="write per-face results and the history")
+    p.add_argument(
+        "--report",
+        metavar="REPORT.json",
+        help="write per-face results and the history ('-': standard output)",
+    )
     p.add_argument(
         "--preview", metavar="PICTURE.png", help="the model with unseen faces in red, and them alone"
     )
@@ -80,9 +86,9 @@ def run(args: argparse.Namespace) -> int:
     from meshvis.visibility import visible_from
     from meshvis.visibility.preview import preview
 
-    for path in (args.report, args.preview):
-        if path:
-            check_output(path, [args.input], args.force)
+    check_outputs([p for p in (args.report, args.preview) if p and p != STDOUT], [args.input], args.force)
+    if args.report == STDOUT:
+        args.quiet = True  # standard output carries the report alone
     soup = load(args.input)
     vis = visible_from(
         soup,
@@ -99,9 +105,10 @@ def run(args: argparse.Namespace) -> int:
         f"{args.input}: {r['seen_faces']} of {r['faces']} faces seen ({100 * r['seen_area_fraction']:.1f} % of the area) "
         f"from {args.from_region}; {r['rays']['total']} rays, stopped: {r['stopped']}, {vis.seconds:.1f} s",
     )
-    if args.report:
-        r["input"] = args.input
-        write_json(args.report, r)
-    if args.preview:
-        save_png(preview(soup, vis), args.preview)
+    with staged_outputs():  # the report and the preview appear together or not at all
+        if args.preview:
+            save_png(preview(soup, vis), args.preview)
+        if args.report:
+            r["input"] = args.input
+            write_json(args.report, r)
     return 0

@@ -7,7 +7,7 @@ import sys
 from typing import Any
 
 from meshvis.errors import ParameterError
-from meshvis.io import check_output, staged_outputs  # noqa: F401  (re-exported for the commands)
+from meshvis.io import check_output, check_outputs, staged_outputs  # noqa: F401  (re-exported for the commands)
 from meshvis.io.jsonfile import write_json  # noqa: F401  (re-exported for the commands)
 
 
@@ -87,4 +87,13 @@ def stderr(*text: Any) -> None:
     print(*text, file=sys.stderr)
 
 
-__all__ = ["point", "check_output", "staged_outputs", "write_json", "say", "positive_int", "ParameterError"]
+__all__ = [
+    "point",
+    "check_output",
+    "check_outputs",
+    "staged_outputs",
+    "write_json",
+    "say",
+    "positive_int",
+    "ParameterError",
+]

@@ -7,6 +7,7 @@ pixel and its centre is at (0.5, 0.5).  The vertical field of view ``fov`` is in
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -56,6 +57,35 @@ def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, 
         return AXES[name]
     found = {FORMAT_UP.get(os.path.splitext(str(p))[1].lower(), FALLBACK_UP) for p in paths if p}
     return AXES[found.pop()] if len(found) == 1 else AXES[FALLBACK_UP]
+
+
+def up_vector(up: Any) -> np.ndarray:
+    """The up direction given as an axis name, as three numbers, or as None.
+
+    An axis name is ``"x"``, ``"y"`` or ``"z"``; None stands for :data:`FALLBACK_UP`.
+
+    Raises
+    ------
+    ParameterError
+        Anything else, or a zero or non-finite vector.
+
+    Examples
+    --------
+    >>> up_vector("y").tolist(), up_vector((0, 0, 2)).tolist()
+    ([0.0, 1.0, 0.0], [0.0, 0.0, 2.0])
+    """
+    if up is None:
+        up = FALLBACK_UP
+    if isinstance(up, str):
+        if up not in AXES:
+            raise ParameterError(f"up must be x, y, z or three numbers; got {up!r}")
+        return np.array(AXES[up])
+    v = _validate.points("up", up)
+    if len(v) != 1 or not np.any(v[0]):
+        raise ParameterError(
+            f"up must be one non-zero vector of three numbers; got {np.asarray(up).tolist()!r}"
+        )
+    return v[0]
 
 
 def model_up(model: Any) -> tuple[float, float, float]:
@@ -116,13 +146,19 @@ class Camera:
     ortho_height: float | None = None
 
     def __post_init__(self) -> None:
-        self.position = np.asarray(self.position, np.float64).reshape(3)
-        self.target = np.asarray(self.target, np.float64).reshape(3)
-        self.up = np.asarray(self.up, np.float64).reshape(3)
-        if not (np.isfinite(self.position).all() and np.isfinite(self.target).all()):
-            raise ParameterError("camera position and target must be finite")
+        for name in ("position", "target", "up"):
+            v = _validate.points(f"camera {name}", getattr(self, name))
+            if len(v) != 1:
+                raise ParameterError(f"camera {name} must be three numbers, got {len(v)} points")
+            setattr(self, name, v[0])
+        if not np.any(self.up):
+            raise ParameterError("camera up must not be zero")
+        self.fov = _validate.real("field of view", self.fov)
         if not 0 < self.fov < 180:
             raise ParameterError(f"field of view must be in (0, 180) degrees, got {self.fov}")
+        self.orthographic = _validate.flag("orthographic", self.orthographic)
+        if self.ortho_height is not None:
+            self.ortho_height = _validate.real("ortho_height", self.ortho_height, 0.0, open_lo=True)
 
     # ------------------------------------------------------------------ frame
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -237,10 +273,13 @@ class Camera:
         the model's up axis by the rule of :func:`model_up`.
         """
         azimuth, elevation = _validate.real("azimuth", azimuth), _validate.real("elevation", elevation)
+        if distance is not None:
+            distance = _validate.real("distance", distance, 0.0, open_lo=True)
+        margin = _validate.real("margin", margin, 0.0, open_lo=True)
         bounds = _bounds_of(model)
         center = bounds.mean(axis=0)
         radius = 0.5 * float(np.linalg.norm(bounds[1] - bounds[0])) or 1.0
-        up = _unit(np.asarray(model_up(model) if up is None else up, np.float64))
+        up = _unit(up_vector(model_up(model) if up is None else up))
         # a horizontal frame orthogonal to up; azimuth 0 views the model's "front": from +z
         # for y-up models (glTF, most OBJ), from -y for z-up models (CAD, STL)
         ref = np.array([0.0, 0.0, 1.0]) if abs(up[2]) < 0.9 else np.array([0.0, -1.0, 0.0])
@@ -277,12 +316,20 @@ class Camera:
         Raises
         ------
         ParameterError
-            ``d`` has a key that is not a camera field.
+            ``d`` is not an object with ``position`` and ``target``, has a key that is not
+            a camera field, or a value out of its range.
         """
+        if not isinstance(d, Mapping):
+            raise ParameterError(
+                f"a camera must be an object with position and target, got {type(d).__name__}"
+            )
         known = {"position", "target", "up", "fov", "orthographic", "ortho_height"}
-        unknown = set(d) - known
+        unknown = set(map(str, d)) - known
         if unknown:
             raise ParameterError(f"unknown camera keys: {', '.join(sorted(unknown))}")
+        missing = {"position", "target"} - set(d)
+        if missing:
+            raise ParameterError(f"the camera has no {' and no '.join(sorted(missing))}")
         return cls(**d)
 
 

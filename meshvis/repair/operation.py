@@ -217,6 +217,8 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
 
     r = layers(soup, classification=c, max_layers=o["max_layers"])
     n = int(r.layer.max())
+    if rebuilds_groups(o["output"]) and _same_format(soup, o["output"]):
+        _check_layer_paths(layer_paths(o["output"], n), o)
     names = [f"layer{k}" for k in range(1, n + 1)]
     groups = dict(face_groups=r.layer - 1, group_names=names, face_values={"layer": r.layer})
     edited = _save(soup, o["output"], tell, "one node or group per layer", **groups)
@@ -232,6 +234,27 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     if o["preview"]:
         save_png(render_layers(soup, r.layer, up=up), o["preview"])
     return report
+
+
+def _check_layer_paths(paths: list[str], o: dict) -> None:
+    """Refuse per-layer files that would be another output of the command, or its MTL.
+
+    The other outputs are ``--preview``, ``--report`` and so on; checked before anything is
+    written.
+    """
+    import os
+
+    from meshvis.errors import OutputError
+    from meshvis.io._common import companions
+
+    others = [p for k in (*OUTPUT_KEYS, "per_face") if k != "output" and (p := o.get(k)) and p != "-"]
+    taken = {os.path.realpath(q) for p in others for q in [p, *companions(p)]}
+    for path in paths:
+        for q in [path, *companions(path)]:
+            if os.path.realpath(q) in taken:
+                raise OutputError(
+                    "a file of one layer would be another output of the command; choose another path", q
+                )
 
 
 def _same_format(soup, path: str) -> bool:

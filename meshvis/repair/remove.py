@@ -157,7 +157,7 @@ def remove_interior(
     Raises
     ------
     ParameterError
-        Unknown mode or level, negative ``keep_border``.
+        Unknown mode or level, ``keep_border`` not an integer of at least 0, a budget below 1.
 
     Examples
     --------
@@ -179,8 +179,7 @@ def remove_interior(
         )
     if level not in LEVELS:
         raise ParameterError(f"unknown level {level!r}; choose one of {', '.join(LEVELS)}")
-    if int(keep_border) < 0:
-        raise ParameterError(f"keep_border must be at least 0, got {keep_border}")
+    _validate.removal_args(keep_border, budget)
     seed = int(classify_kw.get("seed", 0))
     c: Classification | None = None
     vis: Visibility | None = None

@@ -25,13 +25,15 @@ certifies its first hit as visible from the region.
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from meshvis.errors import ParameterError
+from meshvis.io import one_line
+from meshvis.io.jsonfile import read_json
+from meshvis.rays.camera import up_vector
 from meshvis.rays.samples import uniform_sphere
 from meshvis.visibility import _kernels
 
@@ -286,8 +288,9 @@ def parse_region(text: str | Region, *, up=(0.0, 0.0, 1.0)) -> Region:
         ``box:x0,y0,z0,x1,y1,z1``; ``points:x,y,z;x,y,z;...``; ``path:FILE.json`` (a JSON
         list of ``[x, y, z]`` positions, or ``{"positions": [...]}``, or a list of camera
         objects with a ``position`` key).  A Region is returned as it is.
-    up : (3,) float
-        Up direction of ``upper-hemisphere`` when the text gives none.
+    up : (3,) float or {"x", "y", "z"}
+        Up direction of ``upper-hemisphere`` when the text gives none
+        (:func:`meshvis.rays.camera.up_vector`).
 
     Returns
     -------
@@ -296,7 +299,7 @@ def parse_region(text: str | Region, *, up=(0.0, 0.0, 1.0)) -> Region:
     Raises
     ------
     ParameterError
-        Unknown kind, wrong number of coordinates, unreadable path file.
+        Unknown kind, wrong number of coordinates, a bad ``up``, an unreadable path file.
 
     Examples
     --------
@@ -310,7 +313,7 @@ def parse_region(text: str | Region, *, up=(0.0, 0.0, 1.0)) -> Region:
     if kind == "outside" and not rest:
         return Outside()
     if kind == "upper-hemisphere":
-        return UpperHemisphere(up=_numbers(rest, 3, text) if rest else up)
+        return UpperHemisphere(up=_numbers(rest, 3, text) if rest else up_vector(up))
     if kind == "box":
         v = _numbers(rest, 6, text)
         return Box(lo=v[:3], hi=v[3:])
@@ -339,10 +342,9 @@ def _path_positions(path: str) -> np.ndarray:
     if not path or not os.path.isfile(path):
         raise ParameterError(f"{path or '(no file)'}: camera path file not found")
     try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
+        data = read_json(path)
     except (OSError, ValueError) as exc:
-        raise ParameterError(f"{path}: not a JSON camera path ({exc})") from None
+        raise ParameterError(f"{path}: not a JSON camera path ({one_line(exc)})") from None
     if isinstance(data, dict):
         data = data.get("positions", data.get("cameras", []))
     try:
@@ -352,4 +354,6 @@ def _path_positions(path: str) -> np.ndarray:
         raise ParameterError(f"{path}: expected a list of [x, y, z] positions") from None
     if len(arr) == 0:
         raise ParameterError(f"{path}: the camera path has no positions")
+    if not np.isfinite(arr).all():
+        raise ParameterError(f"{path}: a camera position is not finite")
     return arr

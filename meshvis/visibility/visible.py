@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from meshvis import limits
+from meshvis import _validate, limits
 from meshvis.errors import ParameterError
 from meshvis.geometry.adjacency import weld
 from meshvis.io import as_soup
@@ -284,7 +284,8 @@ def visible_from(
     Raises
     ------
     ParameterError
-        Unknown method or region, negative budget.
+        Unknown method or region, a budget below 1, a seed that is not an integer of at
+        least 0, ``per_side`` not a bool.
 
     Examples
     --------
@@ -295,6 +296,7 @@ def visible_from(
     """
     if method not in METHODS:
         raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    _validate.visibility_args(budget, seed, per_side, min_new, min_new_area)
     soup = as_soup(model)
     region = parse_region(region, up=up).bind(soup)
     asked = np.ones(soup.n_faces, bool)
@@ -304,8 +306,6 @@ def visible_from(
         if asked.shape != (soup.n_faces,):
             raise ParameterError(f"faces must be {soup.n_faces} booleans or face indices")
     budget = default_budget(int(asked.sum())) if budget is None else int(budget)
-    if budget < 0:
-        raise ParameterError(f"budget must be at least 0, got {budget}")
     caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET)
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new, min_new_area)
