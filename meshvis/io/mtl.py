@@ -109,6 +109,17 @@ class MtlSource:
                     out.append((parts[0], parts[-1]))
         return out
 
+    def where(self) -> str:
+        """The start of a message about this block, ``"model.obj: model.mtl: "``.
+
+        The MTL file is named relative to the model's folder.
+        """
+        parts = [self.label] if self.label else []
+        if self.path:
+            root = self.root if self.root is not None else self.folder
+            parts.append(os.path.relpath(self.path, root) if inside_folder(self.path, root) else self.path)
+        return "".join(f"{p}: " for p in parts)
+
     def outside(self, fname: str) -> bool:
         """Whether texture ``fname`` names a place outside the model's folder (:func:`outside_reference`)."""
         return outside_reference(fname, self.folder, self.root if self.root is not None else self.folder)
@@ -120,7 +131,7 @@ class MtlSource:
         (:meth:`outside`) or missing.  Backslashes are folder separators unless a file has
         the name as written.
         """
-        who = f"{self.label}: " if self.label else ""
+        who = self.where()
         if self.outside(fname):
             if warn:
                 warnings.warn(
@@ -318,7 +329,7 @@ def _texture_image(src: MtlSource, fname: str) -> tuple[bytes | None, str | None
     try:
         return _image_bytes(data)
     except Exception as exc:  # PIL raises several kinds for bytes that are not an image
-        who = f"{src.label}: " if src.label else ""
+        who = src.where()
         warnings.warn(
             f"{who}texture {fname} is not an image ({type(exc).__name__}); written without it",
             TextureWarning,

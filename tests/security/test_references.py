@@ -104,7 +104,7 @@ def test_a_texture_reference_outside_the_folder_is_left_out_of_the_output(tmp_pa
     out.mkdir()
     assert main(["orient", str(m / "m.obj"), "-o", str(out / "o.obj"), "-q"]) == 0
     err = capsys.readouterr().err
-    assert f"texture {reference} is outside the model's folder; skipped" in err
+    assert f"m.obj: m.mtl: texture {reference} is outside the model's folder; skipped" in err
     mtl = (out / "o.mtl").read_text()
     assert reference not in mtl and "map_Kd" not in mtl
     assert "map_Ks kept.png" in mtl  # a missing texture inside the folder keeps its reference
@@ -187,3 +187,14 @@ def test_the_library_warns_about_outside_textures_too(tmp_path):
     (tmp_path / "m.mtl").write_text("newmtl a\nmap_Kd file:///etc/hostname\n")
     with pytest.warns(TextureWarning, match="outside the model's folder"):
         meshvis.load(tmp_path / "m.obj")
+
+
+def test_a_texture_warning_names_the_mtl_file(tmp_path):
+    (tmp_path / "mat").mkdir()
+    (tmp_path / "m.obj").write_text("mtllib mat/lib.mtl\nusemtl a\n" + TETRA)
+    (tmp_path / "mat" / "lib.mtl").write_text("newmtl a\nmap_Kd ../../x.png\n")
+    with pytest.warns(TextureWarning) as caught:
+        meshvis.load(tmp_path / "m.obj")
+    assert str(caught[0].message) == (
+        f"{tmp_path / 'm.obj'}: {os.path.join('mat', 'lib.mtl')}: texture ../../x.png is outside the model's folder; skipped"
+    )
