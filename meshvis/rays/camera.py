@@ -153,9 +153,7 @@ class Camera:
             setattr(self, name, v[0])
         if not np.any(self.up):
             raise ParameterError("camera up must not be zero")
-        self.fov = _validate.real("field of view", self.fov)
-        if not 0 < self.fov < 180:
-            raise ParameterError(f"field of view must be in (0, 180) degrees, got {self.fov}")
+        self.fov = _field_of_view(self.fov)
         self.orthographic = _validate.flag("orthographic", self.orthographic)
         if self.ortho_height is not None:
             self.ortho_height = _validate.real("ortho_height", self.ortho_height, 0.0, open_lo=True)
@@ -276,6 +274,7 @@ class Camera:
         if distance is not None:
             distance = _validate.real("distance", distance, 0.0, open_lo=True)
         margin = _validate.real("margin", margin, 0.0, open_lo=True)
+        fov = _field_of_view(fov)
         bounds = _bounds_of(model)
         center = bounds.mean(axis=0)
         radius = 0.5 * float(np.linalg.norm(bounds[1] - bounds[0])) or 1.0
@@ -331,6 +330,14 @@ class Camera:
         if missing:
             raise ParameterError(f"the camera has no {' and no '.join(sorted(missing))}")
         return cls(**d)
+
+
+def _field_of_view(value: Any) -> float:
+    """A vertical field of view: a number of degrees in (0, 180)."""
+    fov = _validate.real("field of view", value)
+    if not 0 < fov < 180:
+        raise ParameterError(f"field of view must be in (0, 180) degrees, got {fov}")
+    return fov
 
 
 def _bounds_of(model: Any) -> np.ndarray:

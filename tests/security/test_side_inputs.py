@@ -146,7 +146,12 @@ def test_a_bad_camera_names_its_file(here, capsys, camera, needle):
 
 @pytest.mark.parametrize(
     "extra, needle",
-    [(["--distance=-1"], "distance must be above 0"), (["--fit-margin", "0"], "margin must be above 0")],
+    [
+        (["--distance=-1"], "distance must be above 0"),
+        (["--fit-margin", "0"], "margin must be above 0"),
+        (["--fov", "0"], "field of view must be in (0, 180)"),
+        (["--fov", "nan"], "field of view must be finite"),
+    ],
 )
 def test_label_camera_options_out_of_range(here, capsys, extra, needle):
     _error(capsys, [*LABEL, *extra], needle)
@@ -217,3 +222,23 @@ def test_batch_options_are_checked_once_before_any_file(here, capsys, extra, nee
     with pytest.raises(SystemExit) if needle.startswith("invalid") else contextlib.nullcontext():
         _error(capsys, ["batch", "lib", "--op", "remove-interior", "--out", "out", "-q", *extra], needle)
     assert not os.path.exists("out")
+
+
+# ---------------------------------------------------------------------------- C4: seeds on the command line
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["visible", "t.obj"],
+        ["orient", "t.obj", "-o", "o.obj", "--from", "box:-1,-1,-1,2,2,2"],
+        ["remove-interior", "t.obj", "-o", "o.obj", "--visibility", "view"],
+        ["remove-interior", "t.obj", "-o", "o.obj"],
+        ["layers", "t.obj", "-o", "o.obj"],
+        ["render", "t.obj", "-o", "o.png", "--color-by", "layer"],
+        ["demo", "--out", "d"],
+    ],
+    ids=lambda argv: " ".join(argv[:1] + argv[4:6] if len(argv) > 4 else argv[:1]),
+)
+@pytest.mark.parametrize("seed", ["-5", str(2**200)])
+def test_every_seed_option_is_checked(here, capsys, argv, seed):
+    _error(capsys, [*argv, "--seed", seed, "-q"], "seed must be at")
+    assert sorted(os.listdir(here)) == ["t.obj"]
