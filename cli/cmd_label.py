@@ -262,6 +262,7 @@ def run(args: argparse.Namespace) -> int:
         A model cannot be read (see :func:`meshvis.load`).
     """
     from meshvis.errors import OutputError
+    from meshvis.io.writing import check_not_read
     from meshvis.labeling import frames as fr
     from meshvis.labeling.inputs import load_models, read_texts
 
@@ -271,7 +272,10 @@ def run(args: argparse.Namespace) -> int:
     soup = load_models(args.inputs if len(args.inputs) > 1 else args.inputs[0])
     cameras = _cameras(args, soup)
     paths = _frame_paths(args.output, len(cameras))
-    check_outputs(paths + [p for p in (args.json, args.png) if p and p != STDOUT], args.inputs, args.force)
+    outputs = paths + [p for p in (args.json, args.png) if p and p != STDOUT]
+    check_outputs(outputs, args.inputs, args.force)
+    for path in outputs:  # not over a texture of a model
+        check_not_read(path, soup)
     if args.json == STDOUT:
         args.quiet = True  # standard output carries the JSON alone
     texts = read_texts(args.texts, soup.part_names) if args.texts else None

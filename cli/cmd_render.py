@@ -65,11 +65,13 @@ def run(args: argparse.Namespace) -> int:
         The model cannot be read (see :func:`meshvis.load`).
     """
     from meshvis.io import load
+    from meshvis.io.writing import check_not_read
     from meshvis.rays.camera import Camera, up_axis
     from meshvis.rays.render import render, save_png
 
     check_output(args.output, [args.input], args.force)
     soup = load(args.input)
+    check_not_read(args.output, soup)  # not over a texture of the model
     values = None
     color_by = None if args.color_by == "none" else args.color_by
     if color_by == "layer":

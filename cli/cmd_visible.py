@@ -81,6 +81,7 @@ def run(args: argparse.Namespace) -> int:
         Unknown region or method, or a bad budget (see :func:`meshvis.visible_from`).
     """
     from meshvis.io import load
+    from meshvis.io.writing import check_not_read
     from meshvis.rays.camera import up_axis
     from meshvis.rays.render import save_png
     from meshvis.visibility import visible_from
@@ -90,6 +91,9 @@ def run(args: argparse.Namespace) -> int:
     if args.report == STDOUT:
         args.quiet = True  # standard output carries the report alone
     soup = load(args.input)
+    for path in (args.report, args.preview):  # not over a texture of the model
+        if path and path != STDOUT:
+            check_not_read(path, soup)
     vis = visible_from(
         soup,
         args.from_region,

@@ -63,6 +63,26 @@ def test_no_output_replaces_a_texture_even_with_force(textured, capsys, monkeypa
     assert _files(textured) == before
 
 
+@pytest.mark.parametrize(
+    "argv",
+    [
+        ["render", "m.obj", "-o", "r.json.png"],
+        ["visible", "m.obj", "--preview", "r.json.png"],
+        ["visible", "m.obj", "--report", "r.json.png"],
+        ["label", "m.obj", "-o", "r.json.png", "--size", "32", "32"],
+        ["label", "m.obj", "-o", "l.svg", "--json", "r.json.png", "--size", "32", "32"],
+    ],
+    ids=lambda argv: " ".join(argv[:1] + argv[2:3]),
+)
+def test_no_picture_or_report_replaces_a_texture(textured, capsys, monkeypatch, argv):
+    monkeypatch.chdir(textured)
+    (textured / "m.mtl").write_text("newmtl a\nmap_Kd r.json.png\n")
+    (textured / "r.json.png").write_bytes(b"texture")
+    before = _files(textured)
+    _error(capsys, [*argv, "-q", "--force"], "r.json.png: is a file of the input model")
+    assert _files(textured) == before
+
+
 def test_the_library_does_not_save_over_a_texture(textured):
     soup = meshvis.load(textured / "m.obj")
     with pytest.raises(OutputError, match="is a file of the input model"):
