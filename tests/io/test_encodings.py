@@ -97,3 +97,23 @@ def test_a_batch_over_a_file_name_that_is_not_utf8(tmp_path, capsys):
     assert (tmp_path / "out" / "summary.csv").read_text().count("\n") == 2
     rows = json.loads((tmp_path / "out" / "summary.json").read_text())["files"]
     assert os.path.exists(rows[0]["output"])  # JSON escapes keep the name as it is
+
+
+def test_messages_about_a_file_name_that_is_not_utf8(tmp_path):
+    """With a strict standard output (a UTF-8 locale other than C), the summary line naming
+    the file is printed with the bytes escaped instead of ending in a UnicodeEncodeError."""
+    import subprocess
+    import sys
+
+    src = tmp_path / f"{NAME}.obj"
+    src.write_text(TETRA)
+    env = {**os.environ, "PYTHONIOENCODING": "utf-8:strict"}
+    r = subprocess.run(
+        [sys.executable, "-m", "meshvis", "orient", os.fsencode(src), "-o", str(tmp_path / "o.obj")],
+        capture_output=True,
+        env=env,
+        cwd=tmp_path,
+        timeout=120,
+    )
+    assert r.returncode == 0, r.stderr.decode(errors="replace")
+    assert b"caf\\udce9.obj: 4 faces" in r.stdout
