@@ -103,6 +103,27 @@ def test_the_library_does_not_save_over_a_texture(textured):
         (["visible", "t.obj", "--preview", "out/x", "--report", "out/x"], "out/x"),
         (["label", "t.obj", "-o", "out/x.svg", "--json", "out/x.svg"], "out/x.svg"),
         (["label", "t.obj", "-o", "out/x.svg", "--png", "out/x.svg"], "out/x.svg"),
+        (["label", "t.obj", "-o", "out/x.png", "--png", "out/x.png"], "out/x.png"),
+        (["label", "t.obj", "-o", "out/x.svg", "--orbit", "3", "--json", "out/x_001.svg"], "out/x_001.svg"),
+        (
+            ["orient", "t.obj", "-o", "out/o.glb", "--report", "out/r.json", "--preview", "out/r.json"],
+            "out/r.json",
+        ),
+        (["classify", "t.obj", "--graphml", "out/g.json", "--report", "out/g.json"], "out/g.json"),
+        (["remove-interior", "t.obj", "-o", "out/o.obj", "--removed", "out/o.mtl"], "out/o.mtl"),
+        (
+            [
+                "remove-interior",
+                "t.obj",
+                "-o",
+                "out/a.obj",
+                "--removed",
+                "out/b.obj",
+                "--report",
+                "out/b.mtl",
+            ],
+            "out/b.mtl",
+        ),
     ],
 )
 def test_two_outputs_of_one_command_on_one_path(tmp_path, capsys, monkeypatch, argv, named):
