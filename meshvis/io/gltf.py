@@ -21,6 +21,7 @@ import io
 import json
 import os
 import struct
+import warnings
 
 import numpy as np
 
@@ -399,6 +400,7 @@ def _children(nodes: list, i: int, label: str) -> list[int]:
 def read_gltf(path: str, label: str | None = None) -> Soup:
     """Read a .glb / .gltf file into a flattened soup (see the module docstring)."""
     import trimesh
+    from PIL import Image
 
     label = label or path
     doc, buffers, glb_bin = read_container(path, label)
@@ -414,7 +416,9 @@ def read_gltf(path: str, label: str | None = None) -> Soup:
         with open(path, "rb") as fh:
             source = io.BytesIO(fh.read()[len(BOM) :])
         options["resolver"] = FilePathResolver(path)
-    scene = trimesh.load(source, **options)
+    with warnings.catch_warnings():  # images are opened, not decoded: the expansion is checked above
+        warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+        scene = trimesh.load(source, **options)
     meshes = doc.get("meshes", [])
     geoms = list(scene.geometry.values())
     prim_counts = [len(m.get("primitives", [])) for m in meshes]

@@ -220,7 +220,8 @@ def _measure() -> None:
             seconds, kb = r.stderr.strip().splitlines()[-1].split()
             said = next((ln for ln in r.stderr.splitlines() if ln.startswith("meshvis:")), "")
             said = said.replace(d + os.sep, "")
-            what = " ".join(a.replace(d + os.sep, "") for a in argv[:2])
+            shown = argv[:2] + (argv[-2:] if argv[0] == "label" else [])
+            what = " ".join(a.replace(d + os.sep, "") for a in shown)
             print(
                 f"| {name}, {os.path.getsize(os.path.join(d, name)):,} bytes | `{what}` | exit {r.returncode}, "
                 f"{float(seconds):.1f} s, {int(kb) // 1024} MB | {said[:110]} |"
