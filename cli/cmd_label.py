@@ -5,9 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from meshvis.io.jsonfile import STDOUT
-
-from .common import check_outputs, positive_int, say, staged_outputs
+from .common import check_outputs, positive_int, say, staged_outputs, verbosity_options
 
 UP_AXES = ("auto", "x", "y", "z")
 
@@ -68,7 +66,7 @@ def add_parser(sub) -> None:
     p.add_argument("--show-area", action="store_true", help="draw the internal area's boundary")
     p.add_argument("--duration", type=positive_int, default=120, help="GIF frame time in ms (default 120)")
     p.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    p.add_argument("--quiet", "-q", action="store_true")
+    verbosity_options(p)
     p.set_defaults(func=run)
 
 
@@ -204,25 +202,34 @@ def _write_outputs(args: argparse.Namespace, results: list, ext: str) -> None:
 
 
 def _report(args: argparse.Namespace, results: list, paths: list[str]) -> None:
-    """One-line summaries: what was written, the first frame's quality, the motion of a sequence."""
+    """One summary line (labels placed, what was written); the quality figures with ``--verbose``."""
     from meshvis.labeling.metrics import sequence_metrics
+
+    from .common import detail
 
     first = results[0]
     m = first.metrics
-    say(args, f"wrote {', '.join(paths if len(paths) <= 3 else paths[:2] + ['...', paths[-1]])}")
+    shown = ", ".join(paths if len(paths) <= 3 else paths[:2] + ["...", paths[-1]])
+    left = len(first.invisible) + len(first.unplaced)
+    frames = f" in each of {len(results)} frames" if len(results) > 1 else ""
     say(
         args,
-        f"{len(first.labels)} labels ({args.layout}, {args.method}); "
+        f"label: {len(first.labels)} labels{frames} ({args.layout}, {args.method})"
+        + (f", {left} parts not labelled (--verbose names them)" if left else "")
+        + f"; wrote {shown}",
+    )
+    detail(
+        args,
         f"overlaps {m['overlaps']}, crossings {m['crossings']}, label over model {m['label_over_model']} px; "
         f"layout {first.timings['layout_ms']:.1f} ms",
     )
     if first.invisible:
-        say(args, f"not visible, not labelled: {', '.join(n for _, n in first.invisible)}")
+        detail(args, f"not visible, not labelled: {', '.join(n for _, n in first.invisible)}")
     if first.unplaced:
-        say(args, f"no room found for: {', '.join(n for _, n in first.unplaced)}")
+        detail(args, f"no room found for: {', '.join(n for _, n in first.unplaced)}")
     if len(results) > 1:
         s = sequence_metrics(results)
-        say(
+        detail(
             args,
             f"{len(results)} frames; mean label motion {s['label_motion_mean']:.1f} px, "
             f"side flips {s['side_flips']}, order swaps {s['order_swaps']}",
@@ -262,6 +269,7 @@ def run(args: argparse.Namespace) -> int:
         A model cannot be read (see :func:`meshvis.load`).
     """
     from meshvis.errors import OutputError
+    from meshvis.io.jsonfile import STDOUT
     from meshvis.io.writing import check_not_read
     from meshvis.labeling import frames as fr
     from meshvis.labeling.inputs import load_models, read_texts

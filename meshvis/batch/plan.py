@@ -7,10 +7,10 @@ import os
 import warnings
 from collections.abc import Sequence
 
-from meshvis import _validate
 from meshvis.errors import ParameterError
 from meshvis.io import READ_FORMATS, WRITE_FORMATS
 from meshvis.io.mtl import inside_folder
+from meshvis.repair.operation import check_options
 
 from .tasks import DEFAULT_RUNNER, OPERATIONS, FileTask
 
@@ -115,22 +115,6 @@ def discover(inputs: Sequence[str]) -> list[tuple[str, str]]:
     return out
 
 
-def check_options(op: str, options: dict) -> None:
-    """Refuse options that would make every file of a batch fail, before any file starts.
-
-    Raises
-    ------
-    ParameterError
-        A classification option out of its range, or for ``remove-interior`` a region
-        that does not parse (``--from``), a negative ``keep_border`` or a budget below 1.
-    """
-    from meshvis.visibility.regions import parse_region
-
-    _validate.operation_options(options)
-    if op == "remove-interior" and options.get("from_region") is not None:
-        parse_region(options["from_region"])
-
-
 def output_extension(path: str, op: str) -> str:
     """Extension of the output of ``op`` for input ``path``: the input's, unless it cannot hold the result.
 
@@ -160,13 +144,14 @@ def plan(
     Raises
     ------
     ParameterError
-        Unknown operation, options that every file would fail on (:func:`check_options`),
+        Unknown operation, options that every file would fail on
+        (:func:`meshvis.repair.operation.check_options`),
         inputs not found (see :func:`discover`), or an output that would overwrite one of
         the inputs.
     """
     if op not in OPERATIONS:
         raise ParameterError(f"unknown operation {op!r}; choose one of {', '.join(OPERATIONS)}")
-    check_options(op, options or {})
+    check_options(op, options or {})  # every file would fail on a bad option
     found = discover(inputs)
     if not found:
         raise ParameterError("no model file to run on: every file found lies outside its folder")

@@ -42,7 +42,14 @@ DEMO_FILES = (
 )
 
 
-def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str], None] = print) -> dict:
+def run_demo(
+    folder: str,
+    *,
+    seed: int = 0,
+    size: int = 512,
+    say: Callable[[str], None] = print,
+    detail: Callable[[str], None] | None = None,
+) -> dict:
     """Run the three applications on the bundled soup and write everything to ``folder``.
 
     The soup is :func:`~meshvis.eval.generators.overlapping_solids` through
@@ -64,6 +71,8 @@ def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str]
         Width and height of the previews, in pixels.
     say : callable
         Receives one line of text per step (default :func:`print`).
+    detail : callable, optional
+        Receives the classification's summary (default: nowhere).
 
     Returns
     -------
@@ -92,7 +101,7 @@ def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str]
     os.makedirs(folder, exist_ok=True)
     try:
         with staged_outputs():
-            return _run(folder, seed, size, say)
+            return _run(folder, seed, size, say, detail)
     except BaseException:
         if made:
             with contextlib.suppress(OSError):
@@ -100,7 +109,9 @@ def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str]
         raise
 
 
-def _run(folder: str, seed: int, size: int, say: Callable[[str], None]) -> dict:
+def _run(
+    folder: str, seed: int, size: int, say: Callable[[str], None], detail: Callable[[str], None] | None
+) -> dict:
     """:func:`run_demo` once its arguments are checked, inside one stage of outputs."""
     t0 = time.perf_counter()
     truth = soupify(overlapping_solids(), flip=0.3, seed=seed)
@@ -116,7 +127,8 @@ def _run(folder: str, seed: int, size: int, say: Callable[[str], None]) -> dict:
     shot(soup, "input.png")
 
     c = classify(soup, seed=seed)
-    say(c.summary())
+    if detail is not None:
+        detail(c.summary())
     ok = ~truth.ambiguous
     area = soup.areas
 

@@ -116,4 +116,4 @@ def test_messages_about_a_file_name_that_is_not_utf8(tmp_path):
         timeout=120,
     )
     assert r.returncode == 0, r.stderr.decode(errors="replace")
-    assert b"caf\\udce9.obj: 4 faces" in r.stdout
+    assert b"caf\\udce9.obj: orient: turned 0 of 4 faces" in r.stdout

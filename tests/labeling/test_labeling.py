@@ -69,7 +69,7 @@ def models(scene):
     out = [("scene", scene, (0, 0, 1))]
     assembly = os.path.join(ROOT, "models", "assembly.obj")
     if os.path.exists(assembly):
-        out.append(("assembly", load_models(assembly), (0, 0, 1)))
+        out.append(("assembly", load_models(assembly), (0, 1, 0)))  # the bundled files are y-up
     else:  # the generator is the source of the file
         from meshvis.eval.generators import assembly as make_assembly
 
@@ -725,7 +725,7 @@ def test_silhouette_crowded_small_views_place_every_label_near(azimuth, elevatio
     """~30 labels around a model 60 px wide: all placed, none sent far off (once up to 7 d_S)."""
     path = os.path.join(ROOT, "models", "assembly.obj")
     soup = load_models(path)
-    cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=(0, 0, 1))
+    cam = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=(0, 1, 0))  # the bundled files are y-up
     ib = id_buffer(soup, cam, (192, 192))
     for method in ("fuzzy", "two-step"):
         r = solve(ib, label_texts(soup.part_names), layout="silhouette", method=method)
@@ -741,7 +741,7 @@ def test_row_label_with_no_room_moves_to_the_other_side(monkeypatch):
     import meshvis.labeling.pipeline  # noqa: F401  (makes labeling.pipeline an attribute)
 
     soup = load_models(os.path.join(ROOT, "models", "assembly.obj"))
-    ib = id_buffer(soup, fit_camera(soup, azimuth=270.0, elevation=20.0, up=(0, 0, 1)), (512, 512))
+    ib = id_buffer(soup, fit_camera(soup, azimuth=270.0, elevation=20.0, up=(0, 1, 0)), (512, 512))
     texts = label_texts(soup.part_names)
     r = solve(ib, texts, layout="top-bottom")
     assert is_clean(r.metrics) and r.metrics["leaders_through_labels"] == 0

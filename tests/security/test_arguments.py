@@ -236,14 +236,18 @@ CASES = [
     (
         lambda c, rc, tmp: meshvis.parse_region("upper-hemisphere", up="q"),
         ParameterError,
-        "up must be x, y, z",
+        "up must be auto, x, y, z",
     ),
     (
         lambda c, rc, tmp: meshvis.parse_region("upper-hemisphere", up=[1, 2]),
         ParameterError,
-        "up must have shape",
+        "up must be auto, x, y, z or three numbers",
     ),
-    (lambda c, rc, tmp: meshvis.parse_region("upper-hemisphere", up=[0, 0, 0]), ParameterError, "non-zero"),
+    (
+        lambda c, rc, tmp: meshvis.parse_region("upper-hemisphere", up=[0, 0, 0]),
+        ParameterError,
+        "finite non-zero",
+    ),
     (
         lambda c, rc, tmp: meshvis.Soup(V, F, part_id=[0, 1]),
         ModelError,
@@ -266,7 +270,7 @@ CASES = [
         "ortho_height",
     ),
     (lambda c, rc, tmp: meshvis.Camera.fit(M, distance=-1), ParameterError, "distance must be above 0"),
-    (lambda c, rc, tmp: meshvis.Camera.fit(M, up="q"), ParameterError, "up must be x, y, z"),
+    (lambda c, rc, tmp: meshvis.Camera.fit(M, up="q"), ParameterError, "up must be auto, x, y, z"),
     (
         lambda c, rc, tmp: meshvis.classify(M, hints={"inside_points": [[10**400, 0, 0]]}),
         ParameterError,

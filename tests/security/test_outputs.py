@@ -41,8 +41,10 @@ def textured(tmp_path):
     """m.obj whose MTL names textures called like outputs: sub/o.obj, sub/o.mtl, r.json."""
     (tmp_path / "sub").mkdir()
     (tmp_path / "m.obj").write_text("mtllib m.mtl\nusemtl a\n" + TETRA)
-    (tmp_path / "m.mtl").write_text("newmtl a\nmap_Kd sub/o.obj\nmap_Ks r.json\nmap_Ka sub/o.mtl\n")
-    for name in ("sub/o.obj", "sub/o.mtl", "r.json"):
+    (tmp_path / "m.mtl").write_text(
+        "newmtl a\nmap_Kd sub/o.obj\nmap_Ks r.json\nmap_Ka sub/o.mtl\nbump shot.png\n"
+    )
+    for name in ("sub/o.obj", "sub/o.mtl", "r.json", "shot.png"):
         (tmp_path / name).write_bytes(b"texture " + name.encode())
     return tmp_path
 
@@ -53,7 +55,7 @@ def textured(tmp_path):
         (["-o", "sub/o.obj"], "sub/o.obj"),  # the model output over a texture
         (["-o", "sub/o2.obj", "--report", "r.json"], "r.json"),  # the report over a texture
         (["-o", "sub/o2.obj", "--report", "sub/o.mtl"], "sub/o.mtl"),
-        (["-o", "sub/o.obj.glb", "--preview", "r.json"], "r.json"),
+        (["-o", "sub/o.obj.glb", "--preview", "shot.png"], "shot.png"),
     ],
 )
 def test_no_output_replaces_a_texture_even_with_force(textured, capsys, monkeypatch, extra, named):
@@ -97,20 +99,19 @@ def test_the_library_does_not_save_over_a_texture(textured):
     "argv, named",
     [
         (["orient", "t.obj", "-o", "out/o.obj", "--report", "out/o.mtl"], "out/o.mtl"),
-        (["orient", "t.obj", "-o", "out/o.obj", "--preview", "out/../out/o.obj"], "o.obj"),
+        (["orient", "t.obj", "-o", "out/o.obj", "--report", "out/../out/o.obj"], "o.obj"),
         (["remove-interior", "t.obj", "-o", "out/o.obj", "--removed", "out/o.obj"], "out/o.obj"),
         (["classify", "t.obj", "--report", "out/r.json", "--per-face", "out/r.json"], "out/r.json"),
-        (["visible", "t.obj", "--preview", "out/x", "--report", "out/x"], "out/x"),
+        (["visible", "t.obj", "--preview", "out/x.png", "--report", "out/x.png"], "out/x.png"),
         (["label", "t.obj", "-o", "out/x.svg", "--json", "out/x.svg"], "out/x.svg"),
         (["label", "t.obj", "-o", "out/x.svg", "--png", "out/x.svg"], "out/x.svg"),
         (["label", "t.obj", "-o", "out/x.png", "--png", "out/x.png"], "out/x.png"),
         (["label", "t.obj", "-o", "out/x.svg", "--orbit", "3", "--json", "out/x_001.svg"], "out/x_001.svg"),
         (
-            ["orient", "t.obj", "-o", "out/o.glb", "--report", "out/r.json", "--preview", "out/r.json"],
-            "out/r.json",
+            ["orient", "t.obj", "-o", "out/o.glb", "--report", "out/r.png", "--preview", "out/r.png"],
+            "out/r.png",
         ),
         (["classify", "t.obj", "--graphml", "out/g.json", "--report", "out/g.json"], "out/g.json"),
-        (["remove-interior", "t.obj", "-o", "out/o.obj", "--removed", "out/o.mtl"], "out/o.mtl"),
         (
             [
                 "remove-interior",
@@ -134,11 +135,11 @@ def test_two_outputs_of_one_command_on_one_path(tmp_path, capsys, monkeypatch, a
     assert os.listdir(tmp_path / "out") == []
 
 
-def test_layers_preview_onto_a_per_layer_file(tmp_path, capsys, monkeypatch):
+def test_layers_report_onto_a_per_layer_file(tmp_path, capsys, monkeypatch):
     monkeypatch.chdir(tmp_path)
     (tmp_path / "n.obj").write_text(NESTED)
     for extra, named in (
-        (["--preview", "o.layer1.obj"], "o.layer1.obj"),
+        (["--report", "o.layer1.obj"], "o.layer1.obj"),
         (["--report", "o.layer2.mtl"], "o.layer2.mtl"),
     ):
         _error(capsys, ["layers", "n.obj", "-o", "o.obj", "-q", *extra], named, "a file of one layer")
