@@ -45,6 +45,8 @@ def add_parser(sub) -> None:
         "stability",
         "labeling",
         "labeling-sweep",
+        "labeling-orbit",
+        "labeling-page",
         "compare",
         "scale",
         "orientation",

@@ -112,8 +112,13 @@ def _optimisation_arguments(opt: argparse._ArgumentGroup) -> None:
     opt.add_argument(
         "--font-size", type=positive_int, help="label font size in pixels (default: from the image size)"
     )
+    from meshvis.labeling.pipeline import MIN_PIXELS
+
     opt.add_argument(
-        "--min-pixels", type=positive_int, default=1, help="parts with fewer visible pixels are not labelled"
+        "--min-pixels",
+        type=positive_int,
+        default=MIN_PIXELS,
+        help=f"parts with fewer visible pixels are not labelled (default {MIN_PIXELS})",
     )
 
 
@@ -149,7 +154,7 @@ def _cameras(args: argparse.Namespace, soup) -> list:
     """Build the cameras of the frames: an orbit, a camera path, one camera file or one fitted view."""
     from meshvis.labeling import frames as fr
     from meshvis.labeling.inputs import read_camera
-    from meshvis.rays.camera import Camera
+    from meshvis.labeling.pipeline import fit_camera
 
     up = _up(args)
     if args.orbit:
@@ -163,13 +168,14 @@ def _cameras(args: argparse.Namespace, soup) -> list:
             up=up,
             fit_margin=args.fit_margin,
             distance=args.distance,
+            size=tuple(args.size),
         )
     if args.camera_path:
         return fr.read_camera_path(args.camera_path)
     if args.camera:
         return [read_camera(args.camera)]
     return [
-        Camera.fit(
+        fit_camera(
             soup,
             azimuth=args.azimuth,
             elevation=args.elevation,
@@ -178,6 +184,7 @@ def _cameras(args: argparse.Namespace, soup) -> list:
             orthographic=args.orthographic,
             margin=args.fit_margin,
             up=up,
+            size=tuple(args.size),
         )
     ]
 
@@ -225,8 +232,15 @@ def _report(args: argparse.Namespace, results: list, paths: list[str]) -> None:
     )
     if first.invisible:
         detail(args, f"not visible, not labelled: {', '.join(n for _, n in first.invisible)}")
-    if first.unplaced:
-        detail(args, f"no room found for: {', '.join(n for _, n in first.unplaced)}")
+    outside = set(first.params.get("outside_image", []))
+    if outside:
+        detail(
+            args,
+            f"left out, no room inside the image even at {first.font_size} px: {', '.join(sorted(outside))}",
+        )
+    rest = [n for _, n in first.unplaced if n not in outside]
+    if rest:
+        detail(args, f"no room found for: {', '.join(rest)}")
     if len(results) > 1:
         s = sequence_metrics(results)
         detail(

@@ -25,6 +25,7 @@ COMMANDS = {
     "layers": "meshvis.cli.cmd_repair",
     "visible": "meshvis.cli.cmd_visible",
     "label": "meshvis.cli.cmd_label",
+    "view": "meshvis.cli.cmd_view",
     "batch": "meshvis.cli.cmd_batch",
     "bench": "meshvis.cli.cmd_bench",
 }

@@ -79,7 +79,23 @@ def test_a_json_side_file_with_a_byte_order_mark_is_read(here, capsys):
         b"\xef\xbb\xbf" + json.dumps({"position": [3, 3, 3], "target": [0, 0, 0]}).encode()
     )
     (here / "texts.json").write_bytes(b"\xef\xbb\xbf" + json.dumps({"t": "Tetra"}).encode())
-    assert main([*LABEL, "--camera", "cam.json", "--texts", "texts.json", "--json", "l.json"]) == 0
+    assert (
+        main(
+            [
+                *LABEL,
+                "--size",
+                "256",
+                "256",
+                "--camera",
+                "cam.json",
+                "--texts",
+                "texts.json",
+                "--json",
+                "l.json",
+            ]
+        )
+        == 0
+    )
     assert json.loads((here / "l.json").read_text())["frames"][0]["labels"][0]["text"] == "Tetra"
 
 
@@ -113,7 +129,7 @@ def test_a_texts_key_naming_no_part_names_the_file(here, capsys, name, content):
 
 def test_a_texts_csv_with_a_byte_order_mark(here, capsys):
     (here / "t.csv").write_bytes(b"\xef\xbb\xbft,Tetra\n")
-    assert main([*LABEL, "--texts", "t.csv", "--json", "l.json"]) == 0
+    assert main([*LABEL, "--size", "256", "256", "--texts", "t.csv", "--json", "l.json"]) == 0
     assert json.loads((here / "l.json").read_text())["frames"][0]["labels"][0]["text"] == "Tetra"
 
 
