@@ -113,8 +113,9 @@ def _roots(doc: dict, nodes: list) -> list:
 
 # ---------------------------------------------------------------------------- checks
 # (before trimesh sees the file: what it may read, how far it may expand, what must index what)
-#: glTF extensions that meshvis reads as the specification asks
-IMPLEMENTED_EXTENSIONS: frozenset[str] = frozenset()
+#: glTF extensions that meshvis reads as the specification asks (Draco through DracoPy,
+#: see :func:`_check_compression`)
+IMPLEMENTED_EXTENSIONS = frozenset({"KHR_draco_mesh_compression"})
 #: glTF extensions that change only what meshvis does not read (shading, lights, texture
 #: formats): a file that requires one is read without it, with a warning
 IGNORABLE_EXTENSIONS = frozenset(
@@ -162,12 +163,12 @@ def check_document(doc: dict, path: str, label: str, buffers: list | None = None
         :func:`~meshvis.io.gltf_edit.read_container` returns it; default: every buffer is
         taken as long as it says.
     """
+    _check_compression(doc, label)  # before the required extensions: its message is the more precise
     _check_extensions(doc, label)
     sizes = _check_uris(doc, path, label, buffers)
     file_bytes = os.path.getsize(path) + sum(s for s in sizes if s is not None)
     _check_expansion(_check_accessors(doc, label, sizes), file_bytes, label)
     _check_node_graph(doc, label)
-    _check_compression(doc, label)
 
 
 def _check_extensions(doc: dict, label: str) -> None:

@@ -2,11 +2,11 @@
 
 Every hostile input of the "small inputs that ask for unbounded memory or time" kind is
 built here (glTF accessors of zeros, sparse and strided accessors, PLY list counts, a deep
-node chain, FIFOs named by URIs, label frames, a 3MF and texture bombs) and run through the
-command line in one child process whose address space is limited to 1 GB: an allocation
-past it would surface as a ``MemoryError`` (or the "more data than fits in memory" refusal),
-so each case must end with its own refusal message or succeed, and within 20 s.
-(Copies of one triangle making the intersection tests quadratic are not among them.)
+node chain, FIFOs named by URIs, label frames, a 3MF and texture bombs, copies of one
+triangle) and run through the command line in one child process whose address space is
+limited to 1 GB: an allocation past it would surface as a ``MemoryError`` (or the "more
+data than fits in memory" refusal), so each case must end with its own refusal message or
+succeed, and within 20 s.
 """
 
 from __future__ import annotations
@@ -142,6 +142,70 @@ def _cases(d: str) -> list[tuple[str, list[str], int, str]]:
     )
     import zipfile
 
+    from helpers import write_glb
+
+    # copies of one triangle: a node graph doubling 13 times over one cube, one face 20,000 times
+    corners = struct.pack("<24f", *[c for z in (0, 1) for y in (0, 1) for x in (0, 1) for c in (x, y, z)])
+    cube = [
+        0,
+        2,
+        1,
+        1,
+        2,
+        3,
+        4,
+        5,
+        6,
+        5,
+        7,
+        6,
+        0,
+        1,
+        4,
+        1,
+        5,
+        4,
+        2,
+        6,
+        3,
+        3,
+        6,
+        7,
+        0,
+        4,
+        2,
+        2,
+        4,
+        6,
+        1,
+        3,
+        5,
+        3,
+        7,
+        5,
+    ]
+    blob = corners + struct.pack("<36H", *cube)
+    nodes = [{"children": [2 * k + 2, 2 * k + 3]} for k in range(13) for _ in (0, 1)] + [{"mesh": 0}] * 2
+    cubes = _gltf(
+        nodes=nodes,
+        meshes=[{"primitives": [{"attributes": {"POSITION": 0}, "indices": 1}]}],
+        accessors=[
+            {
+                "bufferView": 0,
+                "componentType": 5126,
+                "count": 8,
+                "type": "VEC3",
+                "min": [0, 0, 0],
+                "max": [1, 1, 1],
+            },
+            {"bufferView": 1, "componentType": 5123, "count": 36, "type": "SCALAR"},
+        ],
+        bufferViews=[{"buffer": 0, "byteLength": 96}, {"buffer": 0, "byteOffset": 96, "byteLength": 72}],
+        buffers=[{"byteLength": len(blob)}],
+    )
+    write_glb(cubes, blob, os.path.join(d, "cubes.glb"))
+    files["copies.obj"] = "v 0 0 0\nv 1 0 0\nv 0 1 0\n" + "f 1 2 3\n" * 20_000
+
     with zipfile.ZipFile(os.path.join(d, "bomb.3mf"), "w", zipfile.ZIP_DEFLATED, compresslevel=9) as zf:
         zf.writestr("3D/3dmodel.model", xml)
     for name, content in files.items():
@@ -175,6 +239,15 @@ def _cases(d: str) -> list[tuple[str, list[str], int, str]]:
         ("bomb.3mf", orient("bomb.3mf"), 2, "the archive inflates to 19200353 bytes"),
         ("gif.gltf", orient("gif.gltf"), 0, "would decode past the cap MAX_EXPANSION"),
         ("png.gltf", orient("png.gltf"), 0, ""),
+        ("cubes.glb", ["info", p("cubes.glb")], 0, ""),
+        (
+            "cubes.glb",
+            ["remove-interior", p("cubes.glb"), "-o", p("out.glb"), "--force"],
+            2,
+            "MAX_FACE_COPIES",
+        ),
+        ("copies.obj", ["info", p("copies.obj")], 0, ""),
+        ("copies.obj", orient("copies.obj"), 2, "MAX_FACE_COPIES"),
     ]
 
 
