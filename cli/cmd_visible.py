@@ -7,6 +7,24 @@ import argparse
 from .common import check_output, positive_int, say, write_json
 
 
+def conservative_options(p) -> None:
+    """The ``--conservative`` and ``--max-level`` options (defaults from :mod:`meshvis.visibility.conservative`)."""
+    from meshvis.visibility.conservative import DEFAULT_MAX_LEVEL
+
+    p.add_argument(
+        "--conservative",
+        action="store_true",
+        help="also the faces that may be seen from points:... or path:CAMERAS.json (a set that surely "
+        "holds every visible face; docs/conservative.md)",
+    )
+    p.add_argument(
+        "--max-level",
+        type=positive_int,
+        default=DEFAULT_MAX_LEVEL,
+        help=f"with --conservative: frusta are split down to 2**N a side of a cube-map face (default {DEFAULT_MAX_LEVEL})",
+    )
+
+
 def add_parser(sub) -> None:
     """Add the ``visible`` subcommand to the ``meshvis`` parser.
 
@@ -33,6 +51,7 @@ def add_parser(sub) -> None:
         "at least 2**22, at most meshvis.limits.MAX_RAYS)",
     )
     p.add_argument("--per-side", action="store_true", help="keep looking until both sides of a face are seen")
+    conservative_options(p)
     p.add_argument(
         "--up", choices=("auto", "x", "y", "z"), default="auto", help="up axis of upper-hemisphere"
     )
@@ -50,7 +69,8 @@ def run(args: argparse.Namespace) -> int:
     """Run ``meshvis visible``: search which faces can be seen from the region ``--from``.
 
     Prints one line unless ``--quiet`` (faces and share of the area seen, rays, why the
-    search stopped, time).
+    search stopped, time), and with ``--conservative`` a second one (the faces that may be
+    seen, the bracket between the two sets, frusta, time).
     No model is written; ``--report`` writes the JSON report with per-face results and
     ``--preview`` a picture with the unseen faces in red.
 
@@ -58,7 +78,8 @@ def run(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         The parsed options: ``input``, ``from_region``, ``method``, ``budget``, ``per_side``,
-        ``up``, ``seed``, ``report``, ``preview``, ``force``, ``quiet``.
+        ``conservative``, ``max_level``, ``up``, ``seed``, ``report``, ``preview``, ``force``,
+        ``quiet``.
 
     Returns
     -------
@@ -78,27 +99,38 @@ def run(args: argparse.Namespace) -> int:
     from meshvis.rays.camera import up_axis
     from meshvis.rays.render import save_png
     from meshvis.visibility import visible_from
+    from meshvis.visibility.conservative import bracket
     from meshvis.visibility.preview import preview
 
     for path in (args.report, args.preview):
         if path:
             check_output(path, [args.input], args.force)
     soup = load(args.input)
-    vis = visible_from(
-        soup,
-        args.from_region,
+    search = dict(
         budget=args.budget,
         seed=args.seed,
         method=args.method,
         up=up_axis(args.up, [args.input]),
         per_side=args.per_side,
     )
+    if args.conservative:  # visible_from(..., conservative=True), with the subdivision limit
+        vis = bracket(soup, args.from_region, search=visible_from, max_level=args.max_level, **search)
+    else:
+        vis = visible_from(soup, args.from_region, **search)
     r = vis.report(per_face=bool(args.report))
     say(
         args,
         f"{args.input}: {r['seen_faces']} of {r['faces']} faces seen ({100 * r['seen_area_fraction']:.1f} % of the area) "
         f"from {args.from_region}; {r['rays']['total']} rays, stopped: {r['stopped']}, {vis.seconds:.1f} s",
     )
+    if args.conservative:
+        c = r["conservative"]
+        say(
+            args,
+            f"conservative: {c['conservative_faces']} faces may be seen ({c['conservative_area'] / max(c['sampled_area'], 1e-300):.2f} x the "
+            f"sampled area); bracket {c['bracket_faces']} faces, {100 * c['bracket_area_fraction']:.1f} % of the area; "
+            f"{c['frusta']} frusta, {c['seconds']:.1f} s",
+        )
     if args.report:
         r["input"] = args.input
         write_json(args.report, r)

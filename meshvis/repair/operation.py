@@ -54,6 +54,7 @@ OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
         "keep_border": 0,
         "budget": None,  # rays of the from-region search (None: its stop rule ends it)
         "up": "auto",
+        "conservative": False,  # remove only what is outside the conservative set (no cut)
     },
     "layers": {"max_layers": None},
 }
@@ -267,6 +268,7 @@ def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
         budget=None if o["budget"] is None else int(o["budget"]),
         up=up_axis(o["up"], [soup.path] if soup.path else []),
         seed=int(o["seed"]),
+        conservative=bool(o["conservative"]),
     )
 
 
@@ -310,7 +312,7 @@ def run_operation(
     tell = say or (lambda text: None)
     up = up_axis(o.get("up") or "auto", [soup.path] if soup.path else [])  # of the preview
     c = None
-    by_sight = (op == "remove-interior" and o["visibility"] == "view") or (
+    by_sight = (op == "remove-interior" and (o["visibility"] == "view" or o["conservative"])) or (
         op == "orient" and o["from_region"]
     )
     if not by_sight:  # sight alone needs no cut
