@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|conservative``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -50,6 +50,7 @@ def add_parser(sub) -> None:
         "orientation",
         "indoor",
         "real",
+        "conservative",
     ):
         try:
             mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])

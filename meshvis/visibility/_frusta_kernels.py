@@ -75,9 +75,8 @@ PROBE_SLACK = 1e-12
 #: those near the frustum's side are also the neighbouring frustum's (widened by ``mu``)
 TOUCH_SLACK = 1e-6
 TOUCH_WIDTH = 100.0
-#: seeds of a blocker for the rays that hit one triangle: its neighbours across its edges
-#: (up to this many) and the frustum's own seeds
-MAX_NEIGHBOUR_SEEDS = 12
+#: fillers looked through at one edge, and faces beyond them that may span it
+MAX_FILLERS, MAX_SPAN = 32, 16
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -328,19 +327,150 @@ def _off_cone(a, b, P, Q, t, T, wid, delta, eta):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
+def _other_side(g, a, b, P, Q, m0, m1, m2, ez, v, tri, wid, delta, eta, Y):  # pragma: no cover - compiled
+    """Whether face ``g``, across edge ``a``-``b`` (corners ``P``, ``Q``), lies on the other side of
+    the plane through ``v`` and the edge than the corner ``ez`` was measured at, by a margin,
+    and ``v`` sees its plane."""
+    c = 0
+    while c < 2 and (wid[g, c] == a or wid[g, c] == b):
+        c += 1
+    for d in range(3):
+        Y[0, d] = tri[g, c, d] - v[d]
+    ey = Y[0, 0] * m0 + Y[0, 1] * m1 + Y[0, 2] * m2
+    if ez * ey >= 0 or abs(ey) <= _edge_tolerance(P, Q, m0, m1, m2, Y[0], delta, eta, True):
+        return False
+    _relative(tri, g, v, Y)
+    return _sees_plane(Y, delta) != 0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _faces_across(
+    e,
+    f,
+    a,
+    b,
+    P,
+    Q,
+    m0,
+    m1,
+    m2,
+    ez,
+    v,
+    tri,
+    wid,
+    face_edge,
+    edge_start,
+    edge_face,
+    filler,
+    delta,
+    eta,
+    out,
+    n,
+    Y,
+    found,
+    fill,
+    seg,
+):  # pragma: no cover - compiled
+    """The faces that cover the other side of edge ``e`` (welded ends ``a``, ``b``) of face ``f``.
+
+    Writes them to ``found`` and returns their number; 0 when the edge is not covered.  A
+    face across the edge whose far corner lies on the other side of the plane through
+    ``v`` and the edge (by a margin) covers it; one already in ``out[:n]`` is preferred.
+    ``filler`` faces (slivers whose corners lie on one line: they join T-junctions, often
+    several in a row) are looked through: the faces beyond them, on the other side, whose
+    edges on that line together span the edge, cover it.
+    """
+    best = -1
+    n_fill = 0
+    for h in range(edge_start[e], edge_start[e + 1]):
+        g = edge_face[h]
+        if g == f:
+            continue
+        if filler[g] >= 0:
+            if n_fill < len(fill):
+                fill[n_fill] = g
+                n_fill += 1
+            continue
+        if _other_side(g, a, b, P, Q, m0, m1, m2, ez, v, tri, wid, delta, eta, Y):
+            for j in range(n):
+                if out[j] == g:
+                    found[0] = g
+                    return 1
+            if best < 0:
+                best = g
+    if best >= 0:
+        found[0] = best
+        return 1
+    if n_fill == 0:
+        return 0
+    # through the fillers: every face beyond them on the other side, with the stretch of the
+    # edge's line (parameter 0 at P, 1 at Q) that its shared edge spans
+    lx, ly, lz = Q[0] - P[0], Q[1] - P[1], Q[2] - P[2]
+    ll = lx * lx + ly * ly + lz * lz
+    n_seg = 0
+    i = 0
+    while i < n_fill:
+        g = fill[i]
+        i += 1
+        for side in range(3):
+            e2 = face_edge[g, side]
+            if e2 < 0:
+                continue
+            a2, b2 = wid[g, side], wid[g, (side + 1) % 3]
+            for h in range(edge_start[e2], edge_start[e2 + 1]):
+                g2 = edge_face[h]
+                if g2 in (g, f):
+                    continue
+                if filler[g2] >= 0:
+                    seen = False
+                    for j in range(n_fill):
+                        if fill[j] == g2:
+                            seen = True
+                            break
+                    if not seen:
+                        if n_fill == len(fill):
+                            return 0
+                        fill[n_fill] = g2
+                        n_fill += 1
+                    continue
+                if not _other_side(g2, a2, b2, P, Q, m0, m1, m2, ez, v, tri, wid, delta, eta, Y):
+                    continue
+                if n_seg == len(found):
+                    return 0
+                s0 = ((tri[g, side, 0] - v[0] - P[0]) * lx + (tri[g, side, 1] - v[1] - P[1]) * ly
+                      + (tri[g, side, 2] - v[2] - P[2]) * lz) / ll  # fmt: skip
+                k = (side + 1) % 3
+                s1 = ((tri[g, k, 0] - v[0] - P[0]) * lx + (tri[g, k, 1] - v[1] - P[1]) * ly
+                      + (tri[g, k, 2] - v[2] - P[2]) * lz) / ll  # fmt: skip
+                found[n_seg] = g2
+                seg[n_seg, 0], seg[n_seg, 1] = min(s0, s1), max(s0, s1)
+                n_seg += 1
+    # those stretches must span [0, 1]: sweep them from the left
+    reach = 0.0
+    progress = True
+    while progress and reach < 1.0:
+        progress = False
+        for j in range(n_seg):
+            if seg[j, 0] <= reach and seg[j, 1] > reach:
+                reach = seg[j, 1]
+                progress = True
+    return n_seg if reach >= 1.0 else 0
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def _walk(
-    seed, v, tri, wid, face_edge, edge_start, edge_face, planes, n_planes, axis, t, T,
-    probes, n_probes, delta, eta, mu, out, X, Y,
+    seed, v, tri, wid, face_edge, edge_start, edge_face, filler, planes, n_planes, axis, t, T,
+    probes, n_probes, delta, eta, mu, out, X, Y, found, fill, seg,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Grow a blocker from ``seed`` (FastV §3.2) into ``out``; its size, 0 when none is proved.
 
-    The frustum is ``planes[:n_planes]`` around ``axis``; with ``t >= 0`` it lies inside the cone of rays
-    through triangle ``t`` (corners ``T``), and edges that miss that cone's interior are
-    not tested (:func:`_off_cone`).  One of the rays ``probes[:n_probes]`` (inside the
-    frustum) must pass strictly inside a triangle of the set.
+    The frustum is ``planes[:n_planes]`` around ``axis``; with ``t >= 0`` it lies inside the
+    cone of rays through triangle ``t`` (corners ``T``), and edges that miss that cone's
+    interior are not tested (:func:`_off_cone`).  One of the rays ``probes[:n_probes]``
+    (inside the frustum) must pass strictly inside a triangle of the set.
     """
     _relative(tri, seed, v, X)
-    if _sees_plane(X, delta) == 0:
+    if _sees_plane(X, delta) == 0 or filler[seed] >= 0:
         return 0
     out[0] = seed
     n = 1
@@ -362,40 +492,23 @@ def _walk(
             ez = Z[0] * m0 + Z[1] * m1 + Z[2] * m2
             if abs(ez) <= _edge_tolerance(P, Q, m0, m1, m2, Z, delta, eta, True):
                 return 0
-            across, known = -1, False
-            for h in range(edge_start[e], edge_start[e + 1]):
-                g = edge_face[h]
-                if g == f:
-                    continue
-                # the corner of g off the edge must lie on the other side of the plane
-                # through v and the edge, by a margin, and v must see g's plane
-                c = 0
-                while c < 2 and (wid[g, c] == a or wid[g, c] == b):
-                    c += 1
-                for d in range(3):
-                    Y[0, d] = tri[g, c, d] - v[d]
-                ey = Y[0, 0] * m0 + Y[0, 1] * m1 + Y[0, 2] * m2
-                if ez * ey >= 0 or abs(ey) <= _edge_tolerance(P, Q, m0, m1, m2, Y[0], delta, eta, True):
-                    continue
-                in_set = False
-                for j in range(n):
-                    if out[j] == g:
-                        in_set = True
-                        break
-                if in_set:
-                    across, known = g, True
-                    break
-                if across < 0:
-                    _relative(tri, g, v, Y)
-                    if _sees_plane(Y, delta) != 0:
-                        across = g
-            if across < 0:
+            n_found = _faces_across(
+                e, f, a, b, P, Q, m0, m1, m2, ez, v, tri, wid, face_edge, edge_start, edge_face, filler,
+                delta, eta, out, n, Y, found, fill, seg,
+            )  # fmt: skip
+            if n_found == 0:
                 return 0  # a free or silhouette edge meets the frustum
-            if not known:
-                if n == len(out):
-                    return 0
-                out[n] = across
-                n += 1
+            for q in range(n_found):
+                known = False
+                for j in range(n):
+                    if out[j] == found[q]:
+                        known = True
+                        break
+                if not known:
+                    if n == len(out):
+                        return 0
+                    out[n] = found[q]
+                    n += 1
         i += 1
     for k in range(n_probes):
         for j in range(n):
@@ -614,15 +727,15 @@ def _cone_of(poly, n_poly, cut, probes, margin):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _hidden_in_cut(
-    t, poly, n_poly, planes, axis, seeds, v, tri, wid, face_edge, edge_start, edge_face, lo, hi, first, count,
-    order, delta, eta, mu, cut, cap, T, probe, blocker, cand, X, Y, clip_a, clip_b, stack,
+    t, poly, n_poly, planes, axis, seeds, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first,
+    count, order, delta, eta, mu, cut, cap, T, probe, blocker, cand, X, Y, clip_a, clip_b, stack, found, fill, seg,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Whether a blocker lies before triangle ``t`` for every ray that reaches ``poly``.
 
     ``poly`` is the part of ``t`` inside the (widened) frustum; the rays through it form the
     convex cone of the planes through ``v`` and ``poly``'s edges, inside the cone of rays
     through ``t``: edges that touch ``t`` from outside that cone are not tested
-    (:func:`_off_cone`).  Seeds: the triangles across ``t``'s edges, then the frustum's.
+    (:func:`_off_cone`).
     """
     _relative(tri, t, v, T)
     if _sees_plane(T, delta) == 0:
@@ -638,22 +751,15 @@ def _hidden_in_cut(
     lp = math.sqrt(probe[0, 0] ** 2 + probe[0, 1] ** 2 + probe[0, 2] ** 2)
     for c in range(3):
         cap[c] = probe[0, c] / lp  # the cone's axis (see _constraint)
-    # seeds: the first triangle before t along each probe ray, the triangles across t's
-    # edges (a silhouette that t touches), then the frustum's
+    # seeds: the first triangle before t along each probe ray (none: t is seen along it), then
+    # the frustum's
     n_cand = 0
     for k in range(n_probes):
         f = _first_hit(v, probe[k], 1.0, t, tri, lo, hi, first, count, order, stack)
-        if f >= 0:
-            cand[n_cand] = f
-            n_cand += 1
-    for s in range(3):
-        e = face_edge[t, s]
-        if e < 0:
-            continue
-        for h in range(edge_start[e], edge_start[e + 1]):
-            if edge_face[h] != t and n_cand < len(cand) - len(seeds):
-                cand[n_cand] = edge_face[h]
-                n_cand += 1
+        if f < 0:
+            return False
+        cand[n_cand] = f
+        n_cand += 1
     for q in range(len(seeds)):
         cand[n_cand] = seeds[q]
         n_cand += 1
@@ -669,8 +775,8 @@ def _hidden_in_cut(
         if dup:
             continue
         n = _walk(
-            s, v, tri, wid, face_edge, edge_start, edge_face, cut, n_cut, cap, t, T, probe, n_probes,
-            delta, eta, mu, blocker, X, Y,
+            s, v, tri, wid, face_edge, edge_start, edge_face, filler, cut, n_cut, cap, t, T, probe, n_probes,
+            delta, eta, mu, blocker, X, Y, found, fill, seg,
         )  # fmt: skip
         if n == 0:
             continue
@@ -688,7 +794,7 @@ def _hidden_in_cut(
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _collect(
-    mode, v, tri, wid, face_edge, edge_start, edge_face, lo, hi, first, count, order,
+    mode, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
     planes, axis, far, delta, eta, mu, keep, blocks, starts, n_blocks, seeds, sc, stack,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Walk the hierarchy over the triangles meeting the frustum before ``far``.
@@ -699,7 +805,7 @@ def _collect(
     (:func:`_hidden_in_cut`); :data:`OPEN`: mark those for which none is found.  Triangles already marked are
     skipped.  Returns the number marked.
     """
-    X, Y, poly, tmp, cut, cap, T, probe, blocker, cand, clip_a, clip_b, ray_stack = sc
+    X, Y, poly, tmp, cut, cap, T, probe, blocker, cand, clip_a, clip_b, ray_stack, found, fill, seg = sc
     top = 0
     stack[0] = 0
     marked = 0
@@ -733,15 +839,15 @@ def _collect(
                     continue
                 _relative(tri, t, v, T)
                 if _hidden_in_cut(
-                    t, poly, n_poly, planes, axis, seeds, v, tri, wid, face_edge, edge_start, edge_face,
+                    t, poly, n_poly, planes, axis, seeds, v, tri, wid, face_edge, edge_start, edge_face, filler,
                     lo, hi, first, count, order, delta, eta, mu, cut, cap, T, probe, blocker, cand, X, Y,
-                    clip_a, clip_b, ray_stack,
+                    clip_a, clip_b, ray_stack, found, fill, seg,
                 ):  # fmt: skip
                     continue
             elif mode == OPEN and _hidden_in_cut(
-                t, poly, n_poly, planes, axis, seeds, v, tri, wid, face_edge, edge_start, edge_face,
+                t, poly, n_poly, planes, axis, seeds, v, tri, wid, face_edge, edge_start, edge_face, filler,
                 lo, hi, first, count, order, delta, eta, mu, cut, cap, T, probe, blocker, cand, X, Y,
-                clip_a, clip_b, ray_stack,
+                clip_a, clip_b, ray_stack, found, fill, seg,
             ):  # fmt: skip
                 continue
             keep[t] = 1
@@ -752,7 +858,7 @@ def _collect(
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def trace_frusta(
     v, roots, root, box, at_limit, seeds,
-    tri, wid, face_edge, edge_start, edge_face,
+    tri, wid, face_edge, edge_start, edge_face, filler,
     lo, hi, first, count, order,
     delta, eta, mu, max_walk, keep, status, far_depth,
 ):  # fmt: skip  # pragma: no cover - compiled
@@ -777,6 +883,9 @@ def trace_frusta(
     face_edge, edge_start, edge_face : int64 arrays
         Edge of each triangle side, and the triangles of each edge (edge ``e``'s are
         ``edge_face[edge_start[e]:edge_start[e + 1]]``).
+    filler : (m,) int8
+        For a face whose corners lie exactly on one line (it joins a T-junction), the side
+        that is its long edge; -1 for other faces.
     lo, hi, first, count, order :
         The :class:`~meshvis.geometry.bvh.Bvh`.
     delta, eta, mu : float
@@ -800,9 +909,11 @@ def trace_frusta(
     sc = (
         np.empty((3, 3)), np.empty((POLY, 3)), np.empty((POLY, 3)), np.empty((POLY, 3)),
         np.empty((POLY, 3)), np.empty(3), np.empty((3, 3)), np.empty((POLY, 3)),
-        np.empty(max_walk, np.int64), np.empty(n_seeds + MAX_NEIGHBOUR_SEEDS + POLY, np.int64),
+        np.empty(max_walk, np.int64), np.empty(n_seeds + POLY, np.int64),
         np.empty((POLY, 3)), np.empty((POLY, 3)), np.empty(STACK, np.int64),
+        np.empty(MAX_SPAN, np.int64), np.empty(MAX_FILLERS, np.int64), np.empty((MAX_SPAN, 2)),
     )  # fmt: skip
+    found, fill, seg = sc[13], sc[14], sc[15]
     X, Y, poly, tmp = sc[0], sc[1], sc[2], sc[3]
     stack = np.empty(STACK, np.int64)
     for i in range(len(root)):
@@ -828,8 +939,8 @@ def trace_frusta(
             if dup:
                 continue
             n = _walk(
-                s, v, tri, wid, face_edge, edge_start, edge_face, planes, FRUSTUM_PLANES, axis,
-                -1, X, probes, len(PROBES), delta, eta, mu, walk, X, Y,
+                s, v, tri, wid, face_edge, edge_start, edge_face, filler, planes, FRUSTUM_PLANES, axis,
+                -1, X, probes, len(PROBES), delta, eta, mu, walk, X, Y, found, fill, seg,
             )  # fmt: skip
             if n == 0:
                 continue
@@ -851,41 +962,16 @@ def trace_frusta(
         if far < np.inf:
             status[i] = BLOCKED
             _collect(
-                BLOCKED, v, tri, wid, face_edge, edge_start, edge_face, lo, hi, first, count, order,
+                BLOCKED, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
                 planes, axis, far, delta, eta, mu, keep, blocks, starts, n_blocks, seeds[i], sc, stack,
             )  # fmt: skip
             continue
         if not hit_any:
-            hit_any = (
-                _collect(
-                    ANY,
-                    v,
-                    tri,
-                    wid,
-                    face_edge,
-                    edge_start,
-                    edge_face,
-                    lo,
-                    hi,
-                    first,
-                    count,
-                    order,
-                    planes,
-                    axis,
-                    far,
-                    delta,
-                    eta,
-                    mu,
-                    keep,
-                    blocks,
-                    starts,
-                    0,
-                    seeds[i],
-                    sc,
-                    stack,
-                )  # fmt: skip
-                > 0
-            )
+            n_any = _collect(
+                ANY, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
+                planes, axis, far, delta, eta, mu, keep, blocks, starts, 0, seeds[i], sc, stack,
+            )  # fmt: skip
+            hit_any = n_any > 0
         if not hit_any:
             status[i] = EMPTY
         elif not at_limit[i]:
@@ -893,6 +979,6 @@ def trace_frusta(
         else:
             status[i] = OPEN
             _collect(
-                OPEN, v, tri, wid, face_edge, edge_start, edge_face, lo, hi, first, count, order,
+                OPEN, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
                 planes, axis, far, delta, eta, mu, keep, blocks, starts, 0, seeds[i], sc, stack,
             )  # fmt: skip

@@ -64,6 +64,9 @@ MAX_WALK = 64
 BATCH = 1 << 16
 #: highest subdivision level the frustum boxes represent exactly (dyadic float64)
 LEVEL_CAP = 24
+#: a face whose middle corner lies within this fraction of the diagonal of the line through
+#: the other two joins a T-junction (:func:`fillers`); far below the margins of the tests
+FILLER_WIDTH = 1e-7
 #: rays per batch of :func:`sample_views`
 SAMPLE_BATCH = 1 << 20
 #: rays in all of a camera path's views when cameras look into views and no budget is given
@@ -192,6 +195,8 @@ class FrustumScene:
         triangles must share their edges exactly).
     face_edge, edge_start, edge_face : int64 arrays
         The edge of each face side and the faces of each edge.
+    filler : (m,) int8
+        :func:`fillers`.
     bvh : Bvh
     caster : RayCaster
         Traces the seed rays.
@@ -203,6 +208,7 @@ class FrustumScene:
     face_edge: np.ndarray
     edge_start: np.ndarray
     edge_face: np.ndarray
+    filler: np.ndarray
     bvh: Bvh
     caster: RayCaster
 
@@ -221,9 +227,44 @@ class FrustumScene:
             face_edge=np.ascontiguousarray(table.face_edge, np.int64),
             edge_start=edge_start,
             edge_face=np.ascontiguousarray(table.half_face, np.int64),
+            filler=fillers(triangles, welded, FILLER_WIDTH * soup.diagonal),
             bvh=build_bvh(triangles),
             caster=caster or RayCaster(soup),
         )
+
+
+def fillers(triangles: np.ndarray, welded: np.ndarray, width: float) -> np.ndarray:
+    """(m,) int8: for each sliver whose corners lie on one line, the side that is its long edge; -1 for the others.
+
+    Such slivers join T-junctions (a corner of one face on the edge of another) with three
+    shared corners: the faces on either side of them close the surface, and a blocker may
+    pass through them (:mod:`._frusta_kernels`).  A sliver is a face with three distinct
+    welded corners whose middle corner lies within ``width`` of the line through the
+    other two.
+
+    Examples
+    --------
+    >>> t = np.array([[[0, 0, 0], [2, 0, 0], [1, 1e-9, 0]], [[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
+    >>> fillers(t, np.array([[0, 1, 2], [0, 2, 3]]), 1e-6).tolist()
+    [0, -1]
+    """
+    distinct = (
+        (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & (welded[:, 2] != welded[:, 0])
+    )
+    out = np.full(len(triangles), -1, np.int8)
+    idx = np.flatnonzero(distinct)
+    t = triangles[idx]
+    # the middle corner along the longest extent; the long edge is the side opposite to it
+    axis = np.argmax(t.max(axis=1) - t.min(axis=1), axis=1)
+    order = np.argsort(t[np.arange(len(idx)), :, axis], axis=1, kind="stable")
+    k = np.arange(len(idx))
+    lo, mid, hi = t[k, order[:, 0]], t[k, order[:, 1]], t[k, order[:, 2]]
+    span = hi - lo
+    length = np.linalg.norm(span, axis=1)
+    off = np.linalg.norm(np.cross(mid - lo, span), axis=1) / np.where(length > 0, length, 1.0)
+    sliver = (length > 0) & (off <= width)
+    out[idx[sliver]] = ((order[sliver, 1] + 1) % 3).astype(np.int8)
+    return out
 
 
 def margins(scene: FrustumScene, position: np.ndarray, tolerance: float) -> tuple[float, float, float]:
@@ -421,7 +462,7 @@ def _trace_viewpoint(
                 s = slice(a + i, a + j)
                 fk.trace_frusta(
                     v, roots, root[s], box[s], at_limit[s], seeds[i:j],
-                    scene.triangles, scene.welded, scene.face_edge, scene.edge_start, scene.edge_face,
+                    scene.triangles, scene.welded, scene.face_edge, scene.edge_start, scene.edge_face, scene.filler,
                     bvh.lo, bvh.hi, bvh.first, bvh.count, bvh.order,
                     delta, eta, mu, MAX_WALK, keep, status[s], far[s],
                 )  # fmt: skip
