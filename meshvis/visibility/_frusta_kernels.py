@@ -7,19 +7,16 @@ Depth is measured along the root's ``axis``.  For each frustum the kernel
 
 1. looks for *blockers* (FastV §3.2) from each seed triangle (the first hits of the
    frustum's centre and corner rays, traced by Embree): sets of triangles that every ray of
-   the frustum provably hits; the smallest deepest point of a blocker in the frustum is
-   its far plane (FastV §3.3, "Far Plane Depth Update");
-2. keeps every triangle that meets the frustum in front of the far plane, walking the
-   bounding volume hierarchy of :mod:`meshvis.geometry.bvh` -- except a triangle that lies
-   behind the plane of every blocker triangle in the frustum: a ray that reaches it
-   crosses that plane, where the blocker is, first;
-3. or asks for the frustum to be split in four (FastV §3.4), when no blocker was found
-   and it is not at the subdivision limit;
-4. at the limit without a blocker (FastV keeps everything there), keeps a triangle
-   ``T`` unless a blocker is found for the rays of the frustum that hit ``T`` (the
-   frustum cut by the three planes through ``v`` and ``T``'s edges), lying before ``T``;
-   this drops the hidden triangles that touch a silhouette, which would otherwise be kept
-   whole for the sake of the line they share with it.
+   the frustum provably hits (:func:`_walk`); the smallest deepest point of a blocker in
+   the frustum is its far plane (FastV §3.3, "Far Plane Depth Update");
+2. with a blocker, walks the bounding volume hierarchy of :mod:`meshvis.geometry.bvh` over
+   the triangles meeting the frustum in front of the far plane and keeps each one unless
+   it lies behind a blocker (:func:`_against`: behind the plane of every blocker triangle
+   whose rays reach it) or a blocker is found for just the rays that reach it
+   (:func:`_hidden_in_cut`);
+3. without a blocker, asks for the frustum to be split in four (FastV §3.4), or at the
+   subdivision limit keeps each triangle it meets unless a blocker is found for the rays
+   that reach it (FastV keeps them all).
 
 Why a walk proves a blocker.  The walk starts at a seed triangle and, for every edge of a
 triangle in the set that meets the frustum (segment against the frustum's planes), adds
@@ -31,9 +28,11 @@ of them, so the directions of the frustum whose rays hit the set are both open a
 in the (connected) frustum: once one ray of the frustum is shown to hit the set (a probe
 ray, checked strictly inside a triangle of the set), all do.  This needs no consistent
 winding and no manifold model, only exactly shared (welded) vertices; a triangle whose
-plane passes near ``v`` never joins a blocker.  For the rays that hit ``T`` (step 4) the
-same holds for the open cone: ``T``'s own edges lie on its boundary planes and are left
-out of the test.
+plane passes near ``v`` never joins a blocker.  Slivers whose corners lie on one line
+(they join T-junctions) are looked through: the faces beyond them that together span the
+edge cover it.  For the rays that reach one triangle ``t`` the frustum is the cone of the
+planes through ``v`` and the edges of ``t``'s part in it; ``t``'s own edges lie on that
+cone's boundary and are left out of the test.
 
 Float safety.  Everything is float64, relative to ``v``.  Every test that *accepts* a
 blocker (an edge's two triangles on opposite sides, a ray strictly inside a triangle, a
@@ -42,7 +41,10 @@ box or a triangle missing the frustum, a triangle behind the far plane) must fai
 margin: ``delta`` (a length, in model units) against moved vertices and viewpoint,
 ``eta`` (an angle) against turned rays, and ``mu`` by which frusta and far depths are
 widened.  All are far above the float32 rounding of the Embree scene that the sampled
-reference traces, so the reference's rays see nothing that these tests hide.
+reference traces, so the reference's rays see nothing that these tests hide.  In
+particular a triangle touching its blocker (a side of a box behind the box's top, sharing
+the top's edge) is kept: a ray through that edge meets both, and rounding decides which
+one a tracer reports.
 """
 
 from __future__ import annotations

@@ -14,7 +14,6 @@ import pytest
 import meshvis
 from meshvis.cli.main import main
 from meshvis.errors import ModelError, ParameterError
-from meshvis.rays.samples import uniform_sphere
 from meshvis.visibility.conservative import FrustumScene, conservative_from, sample_views
 from meshvis.visibility.viewpoints import parse_viewpoints
 
@@ -39,6 +38,7 @@ def sides(result, scene_faces) -> np.ndarray:
     return result.visible_side[scene_faces]
 
 
+@pytest.mark.slow
 def test_a_point_in_a_closed_box_may_see_only_the_inner_sides(scenes):
     cube, _ = scenes.unit_cube()  # fronts out
     for point in ("0,0,0", "0.31,-0.2,0.07"):
@@ -81,6 +81,7 @@ def test_two_coplanar_triangles_sharing_an_edge_block_together_and_a_gap_between
     assert c.visible.tolist() == [True, True, True]
 
 
+@pytest.mark.slow
 def test_a_grazing_view_over_a_floor_keeps_what_stands_on_it_and_not_what_lies_under_it():
     floor = quad_x(-100, 100, -100, 100, 0)
     above = [[(50, -1, 0.005), (51, 1, 0.005), (50, 1, 0.02)]]  # seen 0.01 below the horizon
@@ -94,6 +95,7 @@ def test_a_grazing_view_over_a_floor_keeps_what_stands_on_it_and_not_what_lies_u
     assert c.visible_side[:2].all()
 
 
+@pytest.mark.slow
 def test_the_set_holds_every_face_that_random_rays_see(scenes):
     # random triangles: no connectivity, many small blockers, grazing overlaps
     rng = np.random.default_rng(7)
@@ -162,8 +164,12 @@ def test_an_empty_model_is_refused_and_a_single_triangle_is_seen_from_its_side()
     with pytest.raises(ModelError):
         conservative_from((np.zeros((0, 3)), np.zeros((0, 3), np.int64)), "points:0,0,0")
     one = soup_from([[(0, 0, 1), (1, 0, 1), (0, 1, 1)]])
-    assert conservative_from(one, "points:0.2,0.2,0").visible_side.tolist() == [[False, True]]
-    assert conservative_from(one, "points:0.2,0.2,2").visible_side.tolist() == [[True, False]]
+    assert conservative_from(one, "points:0.2,0.2,0", max_level=LEVEL).visible_side.tolist() == [
+        [False, True]
+    ]
+    assert conservative_from(one, "points:0.2,0.2,2", max_level=LEVEL).visible_side.tolist() == [
+        [True, False]
+    ]
 
 
 def test_visible_from_brackets_the_guided_search(scenes):
@@ -191,7 +197,3 @@ def test_the_command_line_reports_the_bracket_and_removes_only_what_is_surely_hi
     r = json.loads(rep.read_text())
     assert r["visibility"] == "conservative" and r["removed_faces"] >= 12  # the inner cube at least
     assert main(["visible", str(src), "--from", "outside", "--conservative", "-q"]) == 2
-
-
-def _far_point(soup, rng):
-    return soup.bounds.mean(axis=0) + 2 * soup.diagonal * uniform_sphere(1, rng)[0]
