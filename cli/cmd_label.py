@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from .common import check_output, positive_int, say, staged_outputs
+from .common import check_output, positive_int, say, staged_outputs, verbosity_options
 
 UP_AXES = ("auto", "x", "y", "z")
 
@@ -64,7 +64,7 @@ def add_parser(sub) -> None:
     p.add_argument("--show-area", action="store_true", help="draw the internal area's boundary")
     p.add_argument("--duration", type=positive_int, default=120, help="GIF frame time in ms (default 120)")
     p.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    p.add_argument("--quiet", "-q", action="store_true")
+    verbosity_options(p)
     p.set_defaults(func=run)
 
 
@@ -110,8 +110,13 @@ def _optimisation_arguments(opt: argparse._ArgumentGroup) -> None:
     opt.add_argument(
         "--font-size", type=positive_int, help="label font size in pixels (default: from the image size)"
     )
+    from meshvis.labeling.pipeline import MIN_PIXELS
+
     opt.add_argument(
-        "--min-pixels", type=positive_int, default=1, help="parts with fewer visible pixels are not labelled"
+        "--min-pixels",
+        type=positive_int,
+        default=MIN_PIXELS,
+        help=f"parts with fewer visible pixels are not labelled (default {MIN_PIXELS})",
     )
 
 
@@ -149,6 +154,7 @@ def _cameras(args: argparse.Namespace, soup) -> list:
 
     from meshvis.errors import ParameterError
     from meshvis.labeling import frames as fr
+    from meshvis.labeling.pipeline import fit_camera
     from meshvis.rays.camera import Camera
 
     up = _up(args)
@@ -163,6 +169,7 @@ def _cameras(args: argparse.Namespace, soup) -> list:
             up=up,
             fit_margin=args.fit_margin,
             distance=args.distance,
+            size=tuple(args.size),
         )
     if args.camera_path:
         return fr.read_camera_path(args.camera_path)
@@ -173,7 +180,7 @@ def _cameras(args: argparse.Namespace, soup) -> list:
         except (OSError, ValueError, TypeError) as exc:
             raise ParameterError(f"{args.camera}: cannot read the camera: {exc}") from None
     return [
-        Camera.fit(
+        fit_camera(
             soup,
             azimuth=args.azimuth,
             elevation=args.elevation,
@@ -182,6 +189,7 @@ def _cameras(args: argparse.Namespace, soup) -> list:
             orthographic=args.orthographic,
             margin=args.fit_margin,
             up=up,
+            size=tuple(args.size),
         )
     ]
 
@@ -206,25 +214,41 @@ def _write_outputs(args: argparse.Namespace, results: list, ext: str) -> None:
 
 
 def _report(args: argparse.Namespace, results: list, paths: list[str]) -> None:
-    """One-line summaries: what was written, the first frame's quality, the motion of a sequence."""
+    """One summary line (labels placed, what was written); the quality figures with ``--verbose``."""
     from meshvis.labeling.metrics import sequence_metrics
+
+    from .common import detail
 
     first = results[0]
     m = first.metrics
-    say(args, f"wrote {', '.join(paths if len(paths) <= 3 else paths[:2] + ['...', paths[-1]])}")
+    shown = ", ".join(paths if len(paths) <= 3 else paths[:2] + ["...", paths[-1]])
+    left = len(first.invisible) + len(first.unplaced)
+    frames = f" in each of {len(results)} frames" if len(results) > 1 else ""
     say(
         args,
-        f"{len(first.labels)} labels ({args.layout}, {args.method}); "
+        f"label: {len(first.labels)} labels{frames} ({args.layout}, {args.method})"
+        + (f", {left} parts not labelled (--verbose names them)" if left else "")
+        + f"; wrote {shown}",
+    )
+    detail(
+        args,
         f"overlaps {m['overlaps']}, crossings {m['crossings']}, label over model {m['label_over_model']} px; "
         f"layout {first.timings['layout_ms']:.1f} ms",
     )
     if first.invisible:
-        say(args, f"not visible, not labelled: {', '.join(n for _, n in first.invisible)}")
-    if first.unplaced:
-        say(args, f"no room found for: {', '.join(n for _, n in first.unplaced)}")
+        detail(args, f"not visible, not labelled: {', '.join(n for _, n in first.invisible)}")
+    outside = set(first.params.get("outside_image", []))
+    if outside:
+        detail(
+            args,
+            f"left out, no room inside the image even at {first.font_size} px: {', '.join(sorted(outside))}",
+        )
+    rest = [n for _, n in first.unplaced if n not in outside]
+    if rest:
+        detail(args, f"no room found for: {', '.join(rest)}")
     if len(results) > 1:
         s = sequence_metrics(results)
-        say(
+        detail(
             args,
             f"{len(results)} frames; mean label motion {s['label_motion_mean']:.1f} px, "
             f"side flips {s['side_flips']}, order swaps {s['order_swaps']}",

@@ -34,22 +34,32 @@ def orbit(
     up: Sequence[float] = (0.0, 0.0, 1.0),
     fit_margin: float = 1.6,
     distance: float | None = None,
+    size: tuple[int, int] | None = None,
 ) -> list[Camera]:
-    """``n_frames`` cameras turning once around the model, framed for labels (see ``fit_margin``)."""
+    """``n_frames`` cameras turning once around the model, framed for labels.
+
+    Each is :func:`meshvis.labeling.pipeline.fit_camera` at an azimuth ``start + 360 k / n``
+    (``fit_margin`` is its margin; ``size`` makes a portrait image fit its width too).
+    """
+    from .pipeline import fit_camera
+
     if int(n_frames) < 1:
         raise ParameterError(f"an orbit needs at least 1 frame, got {n_frames}")
     soup = load_models(model)
-    return Camera.orbit(
-        soup,
-        int(n_frames),
-        elevation=elevation,
-        start=start,
-        fov=fov,
-        orthographic=orthographic,
-        margin=fit_margin,
-        up=up,
-        distance=distance,
-    )
+    return [
+        fit_camera(
+            soup,
+            azimuth=start + 360.0 * k / int(n_frames),
+            elevation=elevation,
+            distance=distance,
+            fov=fov,
+            orthographic=orthographic,
+            up=up,
+            margin=fit_margin,
+            size=size,
+        )
+        for k in range(int(n_frames))
+    ]
 
 
 def read_camera_path(path: str | os.PathLike) -> list[Camera]:

@@ -263,10 +263,50 @@ def operation_options(options: Mapping[str, Any]) -> None:
     )
 
 
-def ray_budget(total: int, n_nodes: int, rays_per_node: int) -> None:
-    """Refuse a classification whose ray budget exceeds :data:`meshvis.limits.MAX_RAYS`."""
-    if total > limits.MAX_RAYS:
+def ray_budget(soup, rays_per_node: int, rays_per_point: int, samples_per_face: int) -> None:
+    """Refuse a classification that may ask for more rays than its input's size allows.
+
+    The bound is taken before any work: every face flagged, ``2 x samples_per_face x
+    rays_per_point`` rays and as many reverse rays per face, or ``2 x rays_per_node``,
+    whichever is more.  The cap is :data:`meshvis.limits.RAYS_PER_INPUT_BYTE` rays per byte
+    of the input (:func:`input_bytes`), at least :data:`meshvis.limits.MIN_RAY_CAP`: a small
+    file that places many faces cannot ask for unbounded work, a large model may ask for
+    as much as its size.
+    """
+    per_face = 2 * max(int(rays_per_node), 2 * int(samples_per_face) * int(rays_per_point))
+    asked = soup.n_faces * per_face
+    size = input_bytes(soup)
+    cap = max(limits.RAYS_PER_INPUT_BYTE * size, limits.MIN_RAY_CAP)
+    if asked > cap:
+        where = f"{soup.path}: " if soup.path else ""
         raise ParameterError(
-            f"the ray budget is {total} rays ({n_nodes} nodes at rays_per_node={rays_per_node}), more than "
-            f"the cap MAX_RAYS of meshvis.limits ({limits.MAX_RAYS}); lower rays_per_node or samples_per_face"
+            f"{where}{soup.n_faces} faces may ask for {asked} rays ({per_face} per face at rays_per_node="
+            f"{rays_per_node}, rays_per_point={rays_per_point}, samples_per_face={samples_per_face}), more than "
+            f"the {cap} an input of {size} bytes may (RAYS_PER_INPUT_BYTE of meshvis.limits, "
+            f"{limits.RAYS_PER_INPUT_BYTE}); lower rays_per_node, rays_per_point or samples_per_face"
         )
+
+
+def input_bytes(soup) -> int:
+    """Bytes of a model's input: its file (a ``.gltf``'s external buffers too), or its arrays.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from meshvis.soup import Soup
+    >>> input_bytes(Soup(np.eye(3), np.array([[0, 1, 2]])))
+    96
+    """
+    path = soup.path
+    if path is None or not os.path.isfile(path):
+        return int(soup.vertices.nbytes + soup.faces.nbytes)
+    size = os.path.getsize(path)
+    data = getattr(soup.source, "data", None)
+    doc, folder = getattr(data, "doc", None), getattr(data, "folder", None)
+    if isinstance(doc, dict) and isinstance(folder, str):  # a .gltf and its .bin files
+        for buf in doc.get("buffers", []):
+            uri = buf.get("uri") if isinstance(buf, dict) else None
+            if isinstance(uri, str) and not uri.startswith("data:"):
+                other = os.path.join(folder, uri)
+                size += os.path.getsize(other) if os.path.isfile(other) else 0
+    return int(size)

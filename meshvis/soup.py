@@ -98,6 +98,11 @@ class Soup:
     source : SourceRecord or None
         What the reader kept of the file, so that a writer of the same format can edit the
         file instead of rebuilding it.
+    up : (3,) float
+        The model's up direction: the convention of the format it was read from, as
+        :func:`meshvis.load` records it (y for glTF and OBJ, z for STL, PLY, OFF and 3MF);
+        z for a model made in memory.  Functions that need an up direction take ``up=None``
+        to mean this one.
 
     Examples
     --------
@@ -120,6 +125,7 @@ class Soup:
     path: str | None = None
     origin: np.ndarray = None  # type: ignore[assignment]  # filled in __post_init__
     source: SourceRecord | None = None
+    up: tuple[float, float, float] = (0.0, 0.0, 1.0)
 
     def __post_init__(self) -> None:
         self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
@@ -144,6 +150,11 @@ class Soup:
             self.uv = np.asarray(self.uv, np.float64).reshape(m, 3, 2)
         if self.colors is not None:
             self.colors = np.asarray(self.colors, np.uint8).reshape(m, 3, 4)
+        up = np.asarray(self.up, np.float64).reshape(3)
+        norm = float(np.linalg.norm(up))
+        if not np.isfinite(norm) or norm == 0:
+            raise ModelError(f"the up direction must be a finite non-zero vector, got {up.tolist()}")
+        self.up = tuple((up / norm).tolist())
 
     # ------------------------------------------------------------------ basic sizes
     @property
@@ -354,6 +365,7 @@ class Soup:
             if has_col
             else None,
             path=soups[0].path,
+            up=soups[0].up,
         )
 
     def to_trimesh(self):

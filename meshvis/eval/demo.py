@@ -40,7 +40,14 @@ DEMO_FILES = (
 )
 
 
-def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str], None] = print) -> dict:
+def run_demo(
+    folder: str,
+    *,
+    seed: int = 0,
+    size: int = 512,
+    say: Callable[[str], None] = print,
+    detail: Callable[[str], None] | None = None,
+) -> dict:
     """Run the three applications on the bundled soup and write everything to ``folder``.
 
     The soup is :func:`~meshvis.eval.generators.overlapping_solids` through
@@ -62,6 +69,8 @@ def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str]
         Width and height of the previews, in pixels.
     say : callable
         Receives one line of text per step (default :func:`print`).
+    detail : callable, optional
+        Receives the classification's summary (default: nowhere).
 
     Returns
     -------
@@ -91,7 +100,8 @@ def run_demo(folder: str, *, seed: int = 0, size: int = 512, say: Callable[[str]
     shot(soup, "input.png")
 
     c = classify(soup, seed=seed)
-    say(c.summary())
+    if detail is not None:
+        detail(c.summary())
     ok = ~truth.ambiguous
     area = soup.areas
 

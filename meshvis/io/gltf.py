@@ -1,6 +1,7 @@
 """glTF 2.0 / GLB reader (flattened scene, instancing applied) and writer.
 
-Reading: trimesh decodes the primitives (accessors, sparse data, Draco, textures); the
+Reading: trimesh decodes the primitives (accessors, sparse data, Draco through DracoPy,
+textures; buffers compressed with meshoptimizer are refused); the
 scene tree is walked here from the file's own JSON, in file order, so that every *node
 instance* becomes one part named after the node (or after its mesh when the node has no
 name), all primitives of the node's mesh belong to that part, and material ids are the
@@ -106,6 +107,7 @@ def check_document(doc: dict, path: str, label: str) -> None:
     _check_uris(doc, path, label)
     _check_accessors(doc, label)
     _check_node_graph(doc, label)
+    _check_compression(doc, label)
 
 
 def _check_uris(doc: dict, path: str, label: str) -> None:
@@ -123,6 +125,40 @@ def _check_uris(doc: dict, path: str, label: str) -> None:
                 continue
             if "://" in uri or not inside_folder(os.path.join(folder, unquote(uri)), folder):
                 raise ModelFormatError(f"{kind[:-1]} {i} refers to {uri}, outside the model's folder", label)
+
+
+#: the extensions that store buffer views compressed with meshoptimizer (not decoded here)
+MESHOPT_EXTENSIONS = ("EXT_meshopt_compression", "KHR_meshopt_compression")
+
+
+def _check_compression(doc: dict, label: str) -> None:
+    """Compressed geometry is decoded, or refused: never read as its placeholder zeros.
+
+    Draco-compressed primitives (``KHR_draco_mesh_compression``) are decoded by trimesh
+    with DracoPy; without DracoPy their accessors would read as zeros (one point, every
+    face degenerate).  Buffer views compressed with meshoptimizer are refused.
+    """
+    for i, view in enumerate(_list(doc, "bufferViews", label)):
+        used = [
+            e for e in MESHOPT_EXTENSIONS if isinstance(view, dict) and e in (view.get("extensions") or {})
+        ]
+        if used:
+            raise ModelFormatError(
+                f"bufferView {i} is compressed with {used[0]}, which meshvis does not decode", label
+            )
+    draco = any(
+        isinstance(prim, dict) and "KHR_draco_mesh_compression" in (prim.get("extensions") or {})
+        for mesh in _list(doc, "meshes", label)
+        if isinstance(mesh, dict)
+        for prim in mesh.get("primitives", [])
+    )
+    if draco:
+        try:
+            import DracoPy  # noqa: F401
+        except ImportError:
+            raise ModelFormatError(
+                "the geometry is Draco-compressed and DracoPy, which decodes it, is not installed", label
+            ) from None
 
 
 def _list(doc: dict, key: str, label: str) -> list:

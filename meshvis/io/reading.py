@@ -18,6 +18,7 @@ from meshvis.errors import MeshvisError, ModelError, ModelFormatError
 from meshvis.io import gltf, obj, off, ply, stl
 from meshvis.io._common import describe_exception, one_line
 from meshvis.io.scene import soup_from_scene
+from meshvis.io.up_axis import format_up
 from meshvis.soup import Soup, validate
 
 #: file extension -> format name, for reading
@@ -63,7 +64,8 @@ def load(path: str | os.PathLike, *, name: str | None = None) -> Soup:
         float64 vertices, int64 triangles (polygons triangulated; ``source_face`` is the
         index of the polygon in the file, or of the face within its glTF primitive
         after instancing), per-face part and material, per-corner UVs and RGBA colours
-        where the file has them.
+        where the file has them; ``up``, the up axis of the format
+        (:data:`~meshvis.io.up_axis.FORMAT_UP`).
 
     Raises
     ------
@@ -102,6 +104,7 @@ def load(path: str | os.PathLike, *, name: str | None = None) -> Soup:
             f"cannot read as {_FORMAT_TITLES[fmt]}: {describe_exception(exc)}", label
         ) from None
     soup.path = label
+    soup.up = format_up(path)
     validate(soup.vertices, soup.faces, label)
     return soup
 

@@ -28,6 +28,50 @@ WRITE_FORMATS = {".obj": "obj", ".ply": "ply", ".stl": "stl", ".off": "off", ".g
 #: format name -> writer, collected from the format modules
 WRITERS = {**obj.WRITERS, **ply.WRITERS, **stl.WRITERS, **off.WRITERS, **gltf.WRITERS}
 
+#: formats that hold face groups such as layers: OBJ groups, PLY face properties, glTF nodes
+GROUP_FORMATS = ("obj", "ply", "glb", "gltf")
+
+
+def check_format(path: str | os.PathLike, *, layers: bool = False) -> str:
+    """The format that ``path``'s extension names, or :class:`OutputError` before any work.
+
+    Parameters
+    ----------
+    path : str or path-like
+        The output model.
+    layers : bool
+        The output holds layers: refuse the formats that cannot keep them apart (STL and
+        OFF, whose faces carry no group), so that no copy of the input passes for layers.
+
+    Returns
+    -------
+    str
+        The format name (:data:`WRITE_FORMATS`).
+
+    Raises
+    ------
+    OutputError
+        Unknown extension, or a format without groups for ``layers``.
+
+    Examples
+    --------
+    >>> check_format("out.PLY", layers=True)
+    'ply'
+    """
+    path = os.fspath(path)
+    ext = os.path.splitext(path)[1].lower()
+    if ext not in WRITE_FORMATS:
+        known = ", ".join(sorted(WRITE_FORMATS))
+        raise OutputError(f"cannot write '{ext or '(no extension)'}' files; known: {known}", path)
+    fmt = WRITE_FORMATS[ext]
+    if layers and fmt not in GROUP_FORMATS:
+        raise OutputError(
+            f"{fmt.upper()} files cannot hold layers (their faces carry no group); write .ply (a layer "
+            "property per face), .glb / .gltf (a node per layer) or .obj (a group per layer)",
+            path,
+        )
+    return fmt
+
 
 def save(
     soup: Soup,
@@ -125,9 +169,7 @@ def write(
     path = _validate.path("path", path)
     soup = as_soup(soup)
     ext = os.path.splitext(path)[1].lower()
-    if ext not in WRITE_FORMATS:
-        known = ", ".join(sorted(WRITE_FORMATS))
-        raise OutputError(f"cannot write '{ext or '(no extension)'}' files; known: {known}", path)
+    check_format(path)
     check_folder(path)
     m = soup.n_faces
     groups = None

@@ -14,36 +14,14 @@ import numpy as np
 
 from meshvis import _validate
 from meshvis.errors import ParameterError
-
-#: unit vectors of the axis names accepted as "up"
-AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
-
-
-#: the up axis of each file format, the rule every command and function that draws follows
-#: (``--up auto``): glTF is y-up by its specification and 3MF z-up by its; OBJ files are
-#: y-up by the convention of the tools that write them; STL, PLY and OFF (CAD, scanners)
-#: are z-up, as is a model without a file
-FORMAT_UP = {".glb": "y", ".gltf": "y", ".obj": "y", ".3mf": "z", ".stl": "z", ".ply": "z", ".off": "z"}
-FALLBACK_UP = "z"
+from meshvis.io.up_axis import AXES, FALLBACK_UP, FORMAT_UP, format_up, up_vector  # noqa: F401
 
 
 def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, float, float]:
     """The up vector for an axis name, or for ``"auto"`` the up axis of the files' format.
 
-    ``"auto"`` looks the files' extensions up in :data:`FORMAT_UP`; files of formats that
-    disagree, or no file, give :data:`FALLBACK_UP`.
-
-    Parameters
-    ----------
-    name : {"auto", "x", "y", "z"}
-        The axis name.
-    paths : sequence of str
-        The model files, read by ``"auto"``.
-
-    Returns
-    -------
-    tuple of 3 float
-        The unit up vector.
+    ``"auto"`` looks the files' extensions up in :data:`~meshvis.io.up_axis.FORMAT_UP`;
+    files of formats that disagree, or no file, give z.
 
     Examples
     --------
@@ -51,27 +29,16 @@ def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, 
     ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
     """
     if name != "auto":
-        if name not in AXES:
-            raise ParameterError(f"up must be auto, x, y or z; got {name!r}")
-        return AXES[name]
-    found = {FORMAT_UP.get(os.path.splitext(str(p))[1].lower(), FALLBACK_UP) for p in paths if p}
-    return AXES[found.pop()] if len(found) == 1 else AXES[FALLBACK_UP]
+        return tuple(up_vector(name).tolist())
+    found = {format_up(p) for p in paths if p}
+    return found.pop() if len(found) == 1 else AXES[FALLBACK_UP]
 
 
 def model_up(model: Any) -> tuple[float, float, float]:
-    """The up vector of a model by :func:`up_axis` ``"auto"``.
-
-    Taken from its file (a path, a list of paths, or a soup read from a file), else
-    :data:`FALLBACK_UP`.
-    """
-    if isinstance(model, (str, os.PathLike)):
-        paths = [os.fspath(model)]
-    elif isinstance(model, (list, tuple)) and model and all(isinstance(m, (str, os.PathLike)) for m in model):
-        paths = [os.fspath(m) for m in model]
-    else:
-        path = getattr(model, "path", None)
-        paths = [path] if isinstance(path, str) else []
-    return up_axis("auto", paths)
+    """The up vector of a model: ``Soup.up``, or the format's of a file (z for anything else)."""
+    if isinstance(model, (list, tuple)) and model and all(isinstance(m, (str, os.PathLike)) for m in model):
+        return up_axis("auto", [os.fspath(m) for m in model])
+    return tuple(up_vector(None, model).tolist())
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -233,14 +200,14 @@ class Camera:
 
         ``azimuth`` turns around the up axis, ``elevation`` lifts the camera above the
         horizon; both in degrees.  ``distance`` defaults to the distance
-        at which the bounding sphere (times ``margin``) fills the view.  ``up`` defaults to
-        the model's up axis by the rule of :func:`model_up`.
+        at which the bounding sphere (times ``margin``) fills the view.  ``up`` (an axis name
+        or a vector) defaults to the model's up axis (:func:`model_up`).
         """
         azimuth, elevation = _validate.real("azimuth", azimuth), _validate.real("elevation", elevation)
         bounds = _bounds_of(model)
         center = bounds.mean(axis=0)
         radius = 0.5 * float(np.linalg.norm(bounds[1] - bounds[0])) or 1.0
-        up = _unit(np.asarray(model_up(model) if up is None else up, np.float64))
+        up = np.asarray(model_up(model)) if up is None else up_vector(up)
         # a horizontal frame orthogonal to up; azimuth 0 views the model's "front": from +z
         # for y-up models (glTF, most OBJ), from -y for z-up models (CAD, STL)
         ref = np.array([0.0, 0.0, 1.0]) if abs(up[2]) < 0.9 else np.array([0.0, -1.0, 0.0])

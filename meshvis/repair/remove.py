@@ -27,6 +27,7 @@ around kept ones.  Every input face ends up in exactly one of the two outputs, w
 from __future__ import annotations
 
 import inspect
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,7 +40,13 @@ from meshvis.geometry.duplicates import hidden_copies, opposite_copies
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.io import as_soup
 from meshvis.rays.caster import VISIBILITY_OFFSET
-from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, LEVELS, VISIBILITY_MODES, cut_rays_per_point
+from meshvis.repair.remove_modes import (
+    DEFAULT_VISIBILITY,
+    LEVELS,
+    VISIBILITY_MODES,
+    cut_rays_per_point,
+    reuse_note,
+)
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, visible_from
 
@@ -123,7 +130,7 @@ def remove_interior(
     level: str = "face",
     keep_border: int = 0,
     budget: int | None = None,
-    up=(0.0, 0.0, 1.0),
+    up=None,
     view: Visibility | None = None,
     conservative: bool = False,
     **classify_kw: Any,
@@ -133,7 +140,9 @@ def remove_interior(
     Parameters
     ----------
     model : anything :func:`meshvis.classify` accepts
-    classification : reuse an existing classification of the same model
+    classification : reuse an existing classification of the same model (in ``"both"``, one
+        whose sample points got another ray budget than this function's own cut gives them
+        is used as it is, with a warning: the faces kept can differ)
     visibility : {"object", "view", "both"}
         The graph cut alone, sight from ``region`` alone, or both must call a face hidden
         (default :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`, ``"both"``; pass
@@ -146,8 +155,9 @@ def remove_interior(
         Rings of hidden faces (sharing an edge) kept around the kept faces.
     budget : int, optional
         Ray budget of the from-region search (default: :func:`meshvis.visible_from`'s).
-    up : (3,) float
-        Up direction of an ``"upper-hemisphere"`` region.
+    up : None, "x", "y", "z" or (3,) float
+        Up direction of an ``"upper-hemisphere"`` region; None: the model's own
+        (``Soup.up``: y for glTF and OBJ files, z otherwise).
     view : Visibility, optional
         Reuse a from-region search of the same model (``"view"`` only).
     conservative : bool
@@ -207,6 +217,9 @@ def remove_interior(
         code = np.where(keep, _KEPT_SEEN, _GONE_VIEW)
     else:
         c = classification or classify(model, **_cut_keywords(visibility, classify_kw))
+        note = reuse_note(c.params, visibility) if classification is not None else None
+        if note:
+            warnings.warn(note, stacklevel=2)
         soup = c.soup
         by_cut = _kept_by_cut(c)
         if visibility == "object":

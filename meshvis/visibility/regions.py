@@ -32,6 +32,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from meshvis.errors import ParameterError
+from meshvis.io.up_axis import up_vector
 from meshvis.rays.samples import uniform_sphere
 from meshvis.visibility import _kernels
 
@@ -121,19 +122,23 @@ class UpperHemisphere(Region):
 
     Parameters
     ----------
-    up : (3,) float
-        The up direction (normalised here).
+    up : None, "x", "y", "z" or (3,) float
+        The up direction (normalised here); None: the model's own (``Soup.up``, the
+        convention of its file format), taken when the region is bound to the model.
     """
 
     kind: str = "upper-hemisphere"
-    up: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    up: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        up = np.asarray(self.up, np.float64).reshape(3)
-        norm = np.linalg.norm(up)
-        if not np.isfinite(norm) or norm == 0:
-            raise ParameterError("the up direction of upper-hemisphere must be a non-zero vector")
-        self.up = up / norm
+        self._asked = None if self.up is None else up_vector(self.up)
+        self.up = self._asked
+
+    def bind(self, soup) -> Region:
+        """Fix the model's bounding sphere, and its up axis when none was given."""
+        super().bind(soup)
+        self.up = up_vector(None, soup) if self._asked is None else self._asked
+        return self
 
     def _view_directions(self, n, rng):
         d = uniform_sphere(n, rng)
@@ -147,7 +152,7 @@ class UpperHemisphere(Region):
 
     def describe(self):
         """The region as a JSON-ready dict."""
-        return {"kind": self.kind, "up": self.up.tolist()}
+        return {"kind": self.kind, "up": None if self.up is None else self.up.tolist()}
 
 
 @dataclass
@@ -276,7 +281,7 @@ def _aimed(origins: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, np.nda
 REGION_KINDS = ("outside", "upper-hemisphere", "box", "points", "path")
 
 
-def parse_region(text: str | Region, *, up=(0.0, 0.0, 1.0)) -> Region:
+def parse_region(text: str | Region, *, up=None) -> Region:
     """A region from its text form (the ``--from`` option of the command line).
 
     Parameters
@@ -286,8 +291,9 @@ def parse_region(text: str | Region, *, up=(0.0, 0.0, 1.0)) -> Region:
         ``box:x0,y0,z0,x1,y1,z1``; ``points:x,y,z;x,y,z;...``; ``path:FILE.json`` (a JSON
         list of ``[x, y, z]`` positions, or ``{"positions": [...]}``, or a list of camera
         objects with a ``position`` key).  A Region is returned as it is.
-    up : (3,) float
-        Up direction of ``upper-hemisphere`` when the text gives none.
+    up : None, "x", "y", "z" or (3,) float
+        Up direction of ``upper-hemisphere`` when the text gives none; None: the model's
+        own (``Soup.up``), fixed when the region is bound to the model.
 
     Returns
     -------

@@ -245,7 +245,7 @@ def visible_from(
     budget: int | None = None,
     seed: int = 0,
     method: str = "guided",
-    up=(0.0, 0.0, 1.0),
+    up=None,
     per_side: bool = False,
     faces: np.ndarray | None = None,
     min_new: float = MIN_NEW_PER_MILLION,
@@ -271,8 +271,9 @@ def visible_from(
         Seed of the one random generator; same model, region and seed give the same result.
     method : {"guided", "random"}
         GVS guided sampling, or plain random sampling (the baseline).
-    up : (3,) float
-        Up direction of ``"upper-hemisphere"`` when the region text gives none.
+    up : None, "x", "y", "z" or (3,) float
+        Up direction of ``"upper-hemisphere"`` when the region text gives none; None: the
+        model's own (``Soup.up``: y for glTF and OBJ files, z otherwise).
     per_side : bool
         Keep seeding a face until both of its sides are seen (for orientation); by default a
         face gets no more seed rays once either side is seen (enough to know it is visible,
