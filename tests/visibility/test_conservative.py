@@ -197,3 +197,14 @@ def test_the_command_line_reports_the_bracket_and_removes_only_what_is_surely_hi
     r = json.loads(rep.read_text())
     assert r["visibility"] == "conservative" and r["removed_faces"] >= 12  # the inner cube at least
     assert main(["visible", str(src), "--from", "outside", "--conservative", "-q"]) == 2
+
+
+def test_cameras_with_views_bracket_rays_in_their_views(tmp_path, scenes):
+    cube, names = scenes.unit_cube()
+    path = tmp_path / "cameras.json"
+    path.write_text(json.dumps({"cameras": [{"position": [0, 0, 0], "target": [1, 0, 0], "fov": 40}]}))
+    vis = meshvis.visible_from(cube, f"path:{path}", conservative=True, budget=20_000)
+    assert vis.method == "random rays in the views" and vis.rays["total"] == 20_000
+    np.testing.assert_array_equal(vis.seen, names == "+x")  # both +x triangles, nothing else
+    assert vis.report(per_face=False)["conservative"]["outside"] == 0
+    np.testing.assert_array_equal(vis.conservative.visible, names == "+x")
