@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|startup``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|startup|conservative``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -53,6 +53,7 @@ def add_parser(sub) -> None:
         "indoor",
         "real",
         "startup",
+        "conservative",
     ):
         try:
             mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])
