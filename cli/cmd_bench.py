@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|orient-twice|real|scale|labeling|labeling-sweep``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -48,6 +48,7 @@ def add_parser(sub) -> None:
         "compare",
         "scale",
         "orientation",
+        "orient-twice",
         "indoor",
         "real",
     ):

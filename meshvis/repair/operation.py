@@ -301,6 +301,7 @@ def run_operation(
     from meshvis.graphcut.classify import classify
     from meshvis.io.report import with_schema
     from meshvis.rays.camera import up_axis
+    from meshvis.repair.orient import classify_for_orient
 
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
     if op == "classify" and o["graphml"]:  # fail before the classification, not after
@@ -319,7 +320,8 @@ def run_operation(
             kw["rays_per_point"] = cut_rays_per_point(
                 o["visibility"], kw["rays_per_node"], kw["samples_per_face"], kw["rays_per_point"]
             )
-        c = classify(soup, progress=progress, **kw)
+        # orient classifies the faces wound canonically (the cut orient makes itself)
+        c = (classify_for_orient if op == "orient" else classify)(soup, progress=progress, **kw)
         tell(c.summary())
     report = _OUTPUTS[op](soup, c, o, tell, up)
     report["operation"] = op
