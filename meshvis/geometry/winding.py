@@ -11,10 +11,10 @@ per face, :func:`turned_from_canonical`, kept for the rules that honour it.
 >>> import numpy as np
 >>> v = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
 >>> f = np.array([[0, 1, 2], [0, 2, 1], [2, 0, 1]])
->>> canonical_faces(v, f).tolist()
-[[0, 1, 2], [0, 1, 2], [0, 1, 2]]
+>>> canonical_faces(v, f).tolist()  # by x, then y: (0, 0, 0), (0, 1, 0), (1, 0, 0)
+[[0, 2, 1], [0, 2, 1], [0, 2, 1]]
 >>> turned_from_canonical(v, f).tolist()
-[False, True, False]
+[True, False, True]
 """
 
 from __future__ import annotations
