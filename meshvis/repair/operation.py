@@ -479,6 +479,7 @@ def run_operation(
     from meshvis.graphcut.classify import classify
     from meshvis.io.report import with_schema
     from meshvis.io.up_axis import up_vector
+    from meshvis.repair.orient import classify_for_orient
 
     t0 = time.perf_counter()
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
@@ -496,7 +497,8 @@ def run_operation(
             kw["rays_per_point"] = cut_rays_per_point(
                 o["visibility"], kw["rays_per_node"], kw["samples_per_face"], kw["rays_per_point"]
             )
-        c = classify(soup, progress=progress, **kw)
+        # orient classifies the faces wound canonically (the cut orient makes itself)
+        c = (classify_for_orient if op == "orient" else classify)(soup, progress=progress, **kw)
         more(c.summary())
     report, line = _OUTPUTS[op](soup, c, o, tell, up)
     for text in _details(op, report):
