@@ -24,10 +24,11 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from meshvis import limits
+from meshvis import _validate, limits
 from meshvis.errors import ParameterError
 from meshvis.geometry.adjacency import weld
 from meshvis.io import as_soup
@@ -35,6 +36,9 @@ from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.visibility.regions import Region, parse_region
 from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling, view_lines
 from meshvis.visibility.walls import DEFAULT_TRANSPARENT, walls
+
+if TYPE_CHECKING:
+    from meshvis.visibility.conservative import ConservativeSet
 
 #: seed rays per unseen face in successive rounds
 SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
@@ -126,6 +130,9 @@ class Visibility:
         Why sampling stopped: ``"all seen"``, ``"few new faces"``, ``"budget"``, ``"rounds done"``.
     see_through : int
         Faces that sight passed through (see-through materials, :mod:`meshvis.visibility.walls`).
+    conservative : ConservativeSet or None
+        With ``conservative=True``: the faces that may be seen from the viewpoints
+        (:mod:`meshvis.visibility.conservative`).
     """
 
     seen_side: np.ndarray
@@ -143,6 +150,7 @@ class Visibility:
     stopped: str = ""
     see_through: int = 0
     extra: dict = field(default_factory=dict)
+    conservative: ConservativeSet | None = None
 
     @property
     def seen(self) -> np.ndarray:
@@ -171,6 +179,8 @@ class Visibility:
             "seconds": self.seconds,
             "history": self.history,
         }
+        if self.conservative is not None:
+            d["conservative"] = self.conservative.bracket(self.seen_side)
         if per_face:
             d["per_face"] = {
                 "seen_front": self.seen_side[:, 0],
@@ -261,6 +271,7 @@ def visible_from(
     caster: RayCaster | None = None,
     transparent: str = DEFAULT_TRANSPARENT,
     max_unseen: float = MAX_UNSEEN_PER_MILLION,
+    conservative: bool = False,
 ) -> Visibility:
     """Which sides of the model's faces a viewer in ``region`` can see.
 
@@ -303,6 +314,11 @@ def visible_from(
     transparent : {"see-through", "opaque"}
         Whether faces of see-through materials let sight pass (:mod:`meshvis.visibility.walls`;
         without ``caster``).
+    conservative : bool
+        Also bound the search from above: the faces that may be seen from the viewpoints of
+        a ``points:`` or ``path:`` region, in ``result.conservative``
+        (:func:`meshvis.visibility.conservative.bracket`; the search then looks from the
+        viewpoints themselves).
 
     Returns
     -------
@@ -311,7 +327,8 @@ def visible_from(
     Raises
     ------
     ParameterError
-        Unknown method or region, negative budget.
+        Unknown method or region, a budget below 1, a seed that is not an integer of at
+        least 0, ``per_side`` not a bool.
 
     Examples
     --------
@@ -322,6 +339,15 @@ def visible_from(
     """
     if method not in METHODS:
         raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    _validate.visibility_args(budget, seed, per_side, min_new, min_new_area)
+    if conservative:
+        from meshvis.visibility.conservative import bracket
+
+        return bracket(
+            model, region, search=visible_from, budget=budget, seed=seed, method=method, up=up,
+            per_side=per_side, faces=faces, min_new=min_new, min_new_area=min_new_area, caster=caster,
+            transparent=transparent, max_unseen=max_unseen,
+        )  # fmt: skip
     soup = as_soup(model)
     region = parse_region(region, up=up).bind(soup)
     asked = np.ones(soup.n_faces, bool)
@@ -331,8 +357,6 @@ def visible_from(
         if asked.shape != (soup.n_faces,):
             raise ParameterError(f"faces must be {soup.n_faces} booleans or face indices")
     budget = default_budget(int(asked.sum())) if budget is None else int(budget)
-    if budget < 0:
-        raise ParameterError(f"budget must be at least 0, got {budget}")
     caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET, walls=walls(soup, transparent))
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new, min_new_area)
