@@ -197,11 +197,11 @@ def main(args: argparse.Namespace) -> int:
         )
         print(format_model(r), flush=True)
         results.append(r)
+        if args.json:  # after every model: a long run stopped part-way keeps what it measured
+            write_json(args.json, {"machine": _machine(), "results": results})
     print(format_summary(results))
     if args.curve:
         plot_curves(results, args.curve)
-    if args.json:
-        write_json(args.json, {"machine": _machine(), "results": results})
     return 0
 
 
