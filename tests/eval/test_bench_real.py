@@ -43,6 +43,13 @@ def test_bench_real_judges_the_default_removal_at_every_seed_and_the_layers(tmp_
     assert [x["seed"] for x in r["default"]] == [0, 1]
     for x in r["default"]:
         assert x["stopped"] and 0 <= x["check_area"] <= 1 and x["check_faces_seen"] >= 0
+        # by sight every face kept was seen: once the faces the searches saw are out of the
+        # estimate, the default removes all of it
+        assert (
+            x["hidden_removed_all_searches"] == 1.0
+            and x["hidden_removed_all_searches"] >= x["hidden_removed"]
+        )
+    assert r["layers"]["layer1_hidden_share_all_searches"] == 0.0
     rows = r["default"] + r["rows"] + [r["layers"]["layer1"]]
     for row in rows:
         assert 0 <= row["removed_area"] <= 1 and 0 <= row["hidden_removed"] <= 1
