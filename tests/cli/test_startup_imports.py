@@ -117,3 +117,20 @@ def test_what_the_source_does_not_settle_is_imported(tmp_path, monkeypatch):
     assert signature_default("meshvis_probe_mod:f", "d") == 6  # read by importing
     assert module_constant("meshvis_probe_mod:TWICE") == 6
     monkeypatch.delitem(sys.modules, "meshvis_probe_mod")
+
+
+def test_the_program_exits_with_mains_status_and_skips_the_last_collection(tmp_path):
+    model = real_model("soup.stl")
+    probe = (
+        "import atexit, gc, sys\n"
+        "atexit.register(lambda: print('frozen', gc.get_freeze_count() > 0))\n"
+        "sys.argv = ['meshvis', *sys.argv[1:]]\n"
+        "from meshvis.cli.main import program\nprogram()"
+    )
+    ok = subprocess.run([sys.executable, "-c", probe, "info", model], capture_output=True, text=True)
+    assert ok.returncode == 0 and ok.stdout.strip().endswith("frozen True")
+    bad = subprocess.run(
+        [sys.executable, "-m", "meshvis", "info", str(tmp_path / "none.stl")], capture_output=True
+    )
+    assert bad.returncode == 2
+    assert subprocess.run([sys.executable, "-m", "meshvis", "--version"], capture_output=True).returncode == 0
