@@ -73,12 +73,17 @@ class Candidates:
 
     Attributes
     ----------
-    ex, ey : (h, w) float64, endpoint on the boundary of ``A_I`` (NaN outside ``A_I``)
+    ex, ey : (h, w) float64
+        Endpoint on the boundary of ``A_I`` (NaN outside ``A_I``)
     length : (h, w) float64, ``|a e|`` from the pixel centre (NaN outside ``A_I``)
-    side : (h, w) int8, side code (:data:`WEST` ... :data:`RADIAL`), -1 outside ``A_I``
-    eid : (h, w) int64, endpoint id (index into ``endpoints``), -1 outside ``A_I``
-    endpoints : (n_e, 2) float64, the distinct endpoints
-    d_max : float, the longest candidate over all of ``A_I`` (appendix I, §6.1 step 3)
+    side : (h, w) int8
+        Side code (:data:`WEST` ... :data:`RADIAL`), -1 outside ``A_I``
+    eid : (h, w) int64
+        Endpoint id (index into ``endpoints``), -1 outside ``A_I``
+    endpoints : (n_e, 2) float64
+        The distinct endpoints
+    d_max : float
+        The longest candidate over all of ``A_I`` (appendix I, §6.1 step 3)
     """
 
     ex: np.ndarray

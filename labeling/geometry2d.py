@@ -59,7 +59,10 @@ def segments_intersect(a: np.ndarray, b: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    a : (n, 2, 2), b : (m, 2, 2)
+    a : (n, 2, 2) float
+        Segments, each as its two end points.
+    b : (m, 2, 2) float
+        Segments, each as its two end points.
     """
     a = np.asarray(a, np.float64).reshape(-1, 2, 2)
     b = np.asarray(b, np.float64).reshape(-1, 2, 2)

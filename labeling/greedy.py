@@ -69,8 +69,10 @@ class GreedyResult:
 
     Attributes
     ----------
-    area_order : (k,) int, areas in the order they were labelled
-    pick : (k,) int, chosen candidate (index into the candidate arrays) of each of them
+    area_order : (k,) int
+        Areas in the order they were labelled
+    pick : (k,) int
+        Chosen candidate (index into the candidate arrays) of each of them
     feasibility : (k,) float, ``F`` of the chosen candidate when it was chosen
     priority : (k,) float, ``P_i`` of the area when it was chosen
     """
@@ -136,14 +138,21 @@ def greedy_layout(
 
     Parameters
     ----------
-    area : (N,) int, area index (0 .. n_areas-1) of each candidate, **sorted ascending**
-    ax, ay : (N,) float, anchor (pixel centre) of each candidate
-    eid : (N,) int, endpoint id of each candidate (row of ``endpoints``)
-    endpoints : (n_e, 2) float, the distinct endpoints
-    static : (N,) float, product of the weighted memberships that do not depend on the
+    area : (N,) int
+        Area index (0 .. n_areas-1) of each candidate, **sorted ascending**
+    ax, ay : (N,) float
+        Anchor (pixel centre) of each candidate
+    eid : (N,) int
+        Endpoint id of each candidate (row of ``endpoints``)
+    endpoints : (n_e, 2) float
+        The distinct endpoints
+    static : (N,) float
+        Product of the weighted memberships that do not depend on the
         placed leaders: ``f2^w2 f3^w3 f6^w6 f7^w7``
-    n_areas : int, number of areas
-    d_a, d_e : float, distance thresholds of Eq. 4 and Eq. 6, pixels (0 disables)
+    n_areas : int
+        Number of areas
+    d_a, d_e : float
+        Distance thresholds of Eq. 4 and Eq. 6, pixels (0 disables)
     w4, w5 : weights of f4 and f5
 
     Returns

@@ -34,12 +34,18 @@ class InternalArea:
     Attributes
     ----------
     kind : "hull", "circle" or "rectangle"
-    margin : float, growth in pixels
-    polygon : (k, 2) float, the corners of the boundary in order, not closed
-    pad : int, padding of the raster grid on every side
-    mask : (h + 2 pad, w + 2 pad) bool, pixel centres inside the polygon (padded grid)
-    left, right : (h + 2 pad,) float, x of the boundary on each padded row (NaN: row empty)
-    top, bottom : (w + 2 pad,) float, y of the boundary on each padded column (NaN: empty)
+    margin : float
+        Growth in pixels
+    polygon : (k, 2) float
+        The corners of the boundary in order, not closed
+    pad : int
+        Padding of the raster grid on every side
+    mask : (h + 2 pad, w + 2 pad) bool
+        Pixel centres inside the polygon (padded grid)
+    left, right : (h + 2 pad,) float
+        X of the boundary on each padded row (NaN: row empty)
+    top, bottom : (w + 2 pad,) float
+        Y of the boundary on each padded column (NaN: empty)
     integral : (h + 2 pad + 1, w + 2 pad + 1) int64 summed-area table of ``mask``
     """
 
@@ -155,9 +161,11 @@ def internal_area(
 
     Parameters
     ----------
-    model_mask : (h, w) bool, pixels that see the model
+    model_mask : (h, w) bool
+        Pixels that see the model
     kind : "hull" (default), "circle" or "rectangle"
-    margin : float, growth in pixels; default 2 % of the image's smaller side
+    margin : float
+        Growth in pixels; default 2 % of the image's smaller side
 
     Returns
     -------

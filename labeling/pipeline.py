@@ -496,23 +496,37 @@ def solve(
     Parameters
     ----------
     idbuf : IdBuffer
-    texts : one label text per part ("" = do not label)
-    layout : a key of :data:`labeling.candidates.LAYOUTS`
-    area : internal area shape, "hull", "circle" or "rectangle"
-    margin : growth of the internal area in pixels (default 2 % of the image's smaller side)
-    weights : Weights of Eq. 11 (paper defaults)
-    d_a : anchor distance threshold of Eq. 4, as a fraction of ``d_S``
-    d_e : endpoint distance threshold of Eq. 6, as a fraction of ``d_S``; default: the box
+        The view's ID buffer.
+    texts : sequence of str
+        One label text per part ("" = do not label).
+    layout : str
+        A key of :data:`labeling.candidates.LAYOUTS`.
+    area : {"hull", "circle", "rectangle"}
+        Shape of the internal area.
+    margin : float, optional
+        Growth of the internal area in pixels (default 2 % of the image's smaller side).
+    weights : Weights, optional
+        Weights of Eq. 11 (paper defaults).
+    d_a : float
+        Anchor distance threshold of Eq. 4, as a fraction of ``d_S``.
+    d_e : float, optional
+        Endpoint distance threshold of Eq. 6, as a fraction of ``d_S``; default: the box
         height (west/east layouts) or the mean box width (others) plus the box gap, as the
         paper recommends (§7.2)
-    previous : the previous frame's result, for the coherence terms f6 and f7 (Eq. 8-9)
-    method : "fuzzy" (this paper) or "two-step" (classic baseline: the most salient point of
+    previous : LayoutResult, optional
+        The previous frame's result, for the coherence terms f6 and f7 (Eq. 8-9).
+    method : {"fuzzy", "two-step"}
+        "fuzzy" (this paper) or "two-step" (classic baseline: the most salient point of
         each area, then its candidate leader, then the same box corrections)
-    font_size : label font size in pixels (default: :func:`labeling.text.default_font_size`;
+    font_size : int, optional
+        Label font size in pixels (default: :func:`labeling.text.default_font_size`;
         reduced for west/east layouts until the columns fit the image)
-    min_pixels : parts with fewer visible pixels are treated as invisible
-    spacing : Spacing of the boxes
-    compute_metrics : measure the result (:func:`labeling.metrics.frame_metrics`)
+    min_pixels : int
+        Parts with fewer visible pixels are treated as invisible.
+    spacing : Spacing, optional
+        Spacing of the boxes.
+    compute_metrics : bool
+        Measure the result (:func:`labeling.metrics.frame_metrics`).
 
     Returns
     -------
@@ -614,16 +628,24 @@ def layout(
 
     Parameters
     ----------
-    model : Soup, path, trimesh object, or a list of them (combined; see
+    model : Soup, path, trimesh object, or a list of them
+        Combined when several; see
         :func:`labeling.inputs.load_models`)
-    camera : Camera; default :func:`fit_camera` from ``azimuth``, ``elevation``, ``up``,
+    camera : Camera, optional
+        Default default :func:`fit_camera` from ``azimuth``, ``elevation``, ``up``,
         ``fit_margin``
-    layout : "left", "right", "left-right" (default), "top", "bottom", "top-bottom", "silhouette"
-    size : (width, height) in pixels
-    texts : label texts: a mapping {part name or index: text} or one text per part
-    caster : a RayCaster of the same model to reuse (frames, benchmarks)
-    color_by : colouring of the shaded picture
-    **options : passed to :func:`solve` (area, margin, weights, d_a, d_e, previous, method,
+    layout : {"left", "right", "left-right", "top", "bottom", "top-bottom", "silhouette"}
+        Where the boxes go (default left-right).
+    size : (2,) int
+        ``(width, height)`` in pixels.
+    texts : mapping or sequence of str, optional
+        Label texts: a mapping ``{part name or index: text}`` or one text per part
+    caster : RayCaster, optional
+        A ray caster of the same model to reuse (frames, benchmarks).
+    color_by : str or None
+        Colouring of the shaded picture.
+    **options
+        Passed to :func:`solve` (area, margin, weights, d_a, d_e, previous, method,
         font_size, min_pixels, spacing)
 
     Returns

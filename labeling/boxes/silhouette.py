@@ -64,8 +64,10 @@ def _radial_candidates(
     Returns
     -------
     boxes : (K, 4)
-    leaders : (L, 3, 2), anchor -> E -> port, one per (endpoint, tier)
-    lid : (K,) int, the leader of each box
+    leaders : (L, 3, 2)
+        Anchor -> E -> port, one per (endpoint, tier)
+    lid : (K,) int
+        The leader of each box
     cost : (K,) pixels of leader: the push-out ``t * step``, plus for a moved endpoint
         the longer inside part and one box height for the bend; then ``(1 - along) h``
         (boxes centred on the ray before corner flags), :data:`~.costs.BEHIND_PORT_COST` for

@@ -55,7 +55,8 @@ def uncross(anchors: np.ndarray, ports: np.ndarray, max_swaps: int | None = None
 
     Returns
     -------
-    assignment : (n,) int, port index of each anchor
+    assignment : (n,) int
+        Port index of each anchor
     swaps : int
     """
     n = len(anchors)
@@ -91,7 +92,8 @@ def coherent_order(desired: np.ndarray, previous: np.ndarray, pitch: float) -> n
 
     Returns
     -------
-    (n,) int, a permutation of ``range(n)``
+    (n,) int
+        A permutation of ``range(n)``
     """
     desired = np.asarray(desired, np.float64)
     previous = np.asarray(previous, np.float64)

@@ -146,6 +146,7 @@ def reference(model, *, seed: int = 0, cache: str | os.PathLike | None = None, p
     Parameters
     ----------
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model.
     seed : int
         Seed of the one random generator; same model and seed give the same reference.
     cache : path, optional

@@ -103,17 +103,21 @@ def escapes(
 
     Parameters
     ----------
-    soup : Soup, the model ``caster`` was built on
+    soup : Soup
+        The model ``caster`` was built on
     caster : RayCaster of ``soup``
-    faces : (k,) int64, faces to cast from
-    rays : int, rays per face
+    faces : (k,) int64
+        Faces to cast from
+    rays : int
+        Rays per face
     rng : numpy Generator
     through : (k,) int, optional: cast through this side of each face only (0 front,
         1 back), uniformly on its hemisphere; default both, uniformly on the sphere
 
     Returns
     -------
-    (k, 2) int64, escaping rays that left through the front (column 0) and the back
+    (k, 2) int64
+        Escaping rays that left through the front (column 0) and the back
     """
     faces = np.asarray(faces, np.int64)
     out = np.zeros((len(faces), 2), np.int64)
@@ -276,15 +280,25 @@ def more_rays(
     Parameters
     ----------
     soup, caster : the model and its RayCaster
-    faces : (k,) int64, the faces tested
-    escaped : (k, 2) int64, escaping rays per face and side so far (updated)
-    cast : (k,) int64, rays cast per face so far (updated)
-    which : (j,) int, positions in ``faces`` that get more rays
-    rays : int, rays per face; share : float, the cap; rng : numpy Generator
+    faces : (k,) int64
+        The faces tested
+    escaped : (k, 2) int64
+        Escaping rays per face and side so far (updated)
+    cast : (k,) int64
+        Rays cast per face so far (updated)
+    which : (j,) int
+        Positions in ``faces`` that get more rays
+    rays : int
+        Rays per face.
+    share : float
+        The cap.
+    rng : numpy.random.Generator
+        The random generator.
 
     Returns
     -------
-    (i,) int64, the positions of ``which`` that were cast from (all, or the largest under
+    (i,) int64
+        The positions of ``which`` that were cast from (all, or the largest under
     the cap), sorted
     """
     cap = int(share * 2 * FIRST_RAYS * len(faces)) // rays
@@ -321,8 +335,10 @@ def until_decisive(
     ----------
     soup, caster, faces, escaped, cast, which, rng : as :func:`more_rays` (``which``: the
         positions in ``faces`` that get the rounds)
-    shown : (k,) int, the side (0 front, 1 back) each face shows
-    share : float, the cap in place of :data:`RARE_SHARE` (the floor stays)
+    shown : (k,) int
+        The side (0 front, 1 back) each face shows
+    share : float
+        The cap in place of :data:`RARE_SHARE` (the floor stays)
 
     Examples
     --------
@@ -474,17 +490,22 @@ def seen_side(
     Parameters
     ----------
     soup, caster : the model and its RayCaster
-    faces : (k,) int64, faces to test
-    shown : (k,) int, the side (0 front, 1 back) each face would show without this test
+    faces : (k,) int64
+        Faces to test
+    shown : (k,) int
+        The side (0 front, 1 back) each face would show without this test
     rng : numpy Generator
     dominance : float or (k,) float, the dominance that makes a face's evidence decisive
         (:func:`decisive`)
 
     Returns
     -------
-    side : (k,) int8, the side that escapes more often (``shown`` on a tie)
-    sure : (k,) bool, the evidence is decisive (:func:`decisive`)
-    rays : int, rays cast
+    side : (k,) int8
+        The side that escapes more often (``shown`` on a tie)
+    sure : (k,) bool
+        The evidence is decisive (:func:`decisive`)
+    rays : int
+        Rays cast
     """
     shown = np.asarray(shown, np.int64)
     escaped, cast = seen_counts(soup, caster, faces, shown, rng)
@@ -496,12 +517,15 @@ def more_seen(escaped: np.ndarray, shown: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    escaped : (k, 2) int, escapes per face from its front and its back
-    shown : (k,) int, the side (0 front, 1 back) each face shows without the evidence
+    escaped : (k, 2) int
+        Escapes per face from its front and its back
+    shown : (k,) int
+        The side (0 front, 1 back) each face shows without the evidence
 
     Returns
     -------
-    (k,) int8, the side seen more often
+    (k,) int8
+        The side seen more often
 
     Examples
     --------

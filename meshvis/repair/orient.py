@@ -141,19 +141,29 @@ class OrientResult:
 
     Attributes
     ----------
-    soup : the oriented output soup (input faces, some flipped, plus any duplicates)
-    source : (k,) int64, input face of every output face
-    flipped : (m,) bool, input faces written turned over
-    duplicated : (m,) bool, input faces written in both orientations
-    status : (m,) int8, one of ``STATUS_NAMES`` per input face
-    parity_faces : int, hidden faces whose side came from ray parity (:func:`parity_side`)
-    patch_faces : int, faces turned to agree with the vote of their patch
-    visibility : dict, the per-face visibility test: faces ``tested``, faces ``turned``
+    soup : Soup
+        The oriented output (input faces, some flipped, plus any duplicates).
+    source : (k,) int64
+        Input face of every output face
+    flipped : (m,) bool
+        Input faces written turned over
+    duplicated : (m,) bool
+        Input faces written in both orientations
+    status : (m,) int8
+        One of ``STATUS_NAMES`` per input face
+    parity_faces : int
+        Hidden faces whose side came from ray parity (:func:`parity_side`)
+    patch_faces : int
+        Faces turned to agree with the vote of their patch
+    visibility : dict
+        The per-face visibility test: faces ``tested``, faces ``turned``
         to show the side a viewer sees, ``rays`` cast, ``pooled_patches`` (patches
         given the side their faces' rays see, pooled)
-    double_sided : int, faces kept as they are because they are one copy of a sheet stored
+    double_sided : int
+        Faces kept as they are because they are one copy of a sheet stored
         twice with opposite winding (:mod:`meshvis.geometry.duplicates`)
-    view : Visibility or None, the from-region visibility of :func:`orient_from` (then
+    view : Visibility or None
+        The from-region visibility of :func:`orient_from` (then
         ``classification`` is None)
     """
 
@@ -239,8 +249,10 @@ def surface_vote(
 
     Returns
     -------
-    side : (m,) int8, the side of each face in the winning set (0 where there is no vote)
-    decisive : (m,) bool, the face's patch has votes and they are not tied
+    side : (m,) int8
+        The side of each face in the winning set (0 where there is no vote)
+    decisive : (m,) bool
+        The face's patch has votes and they are not tied
     """
     node = clustering.side_node
     votes = np.zeros(clustering.n_nodes)
@@ -270,14 +282,21 @@ def parity_side(
 
     Parameters
     ----------
-    c : Classification of the model
-    faces : (k,) int, faces to decide
-    seed : seed of the ray directions; rays : rays per face
-    max_crossings : crossings followed per ray at most
+    c : Classification
+        The classification of the model.
+    faces : (k,) int
+        Faces to decide
+    seed : int
+        Seed of the ray directions.
+    rays : int
+        Rays per face.
+    max_crossings : int
+        Crossings followed per ray at most.
 
     Returns
     -------
-    (k,) int8, 0 when the front should face out, 1 when the back should
+    (k,) int8
+        0 when the front should face out, 1 when the back should.
     """
     from meshvis.geometry.adjacency import components, duplicate_faces, edges, face_adjacency
     from meshvis.rays.samples import cosine_hemisphere
@@ -322,11 +341,14 @@ class Patches:
 
     Attributes
     ----------
-    clustering : the orientation double cover (:func:`meshvis.graphcut.clusters.cluster_sides`)
+    clustering : Clustering
+        The orientation double cover (:func:`meshvis.graphcut.clusters.cluster_sides`)
         over every face with three distinct welded corners (:func:`_joining`)
-    closed : (m,) bool, the face's patch is closed: every edge of every face of it is a
+    closed : (m,) bool
+        The face's patch is closed: every edge of every face of it is a
         manifold edge between two faces of the patch
-    size : (m,) int64, faces in the face's patch (0 for a face in none)
+    size : (m,) int64
+        Faces in the face's patch (0 for a face in none)
     """
 
     clustering: Clustering
@@ -723,13 +745,20 @@ def orient(
 
     Parameters
     ----------
-    model : anything :func:`meshvis.classify` accepts
-    front : "ccw" (counter-clockwise front, the usual convention) or "cw"
-    two_sided : "keep", "duplicate" or "strongest" (see module docstring)
-    semantics : "layer" (default) or "cavity" for hidden shells
-    conflicts : "majority" or "duplicate" for flagged faces whose sample points disagree
-    classification : reuse an existing classification of the same model
-    **classify_kw : passed to :func:`meshvis.classify`
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.classify` accepts.
+    front : {"ccw", "cw"}
+        Winding of the front side: counter-clockwise (the usual convention) or clockwise.
+    two_sided : {"keep", "duplicate", "strongest"}
+        Faces with both sides outside (see the module docstring).
+    semantics : {"layer", "cavity"}
+        Hidden shells face outward at their layer, or every second layer inward.
+    conflicts : {"majority", "duplicate"}
+        Flagged faces whose sample points disagree: the area majority, or both orientations.
+    classification : Classification, optional
+        An existing classification of the same model to reuse.
+    **classify_kw
+        Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...).
 
     Returns
     -------

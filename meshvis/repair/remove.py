@@ -63,13 +63,20 @@ class RemovalResult:
 
     Attributes
     ----------
-    kept, removed : Soup, the faces kept and removed (attributes preserved)
-    keep : (m,) bool per input face
-    classification : Classification or None (``visibility="view"`` needs none)
-    visibility : Visibility or None, the from-region search (``"view"`` and ``"both"``)
-    reason_code : (m,) int8, index into :data:`REASONS` per input face
-    mode : str, the ``visibility`` used
-    soup : Soup, the input model
+    kept, removed : Soup
+        The faces kept and removed (attributes preserved)
+    keep : (m,) bool
+        Kept, per input face.
+    classification : Classification or None
+        The cut (``visibility="view"`` needs none).
+    visibility : Visibility or None
+        The from-region search (``"view"`` and ``"both"``)
+    reason_code : (m,) int8
+        Index into :data:`REASONS` per input face
+    mode : str
+        The ``visibility`` used
+    soup : Soup
+        The input model
     """
 
     kept: Soup
@@ -128,8 +135,10 @@ def remove_interior(
 
     Parameters
     ----------
-    model : anything :func:`meshvis.classify` accepts
-    classification : reuse an existing classification of the same model
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.classify` accepts.
+    classification : Classification, optional
+        An existing classification of the same model to reuse.
     visibility : {"object", "view", "both"}
         The graph cut alone, sight from ``region`` alone, or both must call a face hidden
         (default :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`, ``"both"``; pass
@@ -146,7 +155,8 @@ def remove_interior(
         Up direction of an ``"upper-hemisphere"`` region.
     view : Visibility, optional
         Reuse a from-region search of the same model (``"view"`` only).
-    **classify_kw : passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
+    **classify_kw
+        Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
         in ``"both"`` an unset ``rays_per_point`` is ``rays_per_node // samples_per_face``
         (module notes)
 

@@ -107,9 +107,13 @@ class Visibility:
     skipped : dict
         Faces that got no rays, by reason, and mutated rays refused by the region.
     region : Region
+        Where the viewers are.
     method : str
+        ``guided`` or ``random``.
     seed : int
+        Seed of the random rays.
     seconds : float
+        Wall time of the search.
     stopped : str
         Why sampling stopped: ``"all seen"``, ``"few new faces"``, ``"budget"``, ``"rounds done"``.
     """
@@ -247,6 +251,7 @@ def visible_from(
     Parameters
     ----------
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model.
     region : str or Region
         Where viewers may be (see :func:`meshvis.visibility.regions.parse_region`):
         ``"outside"``, ``"upper-hemisphere"``, ``"box:x0,y0,z0,x1,y1,z1"``,
