@@ -16,9 +16,9 @@ corners builds its scene about twice as fast on its distinct vertices, and every
 keeps the float32 corners it would have on the full buffer, so the hits are the same.
 
 Threads or processes?  ``embreex`` releases the GIL while it traces, so two threads
-trace a large batch 1.5–1.8 times as fast as one on a 2-core machine (docs/performance.md);
-processes would have to rebuild the scene and copy the rays and results, and measure
-slower.  ``meshvis bench rays`` measures all three side by side.
+trace a large batch faster than one on a machine with a free core; processes would have
+to rebuild the scene and copy the rays and results, and measure slower.  ``meshvis bench
+rays`` measures all three side by side (docs/benchmarks.md, "Ray backend").
 """
 
 from __future__ import annotations
@@ -47,7 +47,7 @@ VISIBILITY_OFFSET = 1e-6
 #: threads of the kept pool (:func:`meshvis._threads.pool`).  Handing a chunk to the pool
 #: costs tens of microseconds, Embree traces 2 k rays in 0.3-1 ms: from 4 k rays two
 #: threads pay (the monastery's from-region search traces 114 batches of 4-32 k rays;
-#: docs/performance.md, "Ray backend")
+#: ``meshvis bench rays`` times the backend)
 CHUNK = 1 << 11
 
 
