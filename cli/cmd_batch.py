@@ -65,7 +65,6 @@ def add_parser(sub) -> None:
         help="run orient / remove-interior / layers over many files (local processes or Dask)",
         description="Run one repair operation over files, folders (recursive) and glob patterns.",
         epilog=EPILOG,
-        formatter_class=argparse.RawDescriptionHelpFormatter,
     )
     p.add_argument(
         "inputs",
@@ -242,6 +241,7 @@ def run(args: argparse.Namespace) -> int:
     from meshvis.batch import default_jobs, plan, run_batch, write_summary
     from meshvis.errors import ParameterError
     from meshvis.io import ensure_folder
+    from meshvis.repair.operation import check_options
 
     if args.dask_scheduler and args.jobs:
         raise ParameterError("--jobs sets local worker processes; with --dask-scheduler the cluster decides")
@@ -251,7 +251,9 @@ def run(args: argparse.Namespace) -> int:
     if args.op == "remove-interior":  # orient has a --from of its own meaning
         dests += _dests(removal_options)
     options = {dest: getattr(args, dest) for dest in dests}
-    _validate.operation_options(options)  # a bad --seed fails here once, not in every file
+    # a bad --seed or --from fails here once, before any file is read, not in every file
+    _validate.operation_options(options)
+    check_options(args.op, options)
     tasks = plan(args.inputs, args.op, args.out, options)
     ensure_folder(args.out)
     jobs = None if args.dask_scheduler else (args.jobs or default_jobs(len(tasks)))

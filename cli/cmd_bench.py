@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|startup``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -45,11 +45,14 @@ def add_parser(sub) -> None:
         "stability",
         "labeling",
         "labeling-sweep",
+        "labeling-orbit",
+        "labeling-page",
         "compare",
         "scale",
         "orientation",
         "indoor",
         "real",
+        "startup",
     ):
         try:
             mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])

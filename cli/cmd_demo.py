@@ -7,7 +7,7 @@ import os
 
 from meshvis.errors import OutputError
 
-from .common import say
+from .common import detail, say, verbosity_options
 
 
 def add_parser(sub) -> None:
@@ -20,10 +20,10 @@ def add_parser(sub) -> None:
     """
     p = sub.add_parser("demo", help="run all three repairs on a bundled model and write results + previews")
     p.add_argument("--out", default="meshvis-demo", help="folder to write into (default ./meshvis-demo)")
-    p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--seed", type=int, default=0, help="seed of the soup and of the classification")
     p.add_argument("--size", type=int, default=512, help="preview size in pixels (default 512)")
     p.add_argument("--force", action="store_true", help="write into a folder that already has demo files")
-    p.add_argument("--quiet", "-q", action="store_true")
+    verbosity_options(p)
     p.set_defaults(func=run)
 
 
@@ -56,5 +56,11 @@ def run(args: argparse.Namespace) -> int:
         raise OutputError("exists and is not a folder", args.out)
     if not args.force and any(os.path.exists(os.path.join(args.out, f)) for f in DEMO_FILES):
         raise OutputError("already holds demo results; use --force to overwrite", args.out)
-    run_demo(args.out, seed=args.seed, size=args.size, say=lambda text: say(args, text))
+    run_demo(
+        args.out,
+        seed=args.seed,
+        size=args.size,
+        say=lambda text: say(args, text),
+        detail=lambda text: detail(args, text),
+    )
     return 0

@@ -7,6 +7,8 @@ import json
 
 from meshvis.errors import ParameterError
 
+from .common import library_default
+
 
 def add_parser(sub) -> None:
     """Add the ``info`` subcommand to the ``meshvis`` parser.
@@ -26,8 +28,8 @@ def add_parser(sub) -> None:
     p.add_argument(
         "--eps",
         type=float,
-        default=1e-6,
-        help="distance tolerance of the intersection tests, fraction of the diagonal (default 1e-6)",
+        default=library_default("meshvis.geometry.diagnostics:diagnose", "eps"),
+        help="distance tolerance of the intersection tests, fraction of the diagonal",
     )
     p.add_argument(
         "--no-intersections",

@@ -1,4 +1,9 @@
-"""``meshvis classify | orient | remove-interior | layers``: the graph-cut commands."""
+"""``meshvis classify | orient | remove-interior | layers``: the graph-cut commands.
+
+Every default is read from the library function the option is passed to
+(:func:`meshvis.repair.operation.default_options`), so a command gives the faces the same
+call gives from Python.
+"""
 
 from __future__ import annotations
 
@@ -9,32 +14,40 @@ import time
 from meshvis.errors import ParameterError
 from meshvis.graphcut.solvers import SOLVERS
 from meshvis.io.report import write_report
-from meshvis.repair.operation import CLASSIFY_DEFAULTS, OPERATION_DEFAULTS
 from meshvis.repair.remove_modes import LEVELS, VISIBILITY_MODES
 
-from .common import check_output, point, positive_int, say, staged_outputs
+from .common import check_outputs, point, positive_int, say, staged_outputs, up_option, verbosity_options
 
 
-def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
+def _defaults(op: str) -> dict:
+    from meshvis.repair.operation import default_options
+
+    return default_options(op)
+
+
+def _common(p: argparse.ArgumentParser, needs_output: bool = True, layers: bool = False) -> None:
     p.add_argument("input", help="input model (OBJ, PLY, STL, OFF, glTF/GLB, 3MF)")
     if needs_output:
-        p.add_argument("-o", "--output", required=True, help="output model; format from the extension")
+        formats = "OBJ, PLY, glTF/GLB" if layers else "OBJ, PLY, STL, OFF, glTF/GLB"
+        p.add_argument(
+            "-o", "--output", required=True, help=f"output model ({formats}); format from the extension"
+        )
     p.add_argument(
         "--report",
         metavar="REPORT.json",
-        help="write a JSON report with per-face results ('-': standard output)",
+        help="write a JSON report with per-face results ('-': standard output; default: none)",
     )
     p.add_argument(
-        "--per-face", metavar="FILE.npz", help="write the report's per-face arrays to a .npz file instead"
+        "--per-face",
+        metavar="FILE.npz",
+        help="write the report's per-face arrays to a .npz file instead (default: in the report)",
     )
-    p.add_argument("--preview", metavar="PICTURE.png", help="write a ray-cast preview image")
     p.add_argument(
-        "--up",
-        choices=("auto", "x", "y", "z"),
-        default="auto",
-        help="the model's up axis, for the preview and the upper-hemisphere region "
-        "(default auto: y for glTF/GLB and OBJ, z otherwise)",
+        "--preview",
+        metavar="PICTURE.png",
+        help="write a ray-cast preview picture, PNG or JPEG (default: none)",
     )
+    up_option(p, "the preview and the upper-hemisphere region")
     algorithm_options(p)
     p.add_argument(
         "--inside-point",
@@ -43,7 +56,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
         action="append",
         default=[],
         metavar="X,Y,Z",
-        help="a point known to be inside (repeatable)",
+        help="a point known to be inside (repeatable; default: none)",
     )
     p.add_argument(
         "--outside-point",
@@ -52,7 +65,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
         action="append",
         default=[],
         metavar="X,Y,Z",
-        help="a point known to be outside (repeatable)",
+        help="a point known to be outside (repeatable; default: none)",
     )
     p.add_argument(
         "--inside-box",
@@ -61,7 +74,7 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
         action="append",
         default=[],
         metavar="X0,Y0,Z0,X1,Y1,Z1",
-        help="an axis-aligned box known to be inside (repeatable)",
+        help="an axis-aligned box known to be inside (repeatable; default: none)",
     )
     p.add_argument(
         "--outside-box",
@@ -70,10 +83,10 @@ def _common(p: argparse.ArgumentParser, needs_output: bool = True) -> None:
         action="append",
         default=[],
         metavar="X0,Y0,Z0,X1,Y1,Z1",
-        help="an axis-aligned box known to be outside (repeatable)",
+        help="an axis-aligned box known to be outside (repeatable; default: none)",
     )
     p.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    p.add_argument("--quiet", "-q", action="store_true", help="print nothing but errors")
+    verbosity_options(p)
 
 
 def box(text: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
@@ -106,51 +119,50 @@ def box(text: str) -> tuple[tuple[float, ...], tuple[float, ...]]:
 def algorithm_options(p: argparse.ArgumentParser) -> None:
     """Add the graph-cut options that apply to any model (shared with ``meshvis batch``).
 
-    The options are ``--seed``, ``--rays-per-node``, ``--rays-per-point``, ``--samples-per-face``, ``--no-filter``,
-    ``--no-progressive`` and ``--solver``, with the defaults of
-    :data:`meshvis.repair.operation.CLASSIFY_DEFAULTS`; their ``dest`` names are the keywords
-    of :func:`meshvis.classify`.
+    The options are ``--seed``, ``--rays-per-node``, ``--rays-per-point``,
+    ``--samples-per-face``, ``--no-filter``, ``--no-progressive`` and ``--solver``; their
+    ``dest`` names are the keywords of :func:`meshvis.classify` and their defaults those of
+    its signature.
 
     Parameters
     ----------
     p : argparse.ArgumentParser
         The parser to add them to.
     """
-    d = CLASSIFY_DEFAULTS
-    p.add_argument("--seed", type=int, default=d["seed"], help=f"random seed (default {d['seed']})")
+    d = _defaults("classify")
+    p.add_argument("--seed", type=int, default=d["seed"], help="random seed")
     p.add_argument(
-        "--rays-per-node",
-        type=positive_int,
-        default=d["rays_per_node"],
-        help=f"ray budget per node (default {d['rays_per_node']})",
+        "--rays-per-node", type=positive_int, default=d["rays_per_node"], help="ray budget per node"
     )
     p.add_argument(
         "--rays-per-point",
         type=positive_int,
         default=d["rays_per_point"],
         help="ray budget per sample point of an intersecting/coplanar face (default: --rays-per-node; "
-        "in remove-interior --visibility both, --rays-per-node divided by --samples-per-face: docs/performance.md)",
+        "in remove-interior --visibility both, --rays-per-node divided by --samples-per-face)",
     )
     p.add_argument(
         "--samples-per-face",
         type=positive_int,
         default=d["samples_per_face"],
-        help="sample points per intersecting/coplanar face (default 4)",
+        help="sample points per intersecting/coplanar face",
     )
     # the flags switch off what the library's keywords (use_filter, progressive) switch on
     p.add_argument(
         "--no-filter",
         dest="use_filter",
         action="store_false",
-        help="switch off the cosine filter (Eq. 8-9)",
+        default=d["use_filter"],
+        help="switch off the cosine filter (Eq. 8-9; on by default)",
     )
     p.add_argument(
         "--no-progressive",
         dest="progressive",
         action="store_false",
-        help="cast the whole ray budget in one round",
+        default=d["progressive"],
+        help="cast the whole ray budget in one round (by default rounds stop when the cut settles)",
     )
-    p.add_argument("--solver", choices=SOLVERS, default=d["solver"])
+    p.add_argument("--solver", choices=SOLVERS, default=d["solver"], help="the min-cut solver")
 
 
 def region_option(p: argparse.ArgumentParser, default: str | None, what: str) -> None:
@@ -179,30 +191,29 @@ def removal_options(p: argparse.ArgumentParser) -> None:
     """Add the options of inside removal by sight to the ``remove-interior`` parser.
 
     The options are ``--visibility``, ``--from``, ``--budget``, ``--level`` and
-    ``--keep-border``, with the defaults of ``remove-interior`` in
-    :data:`meshvis.repair.operation.OPERATION_DEFAULTS`.
+    ``--keep-border``, with the defaults of :func:`meshvis.remove_interior`.
 
     Parameters
     ----------
     p : argparse.ArgumentParser
         The parser to add them to.
     """
-    d = OPERATION_DEFAULTS["remove-interior"]
+    d = _defaults("remove-interior")
     p.add_argument(
         "--visibility",
         choices=VISIBILITY_MODES,
         default=d["visibility"],
         help="remove what the cut calls hidden (object), what no view from --from reaches (view), "
-        "or only what both call hidden (default both)",
+        "or only what both call hidden",
     )
-    region_option(p, d["from_region"], "where viewers are: outside (default)")
+    region_option(p, d["from_region"], "where viewers are")
     p.add_argument(
         "--budget",
         type=positive_int,
+        default=d["budget"],
         metavar="RAYS",
         help="stop the search for views (view and both) after about this many rays (default: its stop "
-        "rule ends it); fewer rays are faster and delete more visible faces (docs/benchmarks.md, error "
-        "against time of the default removal)",
+        "rule ends it); fewer rays are faster and delete more visible faces",
     )
     p.add_argument(
         "--level",
@@ -215,7 +226,7 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         type=int,
         default=d["keep_border"],
         metavar="N",
-        help="keep N rings of hidden faces next to kept ones (default 0)",
+        help="keep N rings of hidden faces next to kept ones",
     )
 
 
@@ -232,24 +243,24 @@ def add_parser(sub) -> None:
     """
     p = sub.add_parser("classify", help="classify every triangle side inside/outside (report only)")
     _common(p, needs_output=False)
-    p.add_argument("--graphml", metavar="GRAPH.graphml", help="export the visibility graph")
+    p.add_argument("--graphml", metavar="GRAPH.graphml", help="export the visibility graph (default: none)")
     p.set_defaults(func=run, op="classify")
 
     p = sub.add_parser("orient", help="orient every face so its front faces the outside")
     _common(p)
-    od = OPERATION_DEFAULTS["orient"]
+    od = _defaults("orient")
     p.add_argument("--front", choices=("ccw", "cw"), default=od["front"], help="winding of the front side")
     p.add_argument(
         "--two-sided",
         choices=("keep", "duplicate", "strongest"),
         default=od["two_sided"],
-        help="what to do with faces whose both sides are outside (default keep)",
+        help="what to do with faces whose both sides are outside",
     )
     p.add_argument(
         "--semantics",
         choices=("layer", "cavity"),
         default=od["semantics"],
-        help="hidden shells face outward per layer (default) or inward as cavities",
+        help="hidden shells face outward per layer, or inward as cavities",
     )
     p.add_argument(
         "--conflicts",
@@ -258,30 +269,40 @@ def add_parser(sub) -> None:
         help="intersected faces whose samples disagree: area majority or both orientations",
     )
     region_option(
-        p, od["from_region"], "orient every face toward the side seen from REGION instead of the outside"
+        p,
+        od["from_region"],
+        "orient every face toward the side seen from REGION instead of the outside (default: the outside "
+        "of the graph cut)",
     )
     p.set_defaults(func=run, op="orient")
 
     p = sub.add_parser("remove-interior", help="remove the faces that cannot be seen from outside")
     _common(p)
-    p.add_argument("--removed", metavar="FILE", help="also write the removed faces")
+    p.add_argument("--removed", metavar="FILE", help="also write the removed faces (default: not written)")
     removal_options(p)
     p.set_defaults(func=run, op="remove-interior")
 
     p = sub.add_parser("layers", help="peel the model into nested layers")
-    _common(p)
-    p.add_argument("--max-layers", type=positive_int, help="stop after K layers")
+    _common(p, layers=True)
+    p.add_argument(
+        "--max-layers",
+        type=positive_int,
+        default=_defaults("layers")["max_layers"],
+        help="stop after K layers (default: peel until every face has a layer)",
+    )
     p.set_defaults(func=run, op="layers")
 
 
 def run(args: argparse.Namespace) -> int:
     """Run one graph-cut command (``args.op``) on one model and write its outputs.
 
-    The output paths are checked before the model is read.  The outputs appear together at
-    the end, or none of them does (an error, Ctrl-C, SIGTERM).  ``--report -`` writes the
-    report to standard output and silences the other messages.  When ``--removed`` is given
-    and no face was removed, an existing file of that name is deleted, so that it does not
-    pass for this run's result.
+    Every option and output path is checked before the model is read
+    (:func:`meshvis.repair.operation.check_options`).  The outputs appear together at
+    the end, or none of them does (an error, Ctrl-C, SIGTERM).  Prints one summary line
+    (and a note for an output written anew); ``--verbose`` adds the internals, ``--quiet``
+    prints nothing.  ``--report -`` writes the report to standard output and silences the
+    other messages.  When ``--removed`` is given and no face was removed, an existing file
+    of that name is deleted, so that it does not pass for this run's result.
 
     Parameters
     ----------
@@ -296,17 +317,22 @@ def run(args: argparse.Namespace) -> int:
     Raises
     ------
     ParameterError
-        Two outputs share one path, ``--per-face`` without ``--report``, or an option out of
-        its range.
+        ``--per-face`` without ``--report``, or an option out of its range (a malformed
+        ``--from`` region, ...).
     OutputError
-        An output path is refused (see :func:`meshvis.io.check_output`).
+        An output path or format is refused (see :func:`meshvis.io.check_outputs`): two
+        outputs share one path, or one would replace the input, its MTL or a texture.
     ModelError
         The model cannot be read (see :func:`meshvis.load`).
     """
     from meshvis.io import load
+    from meshvis.io.writing import check_not_read
+    from meshvis.repair.operation import check_options
 
+    from .common import detail
     from .progress import stage_progress
 
+    t0 = time.perf_counter()
     outputs = [
         x
         for x in (
@@ -319,17 +345,16 @@ def run(args: argparse.Namespace) -> int:
         )
         if x
     ]
-    if len(set(map(os.path.abspath, outputs))) != len(outputs):
-        raise ParameterError("two outputs share one path")
-    for path in outputs:
-        check_output(path, [args.input], args.force)
     if args.per_face and not args.report:
         raise ParameterError("--per-face needs --report")
+    check_options(args.op, args)
+    check_outputs(outputs, [args.input], args.force)
     if args.report == "-":
         args.quiet = True  # standard output carries the report alone
-    t0 = time.perf_counter()
     soup = load(args.input)
-    say(args, f"{args.input}: {soup.n_faces} faces, {soup.n_parts} parts")
+    for path in outputs:  # nor over the MTL or a texture the model reads
+        check_not_read(path, soup)
+    detail(args, f"{args.input}: {soup.n_faces} faces, {soup.n_parts} parts")
     removed = getattr(args, "removed", None)
     # every output appears at the end, together, or none does (an error, Ctrl-C, SIGTERM)
     with staged_outputs(), stage_progress(args) as progress:
@@ -354,7 +379,8 @@ def run_op(op: str, soup, args: argparse.Namespace, progress=None) -> dict:
         The loaded model.
     args : argparse.Namespace
         The operation's options and output paths (see
-        :func:`meshvis.repair.operation.run_operation`); ``quiet`` silences the summaries.
+        :func:`meshvis.repair.operation.run_operation`); ``quiet`` silences the summary,
+        ``verbose`` adds the internals.
     progress : callable, optional
         ``progress(stage, fraction)`` callback of the classification.
 
@@ -365,4 +391,13 @@ def run_op(op: str, soup, args: argparse.Namespace, progress=None) -> dict:
     """
     from meshvis.repair.operation import run_operation
 
-    return run_operation(op, soup, args, progress, say=lambda text: say(args, text))
+    from .common import detail
+
+    return run_operation(
+        op,
+        soup,
+        args,
+        progress,
+        say=lambda text: say(args, f"{args.input}: {text}" if text.startswith(f"{op}:") else text),
+        detail=lambda text: detail(args, text),
+    )

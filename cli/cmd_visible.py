@@ -4,7 +4,20 @@ from __future__ import annotations
 
 import argparse
 
-from .common import check_output, positive_int, say, write_json
+from .common import (
+    check_outputs,
+    detail,
+    library_default,
+    positive_int,
+    say,
+    staged_outputs,
+    up_option,
+    verbosity_options,
+    write_json,
+)
+
+#: the library function whose keywords the options are, and whose defaults they take
+VISIBLE_FROM = "meshvis.visibility.visible:visible_from"
 
 
 def add_parser(sub) -> None:
@@ -15,50 +28,61 @@ def add_parser(sub) -> None:
     sub : argparse._SubParsersAction
         The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
     """
+    from meshvis.visibility.visible import METHODS
+
+    def d(keyword):
+        return library_default(VISIBLE_FROM, keyword)
+
     p = sub.add_parser("visible", help="which faces can be seen from a region (GVS guided sampling)")
     p.add_argument("input", help="input model (OBJ, PLY, STL, OFF, glTF/GLB, 3MF)")
     p.add_argument(
         "--from",
         dest="from_region",
-        default="outside",
+        default=d("region"),
         metavar="REGION",
-        help="outside (default), upper-hemisphere[:ux,uy,uz], box:x0,y0,z0,x1,y1,z1, "
+        help="where the viewers are: outside, upper-hemisphere[:ux,uy,uz], box:x0,y0,z0,x1,y1,z1, "
         "points:x,y,z;..., path:CAMERAS.json",
     )
-    p.add_argument("--method", choices=("guided", "random"), default="guided")
+    p.add_argument("--method", choices=METHODS, default=d("method"), help="guided sampling, or random rays")
     p.add_argument(
         "--budget",
         type=positive_int,
+        default=d("budget"),
         help="stop after about this many rays (default: the stop rule ends the search, capped at 1024 rays per face, "
         "at least 2**22, at most meshvis.limits.MAX_RAYS)",
     )
     p.add_argument("--per-side", action="store_true", help="keep looking until both sides of a face are seen")
+    up_option(p, "the upper-hemisphere region")
+    p.add_argument("--seed", type=int, default=d("seed"), help="random seed")
     p.add_argument(
-        "--up", choices=("auto", "x", "y", "z"), default="auto", help="up axis of upper-hemisphere"
+        "--report",
+        metavar="REPORT.json",
+        help="write per-face results and the history ('-': standard output)",
     )
-    p.add_argument("--seed", type=int, default=0)
-    p.add_argument("--report", metavar="REPORT.json", help="write per-face results and the history")
     p.add_argument(
-        "--preview", metavar="PICTURE.png", help="the model with unseen faces in red, and them alone"
+        "--preview",
+        metavar="PICTURE.png",
+        help="the model with unseen faces in red, and them alone (PNG or JPEG)",
     )
     p.add_argument("--force", action="store_true", help="overwrite existing outputs")
-    p.add_argument("--quiet", "-q", action="store_true", help="print nothing but errors")
+    verbosity_options(p)
     p.set_defaults(func=run)
 
 
 def run(args: argparse.Namespace) -> int:
     """Run ``meshvis visible``: search which faces can be seen from the region ``--from``.
 
-    Prints one line unless ``--quiet`` (faces and share of the area seen, rays, why the
-    search stopped, time).
-    No model is written; ``--report`` writes the JSON report with per-face results and
-    ``--preview`` a picture with the unseen faces in red.
+    The region, the up axis and the outputs are checked before the model is read.  Prints
+    one line unless ``--quiet`` (faces and share of the area seen, rays, why the search
+    stopped, time); ``--verbose`` adds the region and the rays of each kind.  No model is
+    written; ``--report`` writes the JSON report with per-face results and ``--preview`` a
+    picture with the unseen faces in red.
 
     Parameters
     ----------
     args : argparse.Namespace
         The parsed options: ``input``, ``from_region``, ``method``, ``budget``, ``per_side``,
-        ``up``, ``seed``, ``report``, ``preview``, ``force``, ``quiet``.
+        ``up``, ``seed``, ``report``, ``preview``, ``force``, ``quiet``, ``verbose``.
 
     Returns
     -------
@@ -68,40 +92,59 @@ def run(args: argparse.Namespace) -> int:
     Raises
     ------
     OutputError
-        A ``--report`` or ``--preview`` path is refused (see :func:`meshvis.io.check_output`).
+        A ``--report`` or ``--preview`` path is refused (see :func:`meshvis.io.check_outputs`).
     ModelError
         The model cannot be read (see :func:`meshvis.load`).
     ParameterError
         Unknown region or method, or a bad budget (see :func:`meshvis.visible_from`).
     """
     from meshvis.io import load
-    from meshvis.rays.camera import up_axis
-    from meshvis.rays.render import save_png
+    from meshvis.io.jsonfile import STDOUT
+    from meshvis.io.up_axis import up_vector
+    from meshvis.io.writing import check_not_read
+    from meshvis.rays.render import check_image_format, save_image
     from meshvis.visibility import visible_from
     from meshvis.visibility.preview import preview
+    from meshvis.visibility.regions import parse_region
 
-    for path in (args.report, args.preview):
-        if path:
-            check_output(path, [args.input], args.force)
+    up = None if args.up == "auto" else args.up
+    parse_region(args.from_region, up=up)  # a malformed region fails before any work
+    if up is not None:
+        up_vector(up)
+    if args.preview:
+        check_image_format(args.preview)
+    outputs = [p for p in (args.report, args.preview) if p and p != STDOUT]
+    check_outputs(outputs, [args.input], args.force)
+    if args.report == STDOUT:
+        args.quiet = True  # standard output carries the report alone
     soup = load(args.input)
+    for path in outputs:  # not over a texture of the model
+        check_not_read(path, soup)
     vis = visible_from(
         soup,
         args.from_region,
         budget=args.budget,
         seed=args.seed,
         method=args.method,
-        up=up_axis(args.up, [args.input]),
+        up=up,
         per_side=args.per_side,
     )
     r = vis.report(per_face=bool(args.report))
+    detail(args, f"region: {r.get('region', args.from_region)}")
+    detail(args, f"rays: {r['rays']}")
+    wrote = outputs
     say(
         args,
-        f"{args.input}: {r['seen_faces']} of {r['faces']} faces seen ({100 * r['seen_area_fraction']:.1f} % of the area) "
-        f"from {args.from_region}; {r['rays']['total']} rays, stopped: {r['stopped']}, {vis.seconds:.1f} s",
+        f"{args.input}: visible: {r['seen_faces']} of {r['faces']} faces seen "
+        f"({100 * r['seen_area_fraction']:.1f} % of the area) from {args.from_region}; "
+        f"{r['rays']['total']} rays, stopped: {r['stopped']}"
+        + (f"; wrote {' and '.join(wrote)}" if wrote else "")
+        + f"; {vis.seconds:.1f} s",
     )
-    if args.report:
-        r["input"] = args.input
-        write_json(args.report, r)
-    if args.preview:
-        save_png(preview(soup, vis), args.preview)
+    with staged_outputs():  # the report and the preview appear together or not at all
+        if args.preview:
+            save_image(preview(soup, vis), args.preview)
+        if args.report:
+            r["input"] = args.input
+            write_json(args.report, r)
     return 0

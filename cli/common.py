@@ -7,8 +7,35 @@ import sys
 from typing import Any
 
 from meshvis.errors import ParameterError
-from meshvis.io import check_output, staged_outputs  # noqa: F401  (re-exported for the commands)
-from meshvis.io.jsonfile import write_json  # noqa: F401  (re-exported for the commands)
+
+
+# the library's file helpers, imported when a command uses them (a parser needs none of them)
+def check_output(path: str, inputs: list[str], force: bool) -> None:
+    """:func:`meshvis.io.check_output`."""
+    from meshvis.io import check_output as check
+
+    check(path, inputs, force)
+
+
+def check_outputs(paths: list[str], inputs: list[str], force: bool) -> None:
+    """:func:`meshvis.io.check_outputs`."""
+    from meshvis.io import check_outputs as check
+
+    check(paths, inputs, force)
+
+
+def staged_outputs():
+    """:func:`meshvis.io.staged_outputs`."""
+    from meshvis.io import staged_outputs as staged
+
+    return staged()
+
+
+def write_json(path: str, data: Any) -> None:
+    """:func:`meshvis.io.jsonfile.write_json`."""
+    from meshvis.io.jsonfile import write_json as write
+
+    write(path, data)
 
 
 def point(text: str) -> tuple[float, float, float]:
@@ -34,6 +61,91 @@ def point(text: str) -> tuple[float, float, float]:
     except ValueError:
         raise argparse.ArgumentTypeError(f"expected x,y,z, got {text!r}") from None
     return (x, y, z)
+
+
+class HelpFormatter(argparse.ArgumentDefaultsHelpFormatter, argparse.RawDescriptionHelpFormatter):
+    """Help that ends every option's text with its default.
+
+    Flags (a True/False default), required options and help that speaks of its default
+    already say nothing more; an option without a default value says ``(default: none)``.
+    Descriptions and epilogs keep their line breaks.
+    """
+
+    def _get_help_string(self, action: argparse.Action) -> str:
+        text = action.help or ""
+        default = action.default
+        if (
+            "default" in text.lower()  # said in words already
+            or not action.option_strings
+            or action.required
+            or default is argparse.SUPPRESS
+            or isinstance(default, bool)
+            or action.nargs == 0  # a flag
+        ):
+            return text
+        if default is None or default == []:
+            return text + " (default: none)"
+        if isinstance(default, (tuple, list)):
+            return text + f" (default: {' '.join(map(str, default))})"
+        return text + " (default: %(default)s)"
+
+
+class Parser(argparse.ArgumentParser):
+    """An argument parser with :class:`HelpFormatter` unless told otherwise (so its subcommands too)."""
+
+    def __init__(self, *args: Any, **kwargs: Any) -> None:
+        kwargs.setdefault("formatter_class", HelpFormatter)
+        super().__init__(*args, **kwargs)
+
+
+def verbosity_options(p: argparse.ArgumentParser) -> None:
+    """Add ``--quiet`` (errors only) and ``--verbose`` (the internals too)."""
+    group = p.add_mutually_exclusive_group()
+    group.add_argument("--quiet", "-q", action="store_true", help="print nothing but errors")
+    group.add_argument(
+        "--verbose",
+        "-v",
+        action="store_true",
+        help="also print the internals: the graph's nodes, edges and rays, each stage's time, "
+        "the faces per status or reason",
+    )
+
+
+def detail(args: argparse.Namespace, *text: Any) -> None:
+    """Print to standard output with ``--verbose`` only.
+
+    Parameters
+    ----------
+    args : argparse.Namespace
+        The parsed arguments; a namespace without ``verbose`` counts as not verbose.
+    *text : object
+        What to print, separated by spaces as :func:`print` does.
+    """
+    if getattr(args, "verbose", False) and not getattr(args, "quiet", False):
+        print(*text)
+
+
+def library_default(function: str, keyword: str) -> Any:
+    """The default of ``keyword`` in the signature of ``function`` (``"module:name"``).
+
+    The command line's defaults are read from the library here, so each is written once.
+    """
+    from meshvis.repair.operation import library_default as read
+
+    return read(function, keyword)
+
+
+def up_option(p: argparse.ArgumentParser, what: str) -> None:
+    """Add ``--up auto|x|y|z``; ``auto`` is the model's own up axis (the library's ``up=None``)."""
+    from meshvis.io.up_axis import UP_CHOICES
+
+    p.add_argument(
+        "--up",
+        choices=UP_CHOICES,
+        default="auto",
+        help=f"the model's up axis, for {what}; auto: the convention of its file format "
+        "(y for glTF/GLB and OBJ, z for STL, PLY, OFF and 3MF)",
+    )
 
 
 def say(args: argparse.Namespace, *text: Any) -> None:
@@ -87,4 +199,19 @@ def stderr(*text: Any) -> None:
     print(*text, file=sys.stderr)
 
 
-__all__ = ["point", "check_output", "staged_outputs", "write_json", "say", "positive_int", "ParameterError"]
+__all__ = [
+    "point",
+    "check_output",
+    "check_outputs",
+    "staged_outputs",
+    "write_json",
+    "say",
+    "detail",
+    "positive_int",
+    "ParameterError",
+    "HelpFormatter",
+    "Parser",
+    "verbosity_options",
+    "up_option",
+    "library_default",
+]

@@ -25,6 +25,7 @@ COMMANDS = {
     "layers": "meshvis.cli.cmd_repair",
     "visible": "meshvis.cli.cmd_visible",
     "label": "meshvis.cli.cmd_label",
+    "view": "meshvis.cli.cmd_view",
     "batch": "meshvis.cli.cmd_batch",
     "bench": "meshvis.cli.cmd_bench",
 }
@@ -57,12 +58,11 @@ def build_parser(command: str | None = None) -> argparse.ArgumentParser:
     """
     from meshvis._version import __version__
 
-    parser = argparse.ArgumentParser(
-        prog="meshvis",
-        description="Visibility questions about real, broken 3D models.",
-    )
+    from .common import Parser
+
+    parser = Parser(prog="meshvis", description="Visibility questions about real, broken 3D models.")
     parser.add_argument("--version", action="version", version=f"meshvis {__version__}")
-    sub = parser.add_subparsers(dest="command", metavar="COMMAND")
+    sub = parser.add_subparsers(dest="command", metavar="COMMAND", parser_class=Parser)
     seen = set()
     for name, module in COMMANDS.items():
         if module in seen or (command is not None and name != command):
@@ -105,6 +105,9 @@ def main(argv: list[str] | None = None) -> int:
     from meshvis.errors import MeshvisError
 
     argv = sys.argv[1:] if argv is None else list(argv)
+    # a file name that is not UTF-8 must not stop a message about it: print such bytes escaped
+    if getattr(sys.stdout, "errors", None) == "strict" and hasattr(sys.stdout, "reconfigure"):
+        sys.stdout.reconfigure(errors="backslashreplace")
     # the top level has only -h and --version, so a command is the first argument; the
     # version needs no subcommand (building them all imports labeling and the kernels)
     first = argv[0] if argv else None

@@ -6,7 +6,9 @@ Usage::
     python models/make_models.py --out DIR  # write somewhere else
 
 Every model comes from a generator of :mod:`meshvis.eval.generators` with small size
-parameters, so that the folder stays well below 1 MB.  Next to every ``<stem>.obj`` the
+parameters, so that the folder stays well below 1 MB.  The generators build z-up; the
+files are turned y-up (z becomes y), the convention of OBJ that meshvis and other tools
+read them with, so that they stand upright.  Next to every ``<stem>.obj`` the
 script writes ``<stem>.truth.npz`` (see :meth:`meshvis.eval.generators.GroundTruth.save_arrays`),
 whose arrays are indexed like the faces of the OBJ file in file order.  Coordinates are
 rounded to 6 decimals before writing (shorter files; rounding keeps coincident corners
@@ -47,10 +49,22 @@ MODELS: dict[str, Callable[[], GroundTruth]] = {
 
 DECIMALS = 6
 
+#: the turn from the generators' z-up to OBJ's y-up: (x, y, z) -> (x, z, -y), a rotation
+Y_UP = np.array([[1.0, 0.0, 0.0], [0.0, 0.0, 1.0], [0.0, -1.0, 0.0]])
+
 
 def _rounded(truth: GroundTruth) -> GroundTruth:
     soup = truth.soup
     return replace(truth, soup=replace(soup, vertices=np.round(soup.vertices, DECIMALS) + 0.0))
+
+
+def _y_up(truth: GroundTruth) -> GroundTruth:
+    """The model and its hint points turned y-up (exact: the turn only swaps and negates)."""
+    soup = truth.soup
+    hints = {k: v @ Y_UP.T + 0.0 for k, v in truth.hints.items()}  # + 0.0: no -0.0 in the files
+    return replace(
+        truth, soup=replace(soup, vertices=soup.vertices @ Y_UP.T + 0.0, up=(0.0, 1.0, 0.0)), hints=hints
+    )
 
 
 def _save(truth: GroundTruth, path: Path) -> None:
@@ -105,7 +119,7 @@ def build(out: str | os.PathLike = HERE, names: list[str] | None = None, verbose
     for fname, make in MODELS.items():
         if names and fname not in names:
             continue
-        truth = _rounded(make())
+        truth = _y_up(_rounded(make()))
         problems = truth.check()
         if problems:
             raise RuntimeError(f"{fname}: inconsistent truth: {problems}")

@@ -16,8 +16,9 @@ import struct
 from meshvis import _validate
 from meshvis.errors import MeshvisError, ModelError, ModelFormatError
 from meshvis.io import gltf, obj, off, ply, stl
-from meshvis.io._common import describe_exception, one_line
+from meshvis.io._common import describe_exception, one_line, without_bom
 from meshvis.io.scene import soup_from_scene
+from meshvis.io.up_axis import format_up
 from meshvis.soup import Soup, validate
 
 #: file extension -> format name, for reading
@@ -63,7 +64,8 @@ def load(path: str | os.PathLike, *, name: str | None = None) -> Soup:
         float64 vertices, int64 triangles (polygons triangulated; ``source_face`` is the
         index of the polygon in the file, or of the face within its glTF primitive
         after instancing), per-face part and material, per-corner UVs and RGBA colours
-        where the file has them.
+        where the file has them; ``up``, the up axis of the format
+        (:data:`~meshvis.io.up_axis.FORMAT_UP`).
 
     Raises
     ------
@@ -102,6 +104,7 @@ def load(path: str | os.PathLike, *, name: str | None = None) -> Soup:
             f"cannot read as {_FORMAT_TITLES[fmt]}: {describe_exception(exc)}", label
         ) from None
     soup.path = label
+    soup.up = format_up(path)
     validate(soup.vertices, soup.faces, label)
     return soup
 
@@ -138,6 +141,7 @@ def sniff(head: bytes, size: int) -> str | None:
     the content gives no clear sign.  A binary STL is recognised by its size:
     84 header bytes plus 50 per triangle, the count being stored at byte 80.
     """
+    head = without_bom(head)
     if head[:4] == b"glTF":
         return "glb"
     if head[:4] == b"PK\x03\x04":
@@ -186,8 +190,9 @@ def _read(fmt: str, path: str, label: str) -> Soup:
 def check_zip(path: str, label: str) -> None:
     """Refuse a zip archive with more entries or inflated bytes than :mod:`meshvis.limits` allows.
 
-    The sizes are those its directory declares, which :mod:`zipfile` enforces while
-    inflating.
+    The inflated bytes must stay within ``MAX_ZIP_BYTES`` and within ``MAX_ZIP_EXPANSION``
+    times the archive's size (real 3MF files inflate about 5 times).  The sizes are those its
+    directory declares, which :mod:`zipfile` enforces while inflating.
     """
     import zipfile
 
@@ -206,4 +211,12 @@ def check_zip(path: str, label: str) -> None:
     if total > limits.MAX_ZIP_BYTES:
         raise ModelFormatError(
             f"the archive inflates to {total} bytes, more than the cap of {limits.MAX_ZIP_BYTES}", label
+        )
+    allowed = max(limits.MIN_EXPANSION_BYTES, limits.MAX_ZIP_EXPANSION * os.path.getsize(path))
+    if total > allowed:
+        raise ModelFormatError(
+            f"the archive inflates to {total} bytes, more than {limits.MAX_ZIP_EXPANSION} times its "
+            f"{os.path.getsize(path)} bytes (the cap MAX_ZIP_EXPANSION of meshvis.limits; at least "
+            f"MIN_EXPANSION_BYTES, {limits.MIN_EXPANSION_BYTES})",
+            label,
         )

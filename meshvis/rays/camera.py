@@ -7,6 +7,7 @@ pixel and its centre is at (0.5, 0.5).  The vertical field of view ``fov`` is in
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -14,36 +15,14 @@ import numpy as np
 
 from meshvis import _validate
 from meshvis.errors import ParameterError
-
-#: unit vectors of the axis names accepted as "up"
-AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
-
-
-#: the up axis of each file format, the rule every command and function that draws follows
-#: (``--up auto``): glTF is y-up by its specification and 3MF z-up by its; OBJ files are
-#: y-up by the convention of the tools that write them; STL, PLY and OFF (CAD, scanners)
-#: are z-up, as is a model without a file
-FORMAT_UP = {".glb": "y", ".gltf": "y", ".obj": "y", ".3mf": "z", ".stl": "z", ".ply": "z", ".off": "z"}
-FALLBACK_UP = "z"
+from meshvis.io.up_axis import AXES, FALLBACK_UP, FORMAT_UP, format_up, up_vector  # noqa: F401
 
 
 def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, float, float]:
     """The up vector for an axis name, or for ``"auto"`` the up axis of the files' format.
 
-    ``"auto"`` looks the files' extensions up in :data:`FORMAT_UP`; files of formats that
-    disagree, or no file, give :data:`FALLBACK_UP`.
-
-    Parameters
-    ----------
-    name : {"auto", "x", "y", "z"}
-        The axis name.
-    paths : sequence of str
-        The model files, read by ``"auto"``.
-
-    Returns
-    -------
-    tuple of 3 float
-        The unit up vector.
+    ``"auto"`` looks the files' extensions up in :data:`~meshvis.io.up_axis.FORMAT_UP`;
+    files of formats that disagree, or no file, give z.
 
     Examples
     --------
@@ -51,27 +30,16 @@ def up_axis(name: str, paths: list[str] | tuple[str, ...] = ()) -> tuple[float, 
     ((0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))
     """
     if name != "auto":
-        if name not in AXES:
-            raise ParameterError(f"up must be auto, x, y or z; got {name!r}")
-        return AXES[name]
-    found = {FORMAT_UP.get(os.path.splitext(str(p))[1].lower(), FALLBACK_UP) for p in paths if p}
-    return AXES[found.pop()] if len(found) == 1 else AXES[FALLBACK_UP]
+        return tuple(up_vector(name).tolist())
+    found = {format_up(p) for p in paths if p}
+    return found.pop() if len(found) == 1 else AXES[FALLBACK_UP]
 
 
 def model_up(model: Any) -> tuple[float, float, float]:
-    """The up vector of a model by :func:`up_axis` ``"auto"``.
-
-    Taken from its file (a path, a list of paths, or a soup read from a file), else
-    :data:`FALLBACK_UP`.
-    """
-    if isinstance(model, (str, os.PathLike)):
-        paths = [os.fspath(model)]
-    elif isinstance(model, (list, tuple)) and model and all(isinstance(m, (str, os.PathLike)) for m in model):
-        paths = [os.fspath(m) for m in model]
-    else:
-        path = getattr(model, "path", None)
-        paths = [path] if isinstance(path, str) else []
-    return up_axis("auto", paths)
+    """The up vector of a model: ``Soup.up``, or the format's of a file (z for anything else)."""
+    if isinstance(model, (list, tuple)) and model and all(isinstance(m, (str, os.PathLike)) for m in model):
+        return up_axis("auto", [os.fspath(m) for m in model])
+    return tuple(up_vector(None, model).tolist())
 
 
 def _unit(v: np.ndarray) -> np.ndarray:
@@ -116,13 +84,17 @@ class Camera:
     ortho_height: float | None = None
 
     def __post_init__(self) -> None:
-        self.position = np.asarray(self.position, np.float64).reshape(3)
-        self.target = np.asarray(self.target, np.float64).reshape(3)
-        self.up = np.asarray(self.up, np.float64).reshape(3)
-        if not (np.isfinite(self.position).all() and np.isfinite(self.target).all()):
-            raise ParameterError("camera position and target must be finite")
-        if not 0 < self.fov < 180:
-            raise ParameterError(f"field of view must be in (0, 180) degrees, got {self.fov}")
+        for name in ("position", "target", "up"):
+            v = _validate.points(f"camera {name}", getattr(self, name))
+            if len(v) != 1:
+                raise ParameterError(f"camera {name} must be three numbers, got {len(v)} points")
+            setattr(self, name, v[0])
+        if not np.any(self.up):
+            raise ParameterError("camera up must not be zero")
+        self.fov = _field_of_view(self.fov)
+        self.orthographic = _validate.flag("orthographic", self.orthographic)
+        if self.ortho_height is not None:
+            self.ortho_height = _validate.real("ortho_height", self.ortho_height, 0.0, open_lo=True)
 
     # ------------------------------------------------------------------ frame
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -233,14 +205,18 @@ class Camera:
 
         ``azimuth`` turns around the up axis, ``elevation`` lifts the camera above the
         horizon; both in degrees.  ``distance`` defaults to the distance
-        at which the bounding sphere (times ``margin``) fills the view.  ``up`` defaults to
-        the model's up axis by the rule of :func:`model_up`.
+        at which the bounding sphere (times ``margin``) fills the view.  ``up`` (an axis name
+        or a vector) defaults to the model's up axis (:func:`model_up`).
         """
         azimuth, elevation = _validate.real("azimuth", azimuth), _validate.real("elevation", elevation)
+        if distance is not None:
+            distance = _validate.real("distance", distance, 0.0, open_lo=True)
+        margin = _validate.real("margin", margin, 0.0, open_lo=True)
+        fov = _field_of_view(fov)
         bounds = _bounds_of(model)
         center = bounds.mean(axis=0)
         radius = 0.5 * float(np.linalg.norm(bounds[1] - bounds[0])) or 1.0
-        up = _unit(np.asarray(model_up(model) if up is None else up, np.float64))
+        up = np.asarray(model_up(model)) if up is None else up_vector(up)
         # a horizontal frame orthogonal to up; azimuth 0 views the model's "front": from +z
         # for y-up models (glTF, most OBJ), from -y for z-up models (CAD, STL)
         ref = np.array([0.0, 0.0, 1.0]) if abs(up[2]) < 0.9 else np.array([0.0, -1.0, 0.0])
@@ -277,13 +253,29 @@ class Camera:
         Raises
         ------
         ParameterError
-            ``d`` has a key that is not a camera field.
+            ``d`` is not an object with ``position`` and ``target``, has a key that is not
+            a camera field, or a value out of its range.
         """
+        if not isinstance(d, Mapping):
+            raise ParameterError(
+                f"a camera must be an object with position and target, got {type(d).__name__}"
+            )
         known = {"position", "target", "up", "fov", "orthographic", "ortho_height"}
-        unknown = set(d) - known
+        unknown = set(map(str, d)) - known
         if unknown:
             raise ParameterError(f"unknown camera keys: {', '.join(sorted(unknown))}")
+        missing = {"position", "target"} - set(d)
+        if missing:
+            raise ParameterError(f"the camera has no {' and no '.join(sorted(missing))}")
         return cls(**d)
+
+
+def _field_of_view(value: Any) -> float:
+    """A vertical field of view: a number of degrees in (0, 180)."""
+    fov = _validate.real("field of view", value)
+    if not 0 < fov < 180:
+        raise ParameterError(f"field of view must be in (0, 180) degrees, got {fov}")
+    return fov
 
 
 def _bounds_of(model: Any) -> np.ndarray:

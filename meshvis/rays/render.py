@@ -162,6 +162,57 @@ def save_png(image: np.ndarray, path: str) -> None:
         Image.fromarray(np.asarray(image, np.uint8)).save(fh, format="PNG")
 
 
+#: picture file extension -> Pillow format name
+IMAGE_FORMATS = {".png": "PNG", ".jpg": "JPEG", ".jpeg": "JPEG"}
+#: quality of JPEG pictures (Pillow's scale, 1..95)
+JPEG_QUALITY = 92
+
+
+def check_image_format(path: str) -> str:
+    """The Pillow format that ``path``'s extension names (:data:`IMAGE_FORMATS`).
+
+    Raises
+    ------
+    OutputError
+        Any other extension: the picture is refused before it is rendered.
+
+    Examples
+    --------
+    >>> check_image_format("view.JPG")
+    'JPEG'
+    """
+    import os
+
+    from meshvis.errors import OutputError
+
+    ext = os.path.splitext(str(path))[1].lower()
+    if ext not in IMAGE_FORMATS:
+        known = ", ".join(sorted(IMAGE_FORMATS))
+        raise OutputError(f"cannot write '{ext or '(no extension)'}' pictures; known: {known}", str(path))
+    return IMAGE_FORMATS[ext]
+
+
+def save_image(image: np.ndarray, path: str) -> None:
+    """Write an RGB(A) uint8 image in the format its extension names (PNG or JPEG), atomically.
+
+    Raises
+    ------
+    OutputError
+        An extension of no known picture format (:func:`check_image_format`).
+    """
+    from PIL import Image
+
+    from meshvis.io import atomic_write
+
+    fmt = check_image_format(path)
+    picture = Image.fromarray(np.asarray(image, np.uint8))
+    extra = {}
+    if fmt == "JPEG":  # no alpha channel in JPEG
+        picture, extra = picture.convert("RGB"), {"quality": JPEG_QUALITY}
+    with atomic_write(path, "wb") as fh:
+        picture.save(fh, format=fmt, **extra)
+
+
 def render_layers(
     model: Any,
     layer: np.ndarray,

@@ -9,60 +9,95 @@ batch file is processed exactly as the single-file command would process it.
 
 from __future__ import annotations
 
+import functools
+import importlib
+import inspect
+import warnings
 from collections.abc import Callable, Mapping
 from typing import Any
 
 import numpy as np
 
 from meshvis.errors import ParameterError
-from meshvis.graphcut.solvers import DEFAULT_SOLVER
-from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, cut_rays_per_point
+from meshvis.repair.remove_modes import cut_rays_per_point
 
 #: operations that classify a model and write a result
 OPERATIONS = ("classify", "orient", "remove-interior", "layers")
 
-#: options of the classification, shared by every operation: keyword arguments of
-#: :func:`meshvis.classify` under their own names, and the hints as lists
-CLASSIFY_DEFAULTS: dict[str, Any] = {
-    "seed": 0,
-    "rays_per_node": 32,
-    "samples_per_face": 4,
-    "rays_per_point": None,  # None: rays_per_node
-    "use_filter": True,
-    "progressive": True,
-    "solver": DEFAULT_SOLVER,
-    "inside_points": [],
-    "outside_points": [],
-    "inside_boxes": [],
-    "outside_boxes": [],
-}
-#: options of each operation on top of the classification
-OPERATION_DEFAULTS: dict[str, dict[str, Any]] = {
+#: the library function each operation's options are the keywords of
+CLASSIFY = "meshvis.graphcut.classify:classify"
+ORIENT = "meshvis.repair.orient:orient"
+ORIENT_FROM = "meshvis.repair.orient:orient_from"
+REMOVE = "meshvis.repair.remove:remove_interior"
+LAYERS = "meshvis.repair.layers:layers"
+
+#: options of the classification, shared by every operation: keywords of :func:`meshvis.classify`
+CLASSIFY_OPTIONS = (
+    "seed",
+    "rays_per_node",
+    "samples_per_face",
+    "rays_per_point",
+    "use_filter",
+    "progressive",
+    "solver",
+)
+#: options of each operation on top of the classification: option -> (function, its keyword)
+OPERATION_OPTIONS: dict[str, dict[str, tuple[str, str]]] = {
     "classify": {},
     "orient": {
-        "front": "ccw",
-        "two_sided": "keep",
-        "semantics": "layer",
-        "conflicts": "majority",
-        "from_region": None,  # a region: orient toward what its viewers see (no cut)
-        "up": "auto",
+        "front": (ORIENT, "front"),
+        "two_sided": (ORIENT, "two_sided"),
+        "semantics": (ORIENT, "semantics"),
+        "conflicts": (ORIENT, "conflicts"),
+        "up": (ORIENT_FROM, "up"),
     },
     "remove-interior": {
-        "visibility": DEFAULT_VISIBILITY,
-        "from_region": "outside",
-        "level": "face",
-        "keep_border": 0,
-        "budget": None,  # rays of the from-region search (None: its stop rule ends it)
-        "up": "auto",
+        "visibility": (REMOVE, "visibility"),
+        "from_region": (REMOVE, "region"),
+        "level": (REMOVE, "level"),
+        "keep_border": (REMOVE, "keep_border"),
+        "budget": (REMOVE, "budget"),
+        "up": (REMOVE, "up"),
     },
-    "layers": {"max_layers": None},
+    "layers": {"max_layers": (LAYERS, "max_layers")},
+}
+#: options that are no keyword of a library function: the hints (lists of points and boxes,
+#: :class:`meshvis.Hints`) and orient's region (given: orient toward what its viewers see)
+OTHER_DEFAULTS: dict[str, dict[str, Any]] = {
+    "classify": {"inside_points": [], "outside_points": [], "inside_boxes": [], "outside_boxes": []},
+    "orient": {"from_region": None},
 }
 #: where results go (None: not written)
 OUTPUT_KEYS = ("output", "report", "preview", "removed", "graphml")
 
 
+def library_default(function: str, keyword: str) -> Any:
+    """The default of ``keyword`` in the signature of ``function`` (``"module:name"``).
+
+    Every default of the command line and of ``meshvis batch`` is read here, from the
+    function the option is passed to, so it is written once, in the library.
+
+    Examples
+    --------
+    >>> library_default(CLASSIFY, "rays_per_node")
+    32
+    """
+    module, _, name = function.partition(":")
+    fn = getattr(importlib.import_module(module), name)
+    return inspect.signature(fn).parameters[keyword].default
+
+
+@functools.cache
+def _defaults(op: str) -> dict[str, Any]:
+    d = {k: library_default(CLASSIFY, k) for k in CLASSIFY_OPTIONS}
+    d.update(OTHER_DEFAULTS["classify"])
+    d.update({k: library_default(fn, kw) for k, (fn, kw) in OPERATION_OPTIONS[op].items()})
+    d.update(OTHER_DEFAULTS.get(op, {}))
+    return d
+
+
 def default_options(op: str) -> dict[str, Any]:
-    """Every option of ``op`` with its default value.
+    """Every option of ``op`` with its default value, read from the library's signatures.
 
     Parameters
     ----------
@@ -72,7 +107,9 @@ def default_options(op: str) -> dict[str, Any]:
     Returns
     -------
     dict
-        :data:`CLASSIFY_DEFAULTS` and the options of ``op``.
+        The classification's options (:data:`CLASSIFY_OPTIONS` and the hints) and the
+        options of ``op`` (:data:`OPERATION_OPTIONS`), each with the default of the library
+        function it is passed to.
 
     Raises
     ------
@@ -86,7 +123,22 @@ def default_options(op: str) -> dict[str, Any]:
     """
     if op not in OPERATIONS:
         raise ParameterError(f"unknown operation {op!r}; choose one of {', '.join(OPERATIONS)}")
-    return {**CLASSIFY_DEFAULTS, **OPERATION_DEFAULTS[op]}
+    return {k: list(v) if isinstance(v, list) else v for k, v in _defaults(op).items()}
+
+
+def __getattr__(name: str) -> Any:
+    # the two tables of defaults, built on first use (reading them imports the library)
+    if name == "CLASSIFY_DEFAULTS":
+        return default_options("classify")
+    if name == "OPERATION_DEFAULTS":
+        shared = default_options("classify")
+        return {op: {k: v for k, v in default_options(op).items() if k not in shared} for op in OPERATIONS}
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
+
+def _up(value: Any) -> Any:
+    """The library's ``up`` for an option value: ``auto`` (the command line's word) is None."""
+    return None if value is None or (isinstance(value, str) and value == "auto") else value
 
 
 def _options(options: Mapping[str, Any] | Any) -> dict[str, Any]:
@@ -97,7 +149,7 @@ def classify_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
     """Keyword arguments of :func:`meshvis.classify` from operation options."""
     from meshvis.graphcut.hints import Hints
 
-    o = {**CLASSIFY_DEFAULTS, **_options(options)}
+    o = {**default_options("classify"), **_options(options)}
     hints = None
     if o["inside_points"] or o["outside_points"] or o["inside_boxes"] or o["outside_boxes"]:
         hints = Hints(
@@ -118,29 +170,85 @@ def classify_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
     )
 
 
-def _classify_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
+def check_options(op: str, options: Mapping[str, Any] | Any) -> None:
+    """Refuse, before any work, the options and output paths that ``op`` would refuse later.
+
+    Checks the numbers of the classification, the regions (``from_region``), the up axis,
+    the formats of the outputs (a model output the writers know, one that can hold layers
+    for ``layers``, a picture format for ``preview``) and the extra that ``graphml`` needs.
+    The file system is not touched except to read a camera path file.
+
+    Parameters
+    ----------
+    op : str
+        One of :data:`OPERATIONS`.
+    options : mapping or argparse.Namespace
+        The options and output paths, as for :func:`run_operation`.
+
+    Raises
+    ------
+    ParameterError
+        A bad number, region or up axis.
+    OutputError
+        An output whose extension names no format that can hold the result.
+    MissingExtraError
+        ``graphml`` without networkx installed.
+    """
+    from meshvis import _validate
+    from meshvis.io.up_axis import up_vector
+    from meshvis.io.writing import check_format
+    from meshvis.rays.render import check_image_format
+    from meshvis.visibility.regions import parse_region
+
+    o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
+    _validate.operation_options(o)
+    if _up(o.get("up")) is not None:
+        up_vector(_up(o["up"]))
+    by_region = (op == "orient" and o["from_region"]) or (
+        op == "remove-interior" and o["visibility"] != "object"
+    )
+    if by_region:
+        parse_region(o["from_region"])
+    if o["output"] and op != "classify":
+        check_format(o["output"], layers=op == "layers")
+    if o["removed"]:
+        check_format(o["removed"])
+    if o["preview"]:
+        check_image_format(o["preview"])
+    if op == "classify" and o["graphml"]:  # GraphML needs an extra: missing, it fails here
+        from meshvis._extras import import_extra
+
+        import_extra("networkx", "GraphML export (--graphml)")
+
+
+def _classify_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[dict, str]:
     """``classify``: the report, the visibility graph (GraphML) and a preview of the sides."""
     from meshvis._extras import import_extra
     from meshvis.io import atomic_write
-    from meshvis.rays.render import render, save_png
+    from meshvis.rays.render import render, save_image
 
     report = c.report()
+    wrote = []
     if o["graphml"]:
         nx = import_extra("networkx", "GraphML export (--graphml)")
         with atomic_write(o["graphml"], "wb") as fh:
             nx.write_graphml(c.graph.to_networkx({"area": c.nodes.area}), fh)
+        wrote.append(o["graphml"])
     if o["preview"]:
-        save_png(render(soup, color_by="side", up=up).image, o["preview"])
-    return report
+        save_image(render(soup, color_by="side", up=up).image, o["preview"])
+        wrote.append(o["preview"])
+    hidden, two = int(c.hidden.sum()), int(c.two_sided.sum())
+    line = f"{hidden} of {soup.n_faces} faces hidden (no side seen from outside), {two} seen from both sides"
+    return report, line + (f"; wrote {' and '.join(wrote)}" if wrote else "")
 
 
-def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
+def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[dict, str]:
     """``orient``: the oriented model and its preview."""
-    from meshvis.rays.render import render, save_png
+    from meshvis.rays.render import render, save_image
     from meshvis.repair.orient import orient, orient_from
 
     if o["from_region"]:
-        r = orient_from(soup, o["from_region"], front=o["front"], seed=int(o["seed"]), up=up)
+        r = orient_from(soup, o["from_region"], front=o["front"], seed=int(o["seed"]), up=_up(o["up"]))
     else:
         r = orient(
             soup,
@@ -152,35 +260,41 @@ def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
         )
     _save(r.soup, o["output"], tell)
     report = r.report()
-    tell(
-        f"flipped {report['flipped']} of {report['input_faces']} faces; "
-        f"{report['status_counts']}; wrote {o['output']} ({r.soup.n_faces} faces)"
-    )
+    wrote = [o["output"]]
     if o["preview"]:
-        save_png(render(r.soup, color_by="side", up=up).image, o["preview"])
-    return report
+        save_image(render(r.soup, color_by="side", up=up).image, o["preview"])
+        wrote.append(o["preview"])
+    added = r.soup.n_faces - report["input_faces"]
+    line = f"turned {report['flipped']} of {report['input_faces']} faces" + (
+        f", added {added} copies facing the other way" if added > 0 else ""
+    )
+    return report, f"{line}; wrote {' and '.join(wrote)}"
 
 
-def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
+def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[dict, str]:
     """``remove-interior``: the kept faces, optionally the removed ones, and a preview."""
-    from meshvis.rays.render import render, save_png
+    from meshvis.rays.render import render, save_image
     from meshvis.repair.remove import remove_interior
 
-    r = remove_interior(soup, classification=c, **removal_kwargs(o, soup))
+    with warnings.catch_warnings():  # the cut was made for this removal, with the budget asked for
+        warnings.filterwarnings("ignore", message="the classification given gave its sample points")
+        r = remove_interior(soup, classification=c, **removal_kwargs(o, soup))
     _save(r.kept, o["output"], tell)
-    wrote_removed = bool(o["removed"]) and r.removed.n_faces > 0
-    if wrote_removed:
+    wrote = [o["output"]]
+    if o["removed"] and r.removed.n_faces > 0:
         _save(r.removed, o["removed"], tell)
-    report = r.report()
-    tell(
-        f"kept {report['kept_faces']}, removed {report['removed_faces']} of {report['input_faces']} faces; "
-        f"wrote {o['output']}" + (f" and {o['removed']}" if wrote_removed else "")
-    )
-    if o["removed"] and not wrote_removed:  # an empty model is no model: say so, write nothing
+        wrote.append(o["removed"])
+    elif o["removed"]:  # an empty model is no model: say so, write nothing
         tell(f"nothing was removed: {o['removed']} not written")
+    report = r.report()
     if o["preview"]:
-        save_png(render(r.kept, color_by="side", up=up).image, o["preview"])
-    return report
+        save_image(render(r.kept, color_by="side", up=up).image, o["preview"])
+        wrote.append(o["preview"])
+    line = (
+        f"removed {report['removed_faces']} of {report['input_faces']} faces "
+        f"({100 * report['removed_area_fraction']:.1f} % of the area), kept {report['kept_faces']}"
+    )
+    return report, f"{line}; wrote {' and '.join(wrote)}"
 
 
 def _save(soup, path: str, tell: Callable[[str], None], why: str | None = None, **groups) -> bool:
@@ -202,7 +316,7 @@ def layer_paths(path: str, n: int) -> list[str]:
     return [f"{stem}.layer{k}{ext}" for k in range(1, n + 1)]
 
 
-def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
+def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[dict, str]:
     """``layers``: the model with one face group per layer, and a preview coloured by layer.
 
     An edited glTF output gives each node a child node per deeper layer; a PLY output gets
@@ -212,11 +326,13 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
     """
     from meshvis.io import check_output
     from meshvis.io.writing import rebuilds_groups
-    from meshvis.rays.render import render_layers, save_png
+    from meshvis.rays.render import render_layers, save_image
     from meshvis.repair.layers import layers
 
     r = layers(soup, classification=c, max_layers=o["max_layers"])
     n = int(r.layer.max())
+    if rebuilds_groups(o["output"]) and _same_format(soup, o["output"]):
+        _check_layer_paths(layer_paths(o["output"], n), o)
     names = [f"layer{k}" for k in range(1, n + 1)]
     groups = dict(face_groups=r.layer - 1, group_names=names, face_values={"layer": r.layer})
     edited = _save(soup, o["output"], tell, "one node or group per layer", **groups)
@@ -228,10 +344,34 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> dict:
             _save(soup.subset(r.layer == k), path, tell)
             wrote.append(path)
         report["layer_files"] = wrote[1:]
-    tell(f"{r.n_layers} layers, faces per layer {report['faces_per_layer']}; wrote {', '.join(wrote)}")
     if o["preview"]:
-        save_png(render_layers(soup, r.layer, up=up), o["preview"])
-    return report
+        save_image(render_layers(soup, r.layer, up=up), o["preview"])
+        wrote.append(o["preview"])
+    per_layer = ", ".join(map(str, report["faces_per_layer"][: r.n_layers]))
+    unreached = f", {r.unreached} faces no view reaches" if r.unreached else ""
+    line = f"{r.n_layers} layers ({per_layer} faces{unreached})"
+    return report, f"{line}; wrote {', '.join(wrote)}"
+
+
+def _check_layer_paths(paths: list[str], o: dict) -> None:
+    """Refuse per-layer files that would be another output of the command, or its MTL.
+
+    The other outputs are ``--preview``, ``--report`` and so on; checked before anything is
+    written.
+    """
+    import os
+
+    from meshvis.errors import OutputError
+    from meshvis.io._common import companions
+
+    others = [p for k in (*OUTPUT_KEYS, "per_face") if k != "output" and (p := o.get(k)) and p != "-"]
+    taken = {os.path.realpath(q) for p in others for q in [p, *companions(p)]}
+    for path in paths:
+        for q in [path, *companions(path)]:
+            if os.path.realpath(q) in taken:
+                raise OutputError(
+                    "a file of one layer would be another output of the command; choose another path", q
+                )
 
 
 def _same_format(soup, path: str) -> bool:
@@ -256,8 +396,6 @@ _OUTPUTS = {
 
 def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
     """Keyword arguments of :func:`meshvis.remove_interior` from operation options."""
-    from meshvis.rays.camera import up_axis
-
     o = {**default_options("remove-interior"), **_options(options)}
     return dict(
         visibility=o["visibility"],
@@ -265,9 +403,31 @@ def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
         level=o["level"],
         keep_border=int(o["keep_border"]),
         budget=None if o["budget"] is None else int(o["budget"]),
-        up=up_axis(o["up"], [soup.path] if soup.path else []),
+        up=_up(o["up"]),
         seed=int(o["seed"]),
     )
+
+
+#: what the face statuses of ``orient`` mean, for ``--verbose``
+ORIENT_STATUS_NOTES = {
+    "one-sided": "seen from outside through one side",
+    "two-sided": "seen through both sides",
+    "hidden": "seen through neither side",
+    "conflict": "intersected faces whose sample points disagree about the outside side",
+    "degenerate": "zero area",
+}
+
+
+def _details(op: str, report: dict) -> list[str]:
+    """The ``--verbose`` lines of an operation's report beyond the classification summary."""
+    if op == "orient" and "status_counts" in report:
+        return [
+            f"  {name:<11} {n:>9}  {ORIENT_STATUS_NOTES.get(name, '')}"
+            for name, n in report["status_counts"].items()
+        ]
+    if op == "remove-interior":
+        return [f"  {n:>9}  {reason}" for reason, n in report.get("reasons", {}).items()]
+    return []
 
 
 def run_operation(
@@ -276,6 +436,7 @@ def run_operation(
     options: Mapping[str, Any] | Any,
     progress: Callable | None = None,
     say: Callable[[str], None] | None = None,
+    detail: Callable[[str], None] | None = None,
 ) -> dict:
     """Classify ``soup``, apply ``op``, write the outputs named in ``options``, return the report.
 
@@ -291,24 +452,34 @@ def run_operation(
     progress : callable, optional
         ``progress(stage, fraction)`` callback of :func:`meshvis.classify`.
     say : callable, optional
-        Where to print one-line summaries (default: nowhere).
+        Where the one-line summary goes (what changed, how much, where it was written,
+        time), and the notes about outputs written anew (default: nowhere).
+    detail : callable, optional
+        Where the internals go: the classification's stages, graph and rays, the faces
+        per status or reason (``--verbose``; default: nowhere).
 
     Returns
     -------
     dict
         The JSON report (per-face arrays, counts, stages, rays, nodes, edges, timings, seed).
+
+    Raises
+    ------
+    ParameterError, OutputError
+        An option or output refused by :func:`check_options`, before any work.
     """
+    import time
+
     from meshvis.graphcut.classify import classify
     from meshvis.io.report import with_schema
-    from meshvis.rays.camera import up_axis
+    from meshvis.io.up_axis import up_vector
 
+    t0 = time.perf_counter()
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
-    if op == "classify" and o["graphml"]:  # fail before the classification, not after
-        from meshvis._extras import import_extra
-
-        import_extra("networkx", "GraphML export (--graphml)")
+    check_options(op, o)
     tell = say or (lambda text: None)
-    up = up_axis(o.get("up") or "auto", [soup.path] if soup.path else [])  # of the preview
+    more = detail or (lambda text: None)
+    up = up_vector(_up(o.get("up")), soup)  # of the preview
     c = None
     by_sight = (op == "remove-interior" and o["visibility"] == "view") or (
         op == "orient" and o["from_region"]
@@ -320,8 +491,11 @@ def run_operation(
                 o["visibility"], kw["rays_per_node"], kw["samples_per_face"], kw["rays_per_point"]
             )
         c = classify(soup, progress=progress, **kw)
-        tell(c.summary())
-    report = _OUTPUTS[op](soup, c, o, tell, up)
+        more(c.summary())
+    report, line = _OUTPUTS[op](soup, c, o, tell, up)
+    for text in _details(op, report):
+        more(text)
+    tell(f"{op}: {line}; {time.perf_counter() - t0:.1f} s")
     report["operation"] = op
     report["seed"] = o["seed"]
     return with_schema(report)

@@ -844,8 +844,8 @@ def orient_from(
         Ray budget of :func:`meshvis.visible_from` (default: its own).
     seed : int
         Seed of the one random generator.
-    up : (3,) float, optional
-        Up direction for an ``upper-hemisphere`` region.
+    up : None, "x", "y", "z" or (3,) float
+        Up direction for an ``upper-hemisphere`` region; None: the model's own (``Soup.up``).
 
     Returns
     -------

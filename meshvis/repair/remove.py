@@ -27,6 +27,7 @@ around kept ones.  Every input face ends up in exactly one of the two outputs, w
 from __future__ import annotations
 
 import inspect
+import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -39,7 +40,13 @@ from meshvis.geometry.duplicates import hidden_copies, opposite_copies
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.io import as_soup
 from meshvis.rays.caster import VISIBILITY_OFFSET
-from meshvis.repair.remove_modes import DEFAULT_VISIBILITY, LEVELS, VISIBILITY_MODES, cut_rays_per_point
+from meshvis.repair.remove_modes import (
+    DEFAULT_VISIBILITY,
+    LEVELS,
+    VISIBILITY_MODES,
+    cut_rays_per_point,
+    reuse_note,
+)
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, visible_from
 
@@ -127,7 +134,7 @@ def remove_interior(
     level: str = "face",
     keep_border: int = 0,
     budget: int | None = None,
-    up=(0.0, 0.0, 1.0),
+    up=None,
     view: Visibility | None = None,
     **classify_kw: Any,
 ) -> RemovalResult:
@@ -138,7 +145,9 @@ def remove_interior(
     model : Soup, trimesh object, (vertices, faces) or path
         Anything :func:`meshvis.classify` accepts.
     classification : Classification, optional
-        An existing classification of the same model to reuse.
+        An existing classification of the same model to reuse (in ``"both"``, one whose
+        sample points got another ray budget than this function's own cut gives them is
+        used as it is, with a warning: the faces kept can differ).
     visibility : {"object", "view", "both"}
         The graph cut alone, sight from ``region`` alone, or both must call a face hidden
         (default :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`, ``"both"``; pass
@@ -151,8 +160,9 @@ def remove_interior(
         Rings of hidden faces (sharing an edge) kept around the kept faces.
     budget : int, optional
         Ray budget of the from-region search (default: :func:`meshvis.visible_from`'s).
-    up : (3,) float
-        Up direction of an ``"upper-hemisphere"`` region.
+    up : None, "x", "y", "z" or (3,) float
+        Up direction of an ``"upper-hemisphere"`` region; None: the model's own
+        (``Soup.up``: y for glTF and OBJ files, z otherwise).
     view : Visibility, optional
         Reuse a from-region search of the same model (``"view"`` only).
     **classify_kw
@@ -167,7 +177,7 @@ def remove_interior(
     Raises
     ------
     ParameterError
-        Unknown mode or level, negative ``keep_border``.
+        Unknown mode or level, ``keep_border`` not an integer of at least 0, a budget below 1.
 
     Examples
     --------
@@ -189,8 +199,7 @@ def remove_interior(
         )
     if level not in LEVELS:
         raise ParameterError(f"unknown level {level!r}; choose one of {', '.join(LEVELS)}")
-    if int(keep_border) < 0:
-        raise ParameterError(f"keep_border must be at least 0, got {keep_border}")
+    _validate.removal_args(keep_border, budget)
     seed = int(classify_kw.get("seed", 0))
     c: Classification | None = None
     vis: Visibility | None = None
@@ -201,6 +210,9 @@ def remove_interior(
         code = np.where(keep, _KEPT_SEEN, _GONE_VIEW)
     else:
         c = classification or classify(model, **_cut_keywords(visibility, classify_kw))
+        note = reuse_note(c.params, visibility) if classification is not None else None
+        if note:
+            warnings.warn(note, stacklevel=2)
         soup = c.soup
         by_cut = _kept_by_cut(c)
         if visibility == "object":

@@ -40,3 +40,40 @@ def cut_rays_per_point(
     if rays_per_point is not None or visibility != "both":
         return rays_per_point
     return max(1, int(rays_per_node) // int(samples_per_face))
+
+
+def reuse_note(params: dict, visibility: str) -> str | None:
+    """Why a reused classification may keep other faces than the cut of ``visibility`` would.
+
+    In ``both`` the cut's sample points get ``rays_per_node // samples_per_face`` rays
+    (:func:`cut_rays_per_point`); a classification made for ``orient`` or ``layers`` gives
+    them ``rays_per_node``, so its cut can call a few faces outside that the removal's own
+    cut calls hidden.
+
+    Parameters
+    ----------
+    params : dict
+        ``Classification.params`` of the reused classification.
+    visibility : str
+        The removal's mode.
+
+    Returns
+    -------
+    str or None
+        One line saying so, or None when the budgets agree.
+
+    Examples
+    --------
+    >>> reuse_note({"rays_per_node": 32, "samples_per_face": 4, "rays_per_point": 8}, "both") is None
+    True
+    >>> reuse_note({"rays_per_node": 32, "samples_per_face": 4, "rays_per_point": 32}, "both")[:44]
+    'the classification given gave its sample poi'
+    """
+    expected = cut_rays_per_point(visibility, params["rays_per_node"], params["samples_per_face"])
+    if expected is None or params.get("rays_per_point") == expected:
+        return None
+    return (
+        f"the classification given gave its sample points {params.get('rays_per_point')} rays, "
+        f"remove_interior's own cut gives them {expected} (visibility={visibility!r}); the faces kept can "
+        f"differ from remove_interior(model): classify with rays_per_point={expected} for the same answer"
+    )

@@ -25,13 +25,15 @@ certifies its first hit as visible from the region.
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from meshvis.errors import ParameterError
+from meshvis.io import one_line
+from meshvis.io.jsonfile import read_json
+from meshvis.io.up_axis import up_vector
 from meshvis.rays.samples import uniform_sphere
 from meshvis.visibility import _kernels
 
@@ -121,19 +123,23 @@ class UpperHemisphere(Region):
 
     Parameters
     ----------
-    up : (3,) float
-        The up direction (normalised here).
+    up : None, "x", "y", "z" or (3,) float
+        The up direction (normalised here); None: the model's own (``Soup.up``, the
+        convention of its file format), taken when the region is bound to the model.
     """
 
     kind: str = "upper-hemisphere"
-    up: np.ndarray = field(default_factory=lambda: np.array([0.0, 0.0, 1.0]))
+    up: np.ndarray | None = None
 
     def __post_init__(self) -> None:
-        up = np.asarray(self.up, np.float64).reshape(3)
-        norm = np.linalg.norm(up)
-        if not np.isfinite(norm) or norm == 0:
-            raise ParameterError("the up direction of upper-hemisphere must be a non-zero vector")
-        self.up = up / norm
+        self._asked = None if self.up is None else up_vector(self.up)
+        self.up = self._asked
+
+    def bind(self, soup) -> Region:
+        """Fix the model's bounding sphere, and its up axis when none was given."""
+        super().bind(soup)
+        self.up = up_vector(None, soup) if self._asked is None else self._asked
+        return self
 
     def _view_directions(self, n, rng):
         d = uniform_sphere(n, rng)
@@ -147,7 +153,7 @@ class UpperHemisphere(Region):
 
     def describe(self):
         """The region as a JSON-ready dict."""
-        return {"kind": self.kind, "up": self.up.tolist()}
+        return {"kind": self.kind, "up": None if self.up is None else self.up.tolist()}
 
 
 @dataclass
@@ -277,7 +283,7 @@ def _aimed(origins: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, np.nda
 REGION_KINDS = ("outside", "upper-hemisphere", "box", "points", "path")
 
 
-def parse_region(text: str | Region, *, up=(0.0, 0.0, 1.0)) -> Region:
+def parse_region(text: str | Region, *, up=None) -> Region:
     """A region from its text form (the ``--from`` option of the command line).
 
     Parameters
@@ -287,8 +293,9 @@ def parse_region(text: str | Region, *, up=(0.0, 0.0, 1.0)) -> Region:
         ``box:x0,y0,z0,x1,y1,z1``; ``points:x,y,z;x,y,z;...``; ``path:FILE.json`` (a JSON
         list of ``[x, y, z]`` positions, or ``{"positions": [...]}``, or a list of camera
         objects with a ``position`` key).  A Region is returned as it is.
-    up : (3,) float
-        Up direction of ``upper-hemisphere`` when the text gives none.
+    up : None, "x", "y", "z" or (3,) float
+        Up direction of ``upper-hemisphere`` when the text gives none; None: the model's
+        own (``Soup.up``), fixed when the region is bound to the model.
 
     Returns
     -------
@@ -297,7 +304,7 @@ def parse_region(text: str | Region, *, up=(0.0, 0.0, 1.0)) -> Region:
     Raises
     ------
     ParameterError
-        Unknown kind, wrong number of coordinates, unreadable path file.
+        Unknown kind, wrong number of coordinates, a bad ``up``, an unreadable path file.
 
     Examples
     --------
@@ -340,10 +347,9 @@ def _path_positions(path: str) -> np.ndarray:
     if not path or not os.path.isfile(path):
         raise ParameterError(f"{path or '(no file)'}: camera path file not found")
     try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
+        data = read_json(path)
     except (OSError, ValueError) as exc:
-        raise ParameterError(f"{path}: not a JSON camera path ({exc})") from None
+        raise ParameterError(f"{path}: not a JSON camera path ({one_line(exc)})") from None
     if isinstance(data, dict):
         data = data.get("positions", data.get("cameras", []))
     try:
@@ -353,4 +359,6 @@ def _path_positions(path: str) -> np.ndarray:
         raise ParameterError(f"{path}: expected a list of [x, y, z] positions") from None
     if len(arr) == 0:
         raise ParameterError(f"{path}: the camera path has no positions")
+    if not np.isfinite(arr).all():
+        raise ParameterError(f"{path}: a camera position is not finite")
     return arr

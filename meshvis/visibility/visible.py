@@ -25,7 +25,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from meshvis import limits
+from meshvis import _validate, limits
 from meshvis.errors import ParameterError
 from meshvis.geometry.adjacency import weld
 from meshvis.io import as_soup
@@ -239,7 +239,7 @@ def visible_from(
     budget: int | None = None,
     seed: int = 0,
     method: str = "guided",
-    up=(0.0, 0.0, 1.0),
+    up=None,
     per_side: bool = False,
     faces: np.ndarray | None = None,
     min_new: float = MIN_NEW_PER_MILLION,
@@ -265,8 +265,9 @@ def visible_from(
         Seed of the one random generator; same model, region and seed give the same result.
     method : {"guided", "random"}
         GVS guided sampling, or plain random sampling (the baseline).
-    up : (3,) float
-        Up direction of ``"upper-hemisphere"`` when the region text gives none.
+    up : None, "x", "y", "z" or (3,) float
+        Up direction of ``"upper-hemisphere"`` when the region text gives none; None: the
+        model's own (``Soup.up``: y for glTF and OBJ files, z otherwise).
     per_side : bool
         Keep seeding a face until both of its sides are seen (for orientation); by default a
         face gets no more seed rays once either side is seen (enough to know it is visible,
@@ -289,7 +290,8 @@ def visible_from(
     Raises
     ------
     ParameterError
-        Unknown method or region, negative budget.
+        Unknown method or region, a budget below 1, a seed that is not an integer of at
+        least 0, ``per_side`` not a bool.
 
     Examples
     --------
@@ -300,6 +302,7 @@ def visible_from(
     """
     if method not in METHODS:
         raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    _validate.visibility_args(budget, seed, per_side, min_new, min_new_area)
     soup = as_soup(model)
     region = parse_region(region, up=up).bind(soup)
     asked = np.ones(soup.n_faces, bool)
@@ -309,8 +312,6 @@ def visible_from(
         if asked.shape != (soup.n_faces,):
             raise ParameterError(f"faces must be {soup.n_faces} booleans or face indices")
     budget = default_budget(int(asked.sum())) if budget is None else int(budget)
-    if budget < 0:
-        raise ParameterError(f"budget must be at least 0, got {budget}")
     caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET)
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new, min_new_area)

@@ -52,7 +52,10 @@ def _argv(cmd: str, path: str, tmp_path, out: str | None = None) -> list[str]:
         return ["classify", path, "-q"]
     if cmd == "render":
         return ["render", path, "-o", out or str(tmp_path / "picture.png"), "-q", "--size", "32", "32"]
-    return [cmd, path, "-o", out or str(tmp_path / f"out{os.path.splitext(path)[1] or '.obj'}"), "-q"]
+    ext = os.path.splitext(path)[1] or ".obj"
+    if ext == ".3mf" or (cmd == "layers" and ext in (".stl", ".off")):
+        ext = ".glb"  # a format that cannot hold the result is refused before the input is read
+    return [cmd, path, "-o", out or str(tmp_path / f"out{ext}"), "-q"]
 
 
 def _cli(capsys, argv: list[str]) -> tuple[int, str, str]:

@@ -1,0 +1,174 @@
+"""Start-up cost of the command: ``meshvis info`` on a tiny model next to ``python -c pass``.
+
+Each command runs in a fresh process, the commands taking turns so that a change of the
+machine's load touches them alike; the table gives the median and the best of
+``--repeat`` runs of each, the median's excess over bare ``python -c pass``, and the
+median CPU time (user + system), which a busy machine inflates less than wall time.
+Then the steps of the start are timed one by one (CPU seconds) in fresh processes.  The
+default model (100 triangles) makes the work itself negligible: what is left is the
+fixed cost of starting the interpreter, importing and setting up the compiled kernels.
+"""
+
+from __future__ import annotations
+
+import os
+import resource
+import statistics
+import subprocess
+import sys
+import time
+
+from meshvis.eval.bench.real_models import add_models_argument
+
+#: the default model, in the folder of --models: 100 triangles
+DEFAULT_MODEL = "soup.stl"
+#: the start-up cost the command is held to (seconds over ``python -c pass``)
+TARGET_SECONDS = 0.5
+
+
+def add_arguments(p) -> None:
+    """Add the options of ``meshvis bench startup`` to ``p``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The benchmark's sub-parser.
+    """
+    p.add_argument("model", nargs="?", help=f"model for meshvis info (default: <models>/{DEFAULT_MODEL})")
+    p.add_argument("--repeat", type=int, default=5, help="runs of each command; the median counts")
+    add_models_argument(p)
+    p.add_argument("--json", metavar="FILE", help="also write the numbers as JSON")
+
+
+def commands(model: str) -> dict[str, list[str]]:
+    """The measured commands, by name: bare Python, ``meshvis --version``, ``meshvis info``."""
+    me = [sys.executable, "-m", "meshvis"]
+    return {
+        "python -c pass": [sys.executable, "-c", "pass"],
+        "meshvis --version": [*me, "--version"],
+        "meshvis info MODEL": [*me, "info", model],
+    }
+
+
+#: the steps of a computing command's start, timed in CPU seconds inside one fresh process
+STEPS_CODE = """
+import json, sys, time
+steps, t = {}, time.process_time()
+def mark(name):
+    global t
+    now = time.process_time(); steps[name] = now - t; t = now
+import numpy; mark("numpy")
+import scipy.sparse.csgraph, scipy.spatial; mark("scipy (sparse graphs, k-d tree)")
+import numba; mark("numba, imported")
+import meshvis.cli.main, meshvis.geometry.diagnostics, meshvis.io; mark("meshvis modules")
+from meshvis.geometry._kernels import exact_groups
+exact_groups(numpy.zeros((1, 3), numpy.uint64), numpy.zeros(1, numpy.uint64))
+mark("numba, first compiled kernel called")
+from meshvis.geometry.diagnostics import diagnose
+diagnose(meshvis.io.load(sys.argv[1])); mark("the work of meshvis info")
+print(json.dumps(steps))
+"""
+
+
+def steps(model: str, repeat: int = 3) -> dict[str, float]:
+    """Median CPU seconds of each step of :data:`STEPS_CODE` over ``repeat`` fresh processes."""
+    import json
+
+    runs = [
+        json.loads(
+            subprocess.run(
+                [sys.executable, "-c", STEPS_CODE, model], capture_output=True, text=True, check=True
+            ).stdout
+        )
+        for _ in range(repeat)
+    ]
+    return {k: statistics.median(r[k] for r in runs) for k in runs[0]}
+
+
+def run(model: str, repeat: int = 5) -> dict:
+    """Time every command of :func:`commands` ``repeat`` times, taking turns.
+
+    Parameters
+    ----------
+    model : str
+        The model given to ``meshvis info``.
+    repeat : int
+        Runs of each command.
+
+    Returns
+    -------
+    dict
+        ``seconds`` (name -> list of wall times), ``median``, ``best``, ``over_python``
+        (median minus the median of ``python -c pass``), ``model``, ``load`` (the load
+        average before the runs), ``target``.
+    """
+    cmds = commands(model)
+    env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "0"}
+    for cmd in cmds.values():  # one untimed run each: byte code and kernel caches in place
+        subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, check=True)
+    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+    seconds: dict[str, list[float]] = {name: [] for name in cmds}
+    cpu: dict[str, list[float]] = {name: [] for name in cmds}
+    for _ in range(repeat):
+        for name, cmd in cmds.items():
+            before = _children_cpu()
+            t0 = time.perf_counter()
+            subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, check=True)
+            seconds[name].append(time.perf_counter() - t0)
+            cpu[name].append(_children_cpu() - before)
+    median = {k: statistics.median(v) for k, v in seconds.items()}
+    base = median["python -c pass"]
+    return {
+        "model": model,
+        "load": load,
+        "repeat": repeat,
+        "seconds": seconds,
+        "median": median,
+        "best": {k: min(v) for k, v in seconds.items()},
+        "over_python": {k: v - base for k, v in median.items()},
+        "cpu_median": {k: statistics.median(v) for k, v in cpu.items()},
+        "steps_cpu": steps(model),
+        "target": TARGET_SECONDS,
+    }
+
+
+def _children_cpu() -> float:
+    """User + system CPU seconds of the finished child processes (less sensitive to load than wall time)."""
+    use = resource.getrusage(resource.RUSAGE_CHILDREN)
+    return use.ru_utime + use.ru_stime
+
+
+def format(r: dict) -> str:
+    """The table of :func:`run`'s result."""
+    load = "" if r["load"] is None else f", load average {r['load']:.2f}"
+    lines = [
+        f"start-up: {r['model']}, median of {r['repeat']} runs each{load}",
+        f"{'command':<22} {'median s':>9} {'best s':>8} {'over python s':>14} {'CPU s':>7}",
+    ]
+    for name in r["median"]:
+        lines.append(
+            f"{name:<22} {r['median'][name]:9.3f} {r['best'][name]:8.3f} {r['over_python'][name]:14.3f}"
+            f" {r['cpu_median'][name]:7.3f}"
+        )
+    over = r["over_python"]["meshvis info MODEL"]
+    verdict = "met" if over <= r["target"] else "missed"
+    lines.append(f"meshvis info over python -c pass: {over:.3f} s (target <= {r['target']} s: {verdict})")
+    lines.append("steps of a computing command's start (CPU s, median of 3 fresh processes):")
+    lines += [f"  {name:<40} {sec:6.3f}" for name, sec in r["steps_cpu"].items()]
+    return "\n".join(lines)
+
+
+def main(args) -> int:
+    """Run ``meshvis bench startup`` and print its table."""
+    from meshvis.errors import ModelError
+
+    model = args.model or os.path.join(args.models_dir, DEFAULT_MODEL)
+    if not os.path.isfile(model):
+        raise ModelError("file not found", model)
+    r = run(model, max(1, int(args.repeat)))
+    print(format(r))
+    if args.json:
+        from meshvis.io.jsonfile import write_json
+
+        write_json(args.json, r)
+    return 0
