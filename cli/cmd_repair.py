@@ -190,8 +190,9 @@ def region_option(p: argparse.ArgumentParser, default: str | None, what: str) ->
 def removal_options(p: argparse.ArgumentParser) -> None:
     """Add the options of inside removal by sight to the ``remove-interior`` parser.
 
-    The options are ``--visibility``, ``--from``, ``--budget``, ``--level`` and
-    ``--keep-border``, with the defaults of :func:`meshvis.remove_interior`.
+    The options are ``--visibility``, ``--from``, ``--budget``, ``--level``,
+    ``--keep-border`` and ``--conservative``, with the defaults of
+    :func:`meshvis.remove_interior`.
 
     Parameters
     ----------
@@ -227,6 +228,13 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         default=d["keep_border"],
         metavar="N",
         help="keep N rings of hidden faces next to kept ones",
+    )
+    p.add_argument(
+        "--conservative",
+        action="store_true",
+        default=d["conservative"],
+        help="remove only faces surely hidden from --from points:... or path:CAMERAS.json (outside the "
+        "conservative set: nothing visible from there is removed; no cut, --visibility is not used)",
     )
 
 

@@ -58,6 +58,7 @@ OPERATION_OPTIONS: dict[str, dict[str, tuple[str, str]]] = {
         "keep_border": (REMOVE, "keep_border"),
         "budget": (REMOVE, "budget"),
         "up": (REMOVE, "up"),
+        "conservative": (REMOVE, "conservative"),
     },
     "layers": {"max_layers": (LAYERS, "max_layers")},
 }
@@ -209,6 +210,10 @@ def check_options(op: str, options: Mapping[str, Any] | Any) -> None:
     )
     if by_region:
         parse_region(o["from_region"])
+    if op == "remove-interior" and o["conservative"]:
+        from meshvis.visibility.viewpoints import parse_viewpoints
+
+        parse_viewpoints(o["from_region"])  # viewpoints, not a region: fails before any work
     if o["output"] and op != "classify":
         check_format(o["output"], layers=op == "layers")
     if o["removed"]:
@@ -405,6 +410,7 @@ def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
         budget=None if o["budget"] is None else int(o["budget"]),
         up=_up(o["up"]),
         seed=int(o["seed"]),
+        conservative=bool(o["conservative"]),
     )
 
 
@@ -473,6 +479,7 @@ def run_operation(
     from meshvis.graphcut.classify import classify
     from meshvis.io.report import with_schema
     from meshvis.io.up_axis import up_vector
+    from meshvis.repair.orient import classify_for_orient
 
     t0 = time.perf_counter()
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
@@ -481,7 +488,7 @@ def run_operation(
     more = detail or (lambda text: None)
     up = up_vector(_up(o.get("up")), soup)  # of the preview
     c = None
-    by_sight = (op == "remove-interior" and o["visibility"] == "view") or (
+    by_sight = (op == "remove-interior" and (o["visibility"] == "view" or o["conservative"])) or (
         op == "orient" and o["from_region"]
     )
     if not by_sight:  # sight alone needs no cut
@@ -490,7 +497,8 @@ def run_operation(
             kw["rays_per_point"] = cut_rays_per_point(
                 o["visibility"], kw["rays_per_node"], kw["samples_per_face"], kw["rays_per_point"]
             )
-        c = classify(soup, progress=progress, **kw)
+        # orient classifies the faces wound canonically (the cut orient makes itself)
+        c = (classify_for_orient if op == "orient" else classify)(soup, progress=progress, **kw)
         more(c.summary())
     report, line = _OUTPUTS[op](soup, c, o, tell, up)
     for text in _details(op, report):

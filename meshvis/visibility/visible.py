@@ -22,6 +22,7 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
@@ -32,6 +33,9 @@ from meshvis.io import as_soup
 from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.visibility.regions import Region, parse_region
 from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling
+
+if TYPE_CHECKING:
+    from meshvis.visibility.conservative import ConservativeSet
 
 #: seed rays per unseen face in successive rounds
 SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
@@ -116,6 +120,9 @@ class Visibility:
         Wall time of the search.
     stopped : str
         Why sampling stopped: ``"all seen"``, ``"few new faces"``, ``"budget"``, ``"rounds done"``.
+    conservative : ConservativeSet or None
+        With ``conservative=True``: the faces that may be seen from the viewpoints
+        (:mod:`meshvis.visibility.conservative`).
     """
 
     seen_side: np.ndarray
@@ -132,6 +139,7 @@ class Visibility:
     seconds: float
     stopped: str = ""
     extra: dict = field(default_factory=dict)
+    conservative: ConservativeSet | None = None
 
     @property
     def seen(self) -> np.ndarray:
@@ -159,6 +167,8 @@ class Visibility:
             "seconds": self.seconds,
             "history": self.history,
         }
+        if self.conservative is not None:
+            d["conservative"] = self.conservative.bracket(self.seen_side)
         if per_face:
             d["per_face"] = {
                 "seen_front": self.seen_side[:, 0],
@@ -245,6 +255,7 @@ def visible_from(
     min_new: float = MIN_NEW_PER_MILLION,
     min_new_area: float = MIN_NEW_AREA_PER_MILLION,
     caster: RayCaster | None = None,
+    conservative: bool = False,
 ) -> Visibility:
     """Which sides of the model's faces a viewer in ``region`` can see.
 
@@ -282,6 +293,11 @@ def visible_from(
         (0 for either: that rule never stops the search).
     caster : RayCaster, optional
         A caster of the same model to reuse (its offset is not changed).
+    conservative : bool
+        Also bound the search from above: the faces that may be seen from the viewpoints of
+        a ``points:`` or ``path:`` region, in ``result.conservative``
+        (:func:`meshvis.visibility.conservative.bracket`; the search then looks from the
+        viewpoints themselves).
 
     Returns
     -------
@@ -303,6 +319,13 @@ def visible_from(
     if method not in METHODS:
         raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
     _validate.visibility_args(budget, seed, per_side, min_new, min_new_area)
+    if conservative:
+        from meshvis.visibility.conservative import bracket
+
+        return bracket(
+            model, region, search=visible_from, budget=budget, seed=seed, method=method, up=up,
+            per_side=per_side, faces=faces, min_new=min_new, min_new_area=min_new_area, caster=caster,
+        )  # fmt: skip
     soup = as_soup(model)
     region = parse_region(region, up=up).bind(soup)
     asked = np.ones(soup.n_faces, bool)
