@@ -64,27 +64,22 @@ LAST_RAYS = 2048
 #: its faces undecided, and 2048 rays for each would cost 30x the rest of ``orient``
 LAST_SHARE = 1.0
 #: :func:`until_decisive` gives its faces this many more rays in its first round, twice
-#: as many in each round after it, up to this many: a face seen through 4.6 % of its back
-#: directions escaped none of 64 back rays in 5 % of the cases (0.954^64), and on the
-#: pandora level 210 lone faces of 0.15 % of the decisive area had kept their side that
-#: way, after fewer than 8 escapes
+#: as many in each round after it, up to this many: a side seen through a few percent of
+#: its directions escapes none of 64 rays in one case of twenty (0.954^64 at 4.6 %)
 RARE_FIRST_RAYS = 192
 RARE_MOST_RAYS = 4096
-#: ... and casts at most this many times the rays of the first round, largest faces first
-#: (on the pandora level its rounds cast 1.1-1.2 times them), or at least
-#: :data:`RARE_MIN_BUDGET` rays: a model with a few faces tested would otherwise give a
-#: lone face no round at all
+#: ... and casts at most this many times the rays of the first round, largest faces first,
+#: or at least :data:`RARE_MIN_BUDGET` rays: a model with a few faces tested would
+#: otherwise give a lone face no round at all
 RARE_SHARE = 2.0
 RARE_MIN_BUDGET = 1 << 16
 #: :func:`until_settled` starts with this many more rays per face
 SETTLE_FIRST_RAYS = 1024
 #: ... and goes on while a true ratio of :data:`DOMINANCE` has at least this chance
 SETTLE_LEVEL = 0.05
-#: ... or this chance, for a face whose counts already pass the line: a face about to
-#: leave the side it shows.  The teapot's face 1601, seen 1.8x as often through its back,
-#: escaped 0 : 14 of 2,560 rays with seed 4 (a chance of 0.044 at 4x) and left its
-#: consistently wound patch; 1 % for every face near the line spent the budget on faces
-#: below it (the van Gogh room as it is, seeds 0-3: 0.0069 -> 0.0326 % confirmed error)
+#: ... or this chance, for a face whose counts already pass the line (about to leave the
+#: side it shows): leaving needs stronger evidence than staying, and the stricter level for
+#: every face near the line would spend the budget on faces below it
 LEAVING_LEVEL = 0.01
 #: evidence is decisive from this many escaping rays ...
 MIN_ESCAPES = 8

@@ -78,36 +78,20 @@ from meshvis.soup import Soup
 ONE_SIDED, TWO_SIDED, HIDDEN, CONFLICT, DEGENERATE = 0, 1, 2, 3, 4
 STATUS_NAMES = ("one-sided", "two-sided", "hidden", "conflict", "degenerate")
 #: a flagged face (it crosses another surface) is not spoken for by its patch's winding
-#: across that surface either, even in a patch the input winds consistently: its own rays
-#: turn it where the side they see more often wins a sign test at this level
-#: (:func:`meshvis.repair.evidence.significant`), not only at 4x.  On the monastery as it
-#: is the faces this turns (seen 1.4-3x as often from one side) were 0.448 % of 0.45 %
-#: error; the unflagged faces of a consistently wound scan keep the 4x rule, because
-#: their sides genuinely differ a little (the test on every face of pymeshlab_face000
-#: turns 2,355 of them)
+#: across that surface: its own rays turn it where the side they see more often wins a
+#: sign test at this level (:func:`meshvis.repair.evidence.significant`), not only at 4x.
+#: Unflagged faces keep the 4x rule: the two sides of a scan differ a little everywhere
 CROSSING_LEVEL = 1e-3
-#: a flagged face whose own rays barely escaped (fewer than
-#: :data:`meshvis.repair.evidence.MIN_ESCAPES`) is left to the cut's sample points, which
-#: disagree between seeds there, and a face seen from both sides that its patch does not
-#: speak for keeps its winding; the largest such faces get the last round's rays
-#: (:data:`meshvis.repair.evidence.LAST_RAYS`), at most this many times the rays of the
-#: first round (on the monastery the largest 476 of 42,000 such faces; with seed 2 three
-#: of them, 0.097 % of the decisive area, had taken the wrong side); the faces that round
-#: does not reach get the doubling rounds of
-#: :func:`meshvis.repair.evidence.until_decisive` under the same cap (on the van Gogh
-#: room as a soup, with seed 1, two flagged faces of 0.084 % together, seen only through
-#: their fronts, had escaped none of 128 rays and kept their patches' sides).  Every lone face (a
-#: patch of one face) whose rays barely escaped gets the doubling rounds of
-#: :func:`meshvis.repair.evidence.until_decisive` instead, whatever the cut said of its
-#: sides: nothing but its own rays speaks for it (on the pandora level, whose lone faces
-#: are seen through a few percent of their directions, the error fell from 0.250 % to
-#: 0.071 % of the decisive area as it is and from 0.274 % to 0.089 % as a soup, seed 0;
-#: docs/benchmarks.md)
+#: flagged faces whose own rays barely escaped (fewer than
+#: :data:`meshvis.repair.evidence.MIN_ESCAPES`) would be left to the cut's sample points,
+#: which disagree between seeds there: the largest get the last round's rays, at most this
+#: many times the rays of the first round, the rest the doubling rounds of
+#: :func:`meshvis.repair.evidence.until_decisive` under the same cap.  A lone face (a patch
+#: of one face) gets those rounds whatever the cut said: only its own rays speak for it
 UNSEEN_SHARE = 0.25
 #: a flagged face whose sign test leans to the side it does not show (below this level, but
 #: not below :data:`CROSSING_LEVEL`) gets :data:`LEANING_RAYS` more rays before the test
-#: decides: on the monastery one large face (0.105 % of the decisive area) passed the test
-#: or not by the seed (p = 4e-4 on 168 escapes, 7e-3 on 171)
+#: decides, so that a large face near the level does not take its side by the seed
 LEANING_LEVEL = 0.05
 #: rays per leaning face: about 2.5x the escapes it had, so that a face seen 1.5x as often
 #: from one side ends far from the test's edge
@@ -115,20 +99,13 @@ LEANING_RAYS = 4096
 #: ... for at most this many times the rays of the first round, largest faces first
 LEANING_SHARE = 0.5
 #: a cluster whose hidden side escapes at least this share of the opening threshold does
-#: not speak for its faces: the cut labels it differently from seed to seed (on the pandora level, with seeds 1 and 3, a 486-face
-#: cluster whose front escapes 2 % of its rays, threshold 3 %, was cut as inside, and its
-#: faces seen only from the front were not tested: 0.40 % of the decisive area the recount
-#: confirms, against 0.15 % with seeds 0 and 2)
+#: not speak for its faces: near the threshold the cut labels it differently from seed to
+#: seed, so its faces are tested with rays of their own
 OPENING_NEAR = 0.5
 #: an open patch of several faces whose faces' own rays, pooled (area times escape
 #: share), see one side this many times as much as the other shows that side as a whole
-#: (the per-face dominance of :mod:`meshvis.repair.evidence`).  The patch vote counts
-#: only the faces the cut settled on one side: on cycloidal.ply 142 such faces turned a
-#: 1,118-face patch whose faces' rays escape through its front only; on the van Gogh room
-#: a patch of 248 faces whose rays escape 17 times as often through the front showed
-#: its back; and on the van Gogh room as a soup, with seed 0, a patch of 24 faces that the
-#: cut called hidden, not consistently wound, gave no vote, and its largest face (0.033 %
-#: of the decisive area), which escaped none of its 128 rays, kept its layer's side
+#: (the per-face dominance of :mod:`meshvis.repair.evidence`): the patch vote counts only
+#: the faces the cut settled on one side, which can be a few faces against the rest
 POOLED_DOMINANCE = 4.0
 
 
@@ -788,8 +765,10 @@ def classify_for_orient(model: Any, **classify_kw: Any) -> Classification:
 
     Parameters
     ----------
-    model : anything :func:`meshvis.classify` accepts
-    **classify_kw : passed to :func:`meshvis.classify`
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.classify` accepts.
+    **classify_kw
+        Passed to :func:`meshvis.classify`.
 
     Returns
     -------
