@@ -5,7 +5,8 @@ under it; its leader crosses no box, leader or path) and blocks no later label's
 Testing every candidate with array operations costs as much for the first valid one as
 for the last; walking them in order of cost and stopping at the first that passes costs
 a few tests per label.  The predicates are those of :mod:`meshvis.labeling.geometry2d`,
-written for one pair at a time, with the same comparisons (so the same answers).
+written for one pair at a time (:mod:`meshvis.labeling._kernels`), with the same
+comparisons (so the same answers).
 """
 
 from __future__ import annotations
@@ -15,57 +16,10 @@ import math
 import numba
 import numpy as np
 
+from .._kernels import hits_box as _hits_box
+from .._kernels import meet as _meet
+
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
-
-
-@numba.njit(**_JIT)
-def _hits_box(px, py, qx, qy, x0, y0, x1, y1):
-    """Segment p-q passes through the interior of box (x0, y0, x1, y1) (``segment_hits_box``)."""
-    if not (min(px, qx) < x1 and x0 < max(px, qx) and min(py, qy) < y1 and y0 < max(py, qy)):
-        return False
-    t_enter, t_exit = 0.0, 1.0
-    for p, d, lo, hi in ((px, qx - px, x0, x1), (py, qy - py, y0, y1)):
-        if d == 0.0:
-            if not (p > lo and p < hi):
-                return False
-            continue
-        t1, t2 = (lo - p) / d, (hi - p) / d
-        t_enter = max(t_enter, min(t1, t2))
-        t_exit = min(t_exit, max(t1, t2))
-    return t_enter < t_exit
-
-
-@numba.njit(**_JIT)
-def _orient(ax, ay, bx, by, cx, cy):
-    v = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-    return 1.0 if v > 0 else (-1.0 if v < 0 else 0.0)
-
-
-@numba.njit(**_JIT)
-def _on_segment(ax, ay, bx, by, cx, cy):
-    return min(ax, bx) <= cx <= max(ax, bx) and min(ay, by) <= cy <= max(ay, by)
-
-
-@numba.njit(**_JIT)
-def _meet(ax, ay, bx, by, cx, cy, dx, dy):
-    """Closed segments a-b and c-d meet, touching included (``segments_intersect``)."""
-    if not (
-        min(ax, bx) <= max(cx, dx)
-        and min(cx, dx) <= max(ax, bx)
-        and min(ay, by) <= max(cy, dy)
-        and min(cy, dy) <= max(ay, by)
-    ):
-        return False
-    o1, o2 = _orient(ax, ay, bx, by, cx, cy), _orient(ax, ay, bx, by, dx, dy)
-    o3, o4 = _orient(cx, cy, dx, dy, ax, ay), _orient(cx, cy, dx, dy, bx, by)
-    if o1 * o2 < 0 and o3 * o4 < 0:
-        return True
-    return (
-        (o1 == 0 and _on_segment(ax, ay, bx, by, cx, cy))
-        or (o2 == 0 and _on_segment(ax, ay, bx, by, dx, dy))
-        or (o3 == 0 and _on_segment(cx, cy, dx, dy, ax, ay))
-        or (o4 == 0 and _on_segment(cx, cy, dx, dy, bx, by))
-    )
 
 
 @numba.njit(**_JIT)
@@ -146,3 +100,44 @@ def first_free(
         if c < best:
             best, fallback = c, i
     return -1, fallback
+
+
+@numba.njit(**_JIT)
+def _leaders_meet(anchors, ports, assign, i, j):
+    a, b = anchors[i], ports[assign[i]]
+    c, d = anchors[j], ports[assign[j]]
+    return _meet(a[0], a[1], b[0], b[1], c[0], c[1], d[0], d[1])
+
+
+@numba.njit(**_JIT)
+def uncross_ports(anchors, ports, limit):
+    """Swap the ports of crossing leaders ``anchor -> port`` (for :func:`.stacking.uncross`).
+
+    The first crossing pair in row-major order is swapped, then only the two moved
+    leaders are tested again.  Returns the port of each anchor and the number of swaps.
+    """
+    n = anchors.shape[0]
+    assign = np.arange(n)
+    x = np.zeros((n, n), np.bool_)
+    for i in range(n):
+        for j in range(i + 1, n):
+            x[i, j] = x[j, i] = _leaders_meet(anchors, ports, assign, i, j)
+    swaps = 0
+    while swaps < limit:
+        first_i, first_j = -1, -1
+        for i in range(n):
+            for j in range(i + 1, n):
+                if x[i, j]:
+                    first_i, first_j = i, j
+                    break
+            if first_i >= 0:
+                break
+        if first_i < 0:
+            break
+        assign[first_i], assign[first_j] = assign[first_j], assign[first_i]
+        swaps += 1
+        for k in (first_i, first_j):
+            for m in range(n):
+                if m != k:
+                    x[k, m] = x[m, k] = _leaders_meet(anchors, ports, assign, k, m)
+    return assign, swaps
