@@ -141,3 +141,69 @@ def uncross_ports(anchors, ports, limit):
                 if m != k:
                     x[k, m] = x[m, k] = _leaders_meet(anchors, ports, assign, k, m)
     return assign, swaps
+
+
+@numba.njit(**_JIT)
+def radial_candidates(E, N, own, anchor, w, h, tier_step, clearance, n_t, below, size, centre, attach, costs):
+    """The candidate lists of :func:`.silhouette._radial_candidates` in one pass.
+
+    ``E``, ``N`` (e, 2): endpoints and their push-out directions; ``own``: the label's own
+    endpoint; ``size`` = (W, H); ``centre``: last frame's box centre (NaN: none);
+    ``attach`` (A, 2): attach points in half sizes; ``costs`` = (behind-port cost,
+    behind-port cosine, outside-image cost, coherence cost).  Candidates are walked in
+    (endpoint, tier, attach) order, with the arithmetic of the array version in the same
+    order.  Returns boxes (K, 4), leaders (L, 3, 2), the leader of each box, cost, tier
+    and endpoint move.
+    """
+    behind_cost, behind_cos, outside_cost, coherence_cost = costs
+    n_e, n_a = E.shape[0], attach.shape[0]
+    cap = n_e * n_t * n_a
+    boxes = np.empty((cap, 4))
+    cost = np.empty(cap)
+    tiers = np.empty(cap, np.int64)
+    shifts = np.empty(cap)
+    lid = np.empty(cap, np.int64)
+    leaders = np.empty((n_e * n_t, 3, 2))
+    hw, hh = w / 2, h / 2
+    base = math.hypot(own[0] - anchor[0], own[1] - anchor[1])
+    follow = not math.isnan(centre[0]) and not math.isinf(centre[0])
+    k = 0
+    n_l = 0
+    for ie in range(n_e):
+        moved = math.hypot(E[ie, 0] - own[0], E[ie, 1] - own[1])
+        longer = math.hypot(E[ie, 0] - anchor[0], E[ie, 1] - anchor[1]) - base
+        bend = (h + longer) if moved > 0 else 0.0
+        for it in range(n_t):
+            push = clearance + it * tier_step
+            px, py = E[ie, 0] + push * N[ie, 0], E[ie, 1] + push * N[ie, 1]
+            first = True
+            for ia in range(n_a):
+                ox, oy = attach[ia, 0] * hw, attach[ia, 1] * hh
+                along = (N[ie, 0] * ox + N[ie, 1] * oy) / math.hypot(ox, oy)
+                c = (
+                    it * tier_step
+                    + bend
+                    + ((1.0 - along) * h + (behind_cost if along <= behind_cos else 0.0))
+                )
+                if not c < below:
+                    continue
+                cx, cy = px + ox, py + oy
+                x0, y0, x1, y1 = cx - hw, cy - hh, cx + hw, cy + hh
+                c = c + (outside_cost if (x0 < 0 or y0 < 0 or x1 > size[0] or y1 > size[1]) else 0.0)
+                if follow:
+                    c = c + coherence_cost * math.hypot(cx - centre[0], cy - centre[1])
+                if not c < below:
+                    continue
+                if first:
+                    leaders[n_l, 0, 0], leaders[n_l, 0, 1] = anchor[0], anchor[1]
+                    leaders[n_l, 1, 0], leaders[n_l, 1, 1] = E[ie, 0], E[ie, 1]
+                    leaders[n_l, 2, 0], leaders[n_l, 2, 1] = px, py
+                    n_l += 1
+                    first = False
+                boxes[k, 0], boxes[k, 1], boxes[k, 2], boxes[k, 3] = x0, y0, x1, y1
+                cost[k] = c
+                tiers[k] = it
+                shifts[k] = moved
+                lid[k] = n_l - 1
+                k += 1
+    return boxes[:k], leaders[:n_l], lid[:k], cost[:k], tiers[:k], shifts[:k]
