@@ -1,10 +1,11 @@
-"""Compiled 2D predicates (numba), one pair of segments or segment and box at a time.
+"""Compiled kernels (numba) of the labeling's 2D geometry.
 
-:mod:`meshvis.labeling.geometry2d` answers the same questions for whole arrays; its
-pairwise matrices call :func:`meet_matrix` and :func:`hits_matrix` here, because the
-frames of a live view test a few dozen leaders at a time, where numpy's per-call cost
-outweighs the arithmetic.  The comparisons are those of the numpy predicates, so the
-answers are the same.
+:mod:`meshvis.labeling.geometry2d` answers its questions for whole arrays; its pairwise
+matrices call :func:`meet_matrix` and :func:`hits_matrix` here, because the frames of a
+live view test a few dozen leaders at a time, where numpy's per-call cost outweighs the
+arithmetic.  The comparisons are those of the numpy predicates, so the answers are the
+same.  :func:`scanline_mask` rasterises the internal area for
+:func:`meshvis.labeling.internal_area.internal_area`.
 """
 
 from __future__ import annotations
@@ -92,3 +93,62 @@ def hits_matrix(seg, boxes, shrink):
             x1, y1 = boxes[j, 2] - shrink, boxes[j, 3] - shrink
             out[i, j] = hits_box(px, py, qx, qy, x0, y0, x1, y1)
     return out
+
+
+@numba.njit(**_JIT)
+def scanline_mask(left, right, xc):
+    """Pixels between ``left[r]`` and ``right[r]`` on every row, and their summed-area table.
+
+    ``xc`` (w,) are the pixel centres of a row; a NaN bound leaves its row empty.
+    Returns mask (h, w) bool and integral (h + 1, w + 1) int32 (``integral[r, c]`` = pixels
+    of the mask above row r and left of column c).
+    """
+    h, w = left.shape[0], xc.shape[0]
+    mask = np.zeros((h, w), np.bool_)
+    integral = np.zeros((h + 1, w + 1), np.int32)
+    for r in range(h):
+        run = 0
+        for c in range(w):
+            inside = xc[c] >= left[r] and xc[c] <= right[r]  # NaN compares False
+            mask[r, c] = inside
+            run += 1 if inside else 0
+            integral[r + 1, c + 1] = integral[r, c + 1] + run
+    return mask, integral
+
+
+@numba.njit(**_JIT)
+def lower_f4_near(px, py, d_a, w4, ax, ay, done, static, cell, f4, f4w, S, acc, grid, order, start):
+    """Lower f4 (Eq. 4-5) of the candidates within ``d_a`` of the new anchor (px, py), in place.
+
+    For :func:`meshvis.labeling.greedy.greedy_layout`: the candidates come from the bucket
+    grid (``grid`` = (cell size, x0, y0, nx, ny); ``order``, ``start`` as in its
+    ``_Buckets``) in the same order; the sums ``S`` (flat) of their (area, endpoint) cells
+    take the change, summed per cell first (in ``acc``, zero on entry and on return) as
+    ``np.bincount`` does.
+    """
+    size, x0, y0, nx, ny = grid[0], int(grid[1]), int(grid[2]), int(grid[3]), int(grid[4])
+    i0 = max(int(math.floor((px - d_a) / size)) - x0, 0)
+    i1 = min(int(math.floor((px + d_a) / size)) - x0, nx - 1)
+    j0 = max(int(math.floor((py - d_a) / size)) - y0, 0)
+    j1 = min(int(math.floor((py + d_a) / size)) - y0, ny - 1)
+    if i0 > i1 or j0 > j1:
+        return
+    touched = []
+    for j in range(j0, j1 + 1):
+        for q in range(start[j * nx + i0], start[j * nx + i1 + 1]):
+            c = order[q]
+            if done[c]:
+                continue
+            new = min(math.hypot(ax[c] - px, ay[c] - py) / d_a, 1.0)
+            new = min(f4[c], new)
+            if not new < f4[c]:
+                continue
+            new_w = new**w4 if w4 != 1 else new
+            if acc[cell[c]] == 0.0:
+                touched.append(cell[c])
+            acc[cell[c]] += static[c] * (new_w - f4w[c])
+            f4[c] = new
+            f4w[c] = new_w
+    for t in touched:
+        S[t] += acc[t]
+        acc[t] = 0.0
