@@ -152,3 +152,37 @@ def lower_f4_near(px, py, d_a, w4, ax, ay, done, static, cell, f4, f4w, S, acc, 
     for t in touched:
         S[t] += acc[t]
         acc[t] = 0.0
+
+
+@numba.njit(**_JIT)
+def boundary_endpoints(inside, k, qx, qy, px, py, n):
+    """Endpoints of nearest-boundary leaders (for :func:`meshvis.labeling.candidates._radial`).
+
+    ``inside`` (m,): flat indices of the inside pixels of a grid of ``n`` pixels, ``k``
+    (m,): flat index of each one's nearest outside pixel ``q``, ``qx``, ``qy``: its centre,
+    ``px``, ``py``: the inside pixel's centre.  The endpoint is ``q`` moved half a pixel back
+    along the mean unit direction of all the pixels that share ``q`` (summed in index
+    order, as ``np.bincount`` does).  Returns, over the grid, the key ``q`` (-1 outside),
+    the endpoint (NaN outside) and the leader length (inf outside).
+    """
+    m = inside.shape[0]
+    sx, sy = np.zeros(n), np.zeros(n)
+    ux, uy = np.empty(m), np.empty(m)
+    for i in range(m):
+        dx, dy = qx[i] - px[i], qy[i] - py[i]
+        norm = max(math.hypot(dx, dy), 1e-12)
+        ux[i], uy[i] = dx / norm, dy / norm
+        sx[k[i]] += ux[i]
+        sy[k[i]] += uy[i]
+    key = np.full(n, -1, np.int64)
+    ex, ey = np.full(n, np.nan), np.full(n, np.nan)
+    length = np.full(n, np.inf)
+    for i in range(m):
+        mx, my = sx[k[i]], sy[k[i]]
+        mn = max(math.hypot(mx, my), 1e-12)
+        p = inside[i]
+        key[p] = k[i]
+        ex[p] = qx[i] - 0.5 * (mx / mn)
+        ey[p] = qy[i] - 0.5 * (my / mn)
+        length[p] = math.hypot(ex[p] - px[i], ey[p] - py[i])
+    return key, ex, ey, length

@@ -32,6 +32,7 @@ from scipy import ndimage
 
 from meshvis.errors import ParameterError
 
+from ._kernels import boundary_endpoints
 from .internal_area import InternalArea
 
 #: side codes of a leader: the direction it leaves the model in
@@ -122,23 +123,15 @@ def _radial(
     """
     hp, wp = mask.shape
     inside, ri, ci = _nearest_outside(mask)
-    k = ri * wp + ci
-    qx = ci + X[0, 0]
-    qy = ri + Y[0, 0]
-    dx, dy = qx - X.ravel()[inside], qy - Y.ravel()[inside]
-    norm = np.maximum(np.hypot(dx, dy), 1e-12)
-    # mean direction per nearest outside pixel: sums over the pixel grid, no sort needed
-    mx = np.bincount(k, dx / norm, hp * wp)[k]
-    my = np.bincount(k, dy / norm, hp * wp)[k]
-    mn = np.maximum(np.hypot(mx, my), 1e-12)
-    ex = np.full(hp * wp, np.nan)
-    ey = np.full(hp * wp, np.nan)
-    ex[inside] = qx - 0.5 * (mx / mn)
-    ey[inside] = qy - 0.5 * (my / mn)
-    length = np.full(hp * wp, np.inf)
-    length[inside] = np.hypot(ex[inside] - X.ravel()[inside], ey[inside] - Y.ravel()[inside])
-    key = np.full(hp * wp, -1, np.int64)
-    key[inside] = k
+    key, ex, ey, length = boundary_endpoints(
+        inside,
+        ri * wp + ci,
+        ci + X[0, 0],
+        ri + Y[0, 0],
+        np.ascontiguousarray(X.ravel()[inside]),
+        np.ascontiguousarray(Y.ravel()[inside]),
+        hp * wp,
+    )
     return length.reshape(hp, wp), ex.reshape(hp, wp), ey.reshape(hp, wp), key
 
 
