@@ -56,3 +56,19 @@ MAX_PIXELS = 4096 * 4096
 #: absolute value of a coordinate: products of up to six coordinates (squared areas of
 #: cross products, squared lengths of Newell normals) must stay below the float64 maximum 1.8e308
 MAX_COORDINATE = 1e50
+#: bytes the accessors of a glTF file may decode to, per byte of the file and the buffers it
+#: names: real files decode about 1:1 (Draco about 10:1), but accessors of zeros (no
+#: bufferView) or many accessors over the same bytes could ask for any amount
+MAX_EXPANSION = 64
+#: bytes the entries of a 3MF (zip) archive may inflate to, per byte of the archive: real
+#: files inflate about 5:1, and parsing takes about 40 bytes of memory per byte of XML
+MAX_ZIP_EXPANSION = 16
+#: what any model file may expand to however small it is (16 MiB), for either rule above
+MIN_EXPANSION_BYTES = 16 << 20
+#: frames of one labelled sequence (``label --orbit``, a camera path): cameras are made
+#: and read only up to this many
+MAX_FRAMES = 1_000
+#: pixels of all the frames of one labelled sequence together: each frame keeps its picture
+#: and ID buffer (11 bytes a pixel) until the sequence is written, so 2**27 pixels (512
+#: frames of 512 x 512) hold about 1.5 GB
+MAX_SEQUENCE_PIXELS = 1 << 27
