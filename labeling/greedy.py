@@ -40,11 +40,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._kernels import lower_f4_near
 from .membership import dist_threshold
 
 
 class _Buckets:
-    """Indices of points grouped by grid cell, for "points within d of p" queries."""
+    """Indices of points grouped by grid cell, for "points within d of p" queries.
+
+    The points of cell (i, j) are ``order[start[j * nx + i] : start[j * nx + i + 1]]``;
+    :func:`._kernels.lower_f4_near` walks the cells around a new anchor.
+    """
 
     def __init__(self, x: np.ndarray, y: np.ndarray, cell: float):
         self.cell = float(max(cell, 4.0))
@@ -56,20 +61,7 @@ class _Buckets:
         key = (self.cy - self.y0) * self.nx + (self.cx - self.x0)
         self.order = np.argsort(key, kind="stable")
         self.start = np.searchsorted(key[self.order], np.arange(self.nx * self.ny + 1))
-
-    def near(self, px: float, py: float, d: float) -> np.ndarray:
-        """Indices of the points in the cells that touch the square ``p +- d``."""
-        i0 = max(int(np.floor((px - d) / self.cell)) - self.x0, 0)
-        i1 = min(int(np.floor((px + d) / self.cell)) - self.x0, self.nx - 1)
-        j0 = max(int(np.floor((py - d) / self.cell)) - self.y0, 0)
-        j1 = min(int(np.floor((py + d) / self.cell)) - self.y0, self.ny - 1)
-        if i0 > i1 or j0 > j1:
-            return np.zeros(0, np.int64)
-        pieces = [
-            self.order[self.start[j * self.nx + i0] : self.start[j * self.nx + i1 + 1]]
-            for j in range(j0, j1 + 1)
-        ]
-        return np.concatenate(pieces) if pieces else np.zeros(0, np.int64)
+        self.grid = np.array([self.cell, self.x0, self.y0, self.nx, self.ny], np.float64)
 
 
 @dataclass
@@ -124,28 +116,6 @@ def _near_pick(F: np.ndarray, dx: np.ndarray, dy: np.ndarray, drift: float, keep
         return best
     j = int(near[np.argmax(F[near])])
     return j if F[j] > 0 and F[best] <= keep * F[j] else best
-
-
-def _lower_f4(
-    near: np.ndarray,
-    new: np.ndarray,
-    w4: float,
-    static: np.ndarray,
-    cell: np.ndarray,
-    f4: np.ndarray,
-    f4w: np.ndarray,
-    S: np.ndarray,
-) -> None:
-    """Lower f4 of the candidates ``near`` to ``new`` in place.
-
-    The sums ``S`` of their (area, endpoint) cells are lowered with it.
-    """
-    if len(near):
-        new_w = new**w4 if w4 != 1 else new
-        delta = static[near] * (new_w - f4w[near])
-        S += np.bincount(cell[near], weights=delta, minlength=S.size).reshape(S.shape)
-        f4[near] = new
-        f4w[near] = new_w
 
 
 def greedy_layout(
@@ -209,6 +179,9 @@ def greedy_layout(
     alive = count > 0
     done = np.zeros(len(area), bool)
     abk = _Buckets(ax, ay, d_a) if d_a > 0 and len(area) else None
+    ax, ay = np.ascontiguousarray(ax, np.float64), np.ascontiguousarray(ay, np.float64)
+    S_flat = S.reshape(-1)  # a view: the compiled f4 update writes through it
+    acc = np.zeros(S.size)
     order, picks, feas, prio = [], [], [], []
     while alive.any():
         f5w = f5**w5 if w5 != 1 else f5
@@ -229,11 +202,10 @@ def greedy_layout(
         alive[i] = False
         done[lo:hi] = True
         if abk is not None:
-            near = abk.near(ax[pick], ay[pick], d_a)
-            near = near[~done[near]]
-            new = np.minimum(f4[near], dist_threshold(ax[near] - ax[pick], ay[near] - ay[pick], d_a))
-            changed = new < f4[near]
-            _lower_f4(near[changed], new[changed], w4, static, cell, f4, f4w, S)
+            lower_f4_near(
+                float(ax[pick]), float(ay[pick]), float(d_a), float(w4), ax, ay, done, static, cell,
+                f4, f4w, S_flat, acc, abk.grid, abk.order, abk.start,
+            )  # fmt: skip
         if d_e > 0:
             e = endpoints[eid[pick]]
             np.minimum(f5, dist_threshold(endpoints[:, 0] - e[0], endpoints[:, 1] - e[1], d_e), out=f5)

@@ -24,6 +24,8 @@ import numpy as np
 
 from meshvis.errors import ParameterError
 
+from ._kernels import scanline_mask
+
 SHAPES = ("hull", "circle", "rectangle")
 
 
@@ -239,11 +241,7 @@ def internal_area(
     hp, wp = h + 2 * pad, w + 2 * pad
     left, right = _scan(polygon, hp, pad, axis=1)
     top, bottom = _scan(polygon, wp, pad, axis=0)
-    xc = np.arange(wp) + 0.5 - pad
-    with np.errstate(invalid="ignore"):
-        mask = (xc[None, :] >= left[:, None]) & (xc[None, :] <= right[:, None])
-    integral = np.zeros((hp + 1, wp + 1), np.int32)
-    integral[1:, 1:] = mask.cumsum(axis=0, dtype=np.int32).cumsum(axis=1, dtype=np.int32)
+    mask, integral = scanline_mask(left, right, np.arange(wp) + 0.5 - pad)
     return InternalArea(
         kind=kind,
         margin=margin,

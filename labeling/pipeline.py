@@ -531,6 +531,7 @@ def _inside_image(place, style: TextStyle, size: tuple[int, int], start: int | N
 
 def _view_maps(
     idbuf: IdBuffer,
+    mask: np.ndarray,
     area: str,
     margin: float | None,
     layout: str,
@@ -540,11 +541,11 @@ def _view_maps(
 ) -> tuple:
     """Compute the internal area, the leader candidates and the salience, timing each stage.
 
-    Returns the internal area ``A_I`` (stage ``area``), every pixel's leader candidate
+    ``mask`` is ``idbuf.model_mask``.  Returns the internal area ``A_I`` (stage ``area``), every pixel's leader candidate
     (``candidates``, Steps 2-3), the distance to its area's silhouette (``salience``,
     Step 4), and the clock.
     """
-    ia = internal_area(idbuf.model_mask, area, margin)
+    ia = internal_area(mask, area, margin)
     t = clock.tick("area", t)
     cand = leader_candidates(ia, layout, prefer, SIDE_KEEP)
     t = clock.tick("candidates", t)
@@ -713,14 +714,15 @@ def solve(
     clock = _Stopwatch()
     t = time.perf_counter()
     invisible, skipped, labelled = _sort_parts(idbuf, texts, min_pixels)
-    if len(labelled) == 0 or not idbuf.model_mask.any():
+    mask = idbuf.model_mask
+    if len(labelled) == 0 or not mask.any():
         empty = dict(layout=layout, method=method, area=area, margin=margin, font_size=font_size)
         return _nothing_to_label(idbuf, invisible, skipped, **empty, timings=clock.timings)
     slot = np.full(len(names), -1, np.int64)
     slot[labelled] = np.arange(len(labelled))
     prev = None if previous is None else _previous_frame(previous, idbuf, slot, len(labelled))
     prefer = _preferred_sides(idbuf, labelled, prev)
-    ia, cand, dist_sil, t = _view_maps(idbuf, area, margin, layout, prefer, clock, t)
+    ia, cand, dist_sil, t = _view_maps(idbuf, mask, area, margin, layout, prefer, clock, t)
     px = _pixels(idbuf, cand, dist_sil, labelled, len(names))
     (h, w), d_s = idbuf.shape, idbuf.sphere_diameter
     style = _fit_font(len(labelled), layout, h, int(font_size or default_font_size(h)))
