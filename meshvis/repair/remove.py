@@ -84,15 +84,24 @@ class RemovalResult:
 
     Attributes
     ----------
-    kept, removed : Soup, the faces kept and removed (attributes preserved)
-    keep : (m,) bool per input face
-    classification : Classification or None (``visibility="view"`` needs none)
-    visibility : Visibility or None, the from-region search (``"view"`` and ``"both"``)
-    reason_code : (m,) int8, index into :data:`REASONS` per input face
-    mode : str, the ``visibility`` used
-    soup : Soup, the input model
-    check : SelfCheck or None, the self-check of the removed faces (None with ``check_rays=0``)
-    see_through : int, faces that sight passed through (see-through materials)
+    kept, removed : Soup
+        The faces kept and removed (attributes preserved)
+    keep : (m,) bool
+        Kept, per input face.
+    classification : Classification or None
+        The cut (``visibility="view"`` needs none).
+    visibility : Visibility or None
+        The from-region search (``"view"`` and ``"both"``)
+    reason_code : (m,) int8
+        Index into :data:`REASONS` per input face
+    mode : str
+        The ``visibility`` used
+    soup : Soup
+        The input model
+    check : SelfCheck or None
+        The self-check of the removed faces (None with ``check_rays=0``)
+    see_through : int
+        Faces that sight passed through (see-through materials)
     """
 
     kept: Soup
@@ -180,10 +189,12 @@ def remove_interior(
 
     Parameters
     ----------
-    model : anything :func:`meshvis.classify` accepts
-    classification : reuse an existing classification of the same model (``"object"``,
-        ``"both"``; in ``"both"``, one whose sample points got another ray budget than this
-        function's own cut gives them is used as it is, with a warning: the faces kept can differ)
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.classify` accepts.
+    classification : Classification, optional
+        An existing classification of the same model to reuse (``"object"``, ``"both"``; in
+        ``"both"``, one whose sample points got another ray budget than this function's own
+        cut gives them is used as it is, with a warning: the faces kept can differ).
     visibility : {"view", "object", "both"}
         Sight from ``region`` alone (default
         :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`), the graph cut alone, or
@@ -212,7 +223,8 @@ def remove_interior(
         ``region`` (``points:...`` or ``path:CAMERAS.json``;
         :func:`meshvis.visible_from` with ``conservative=True``): nothing visible from them
         is removed.  No cut; ``visibility`` is not used.
-    **classify_kw : passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
+    **classify_kw
+        Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
         in ``"both"`` an unset ``rays_per_point`` is ``rays_per_node // samples_per_face``
         (module notes); ``seed`` also seeds the search
 

@@ -46,15 +46,14 @@ SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
 FIRST_ROUND_CHUNKS = 16
 #: default stop rule: fewer new faces than this per million rays (GVS §3.5 uses 50) ...
 MIN_NEW_PER_MILLION = 50.0
-#: ... or less new visible area than this fraction of the model's area per million rays.  What
-#: a viewer misses is area, not a face count: on finely tessellated models the faces found
-#: late are small and keep the count up after the area found has dried up.  At 1e-4 the
-#: search on the so101 assembly stopped with 77 false pixels per million (worst view 1,546)
+#: ... or less new visible area than this fraction of the model's area per million rays:
+#: what a viewer misses is area, not a face count (on a finely tessellated model the small
+#: faces found late keep the count up after the area has dried up; ``meshvis bench real``
+#: measures the false pixels this leaves)
 MIN_NEW_AREA_PER_MILLION = 1e-5
-#: the stop rule must hold twice: at the end of a window, and again on the first window of the
-#: next round, which gives the faces still unseen 4 x the seed rays (the rest of the round is
-#: left out).  Holding once, on the so101 assembly seed 0 stopped at 9.1 false pixels per
-#: million and seed 3 at 43.3: large faces seen through rare gaps had had only that round's seeds
+#: the stop rule must hold twice: at the end of a window, and again on the first window of
+#: the next round, which gives the faces still unseen 4 x the seed rays (the rest of the
+#: round is left out): faces seen through rare gaps get more than one round's seeds
 CONFIRM_NEXT_ROUND = True
 #: the stop rule is judged over at least this many rays (GVS counts new faces per million
 #: rays) or, on small models, this many rays per face, whichever is fewer
@@ -74,9 +73,7 @@ DEFAULT_MIN_BUDGET = 1 << 22
 #: with ``faces=``, sightings are propagated only on the faces asked about and on this many
 #: rings of faces around them (faces sharing a vertex): spreading from every sighting would
 #: search the whole visible model, and without the rings the faces seen only from a viewer
-#: of their visible neighbours are lost (the monastery's faces the cut calls hidden: worst
-#: view 329 false pixels per million with no ring, 47 with 3, 79 spreading everywhere at
-#: 1.6 x the rays; docs/benchmarks.md)
+#: of their visible neighbours are lost
 PROPAGATE_RINGS = 3
 #: sightings propagated in one batch (bounded memory: ~100 rays each)
 PROPAGATE_BATCH = 1 << 15
@@ -123,9 +120,13 @@ class Visibility:
     skipped : dict
         Faces that got no rays, by reason, and mutated rays refused by the region.
     region : Region
+        Where the viewers are.
     method : str
+        ``guided`` or ``random``.
     seed : int
+        Seed of the random rays.
     seconds : float
+        Wall time of the search.
     stopped : str
         Why sampling stopped: ``"all seen"``, ``"few new faces"``, ``"budget"``, ``"rounds done"``.
     see_through : int
@@ -278,6 +279,7 @@ def visible_from(
     Parameters
     ----------
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model.
     region : str or Region
         Where viewers may be (see :func:`meshvis.visibility.regions.parse_region`):
         ``"outside"``, ``"upper-hemisphere"``, ``"box:x0,y0,z0,x1,y1,z1"``,
