@@ -424,6 +424,7 @@ class Hidden:
     seconds : (k,) float64
         Time of each search (not of loading it from the cache).
     area : (m,) float64
+        Face areas.
     """
 
     hidden: np.ndarray
@@ -480,10 +481,12 @@ def hidden(
 
     Parameters
     ----------
-    model : Soup or anything :func:`meshvis.io.as_soup` accepts
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.io.as_soup` accepts.
     ref : Reference
         The dense reference of the same model.
     seed : int
+        The searches take the seeds ``seed + 1 .. seed + searches``.
     searches : int
         Long searches, at least 1.
     max_rays : int
