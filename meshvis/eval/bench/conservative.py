@@ -129,7 +129,7 @@ def aimed_seen(
 
     Returns ``(seen, parts)``: (m,) bool, the faces that ``rays`` rays aimed at random
     points of each of ``faces`` hit first; (len(faces),) int64, how many parts (``part``,
-    a label per face) other than the face's own those rays hit first.  A face hidden by
+    a label per face) those rays hit first, the face itself left out.  A face hidden by
     two parts or more can only be proved hidden by their union.
     """
     from meshvis.rays.samples import uniform_in_triangles
@@ -145,7 +145,7 @@ def aimed_seen(
         hits = scene.caster.intersect(np.broadcast_to(point, d.shape), d)
         out[hits.face[hits.face >= 0]] = True
         label = np.where(hits.face >= 0, part[np.maximum(hits.face, 0)], -1).reshape(len(chunk), rays)
-        label[label == part[chunk][:, None]] = -1
+        label[hits.face.reshape(len(chunk), rays) == chunk[:, None]] = -1
         label.sort(axis=1)
         distinct = (label[:, 1:] != label[:, :-1]) & (label[:, 1:] >= 0)
         parts[lo : lo + len(chunk)] = (label[:, 0] >= 0) + distinct.sum(axis=1)
