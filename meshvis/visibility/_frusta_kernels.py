@@ -852,7 +852,7 @@ def _collect(
                 clip_a, clip_b, ray_stack, found, fill, seg,
             ):  # fmt: skip
                 continue
-            keep[t] = 1
+            keep[t] = mode  # BLOCKED or OPEN: why the triangle is kept
             marked += 1
     return marked
 
@@ -895,7 +895,8 @@ def trace_frusta(
     max_walk : int
         Most triangles in one blocker.
     keep : (m,) uint8, in/out
-        Set to 1 for every triangle kept.
+        Set for every triangle kept, to the status of the frustum that kept it first
+        (:data:`BLOCKED`: in front of a blocker's far plane; :data:`OPEN`: at the limit).
     status : (n,) int8, out
         :data:`EMPTY`, :data:`BLOCKED`, :data:`SPLIT` or :data:`OPEN` per frustum.
     far_depth : (n,) float64, out

@@ -36,7 +36,7 @@ through it, however thin.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
@@ -93,6 +93,11 @@ class ConservativeSet:
     frusta : dict
         Frusta traced, in total and by outcome (``blocked``, ``split``, ``open`` at the
         limit, ``empty``), and per viewpoint (``per_point``).
+    at_limit : (m,) bool
+        Faces in the set only because of the subdivision limit: from every viewpoint that
+        keeps them, the first frustum to keep them was at the limit, without a blocker
+        for the rays that reach them.  The other faces of the set lie in front of a
+        blocker's far plane without being proved behind it.
     parameters : dict
         ``base_level``, ``max_level``, ``tolerance``.
     seconds : float
@@ -107,7 +112,7 @@ class ConservativeSet:
     frusta: dict
     parameters: dict
     seconds: float
-    extra: dict = field(default_factory=dict)
+    at_limit: np.ndarray
 
     @property
     def visible(self) -> np.ndarray:
@@ -346,12 +351,15 @@ def conservative_from(
     soup = scene.soup
     m = soup.n_faces
     visible_side = np.zeros((m, 2), bool)
+    at_limit, in_front = np.zeros(m, bool), np.zeros(m, bool)
     point_faces, point_sides, per_point = [], [], []
     totals = dict.fromkeys(("traced", "blocked", "split", "open", "empty"), 0)
     for view in views:
         t0 = time.perf_counter()
         keep, counts = _trace_viewpoint(scene, view, base_level, max_level, tolerance)
         faces = np.flatnonzero(keep)
+        at_limit |= keep == fk.OPEN
+        in_front |= keep == fk.BLOCKED
         sides = facing_sides(
             scene.triangles[faces], view.position, margins(scene, view.position, tolerance)[0]
         )
@@ -371,6 +379,7 @@ def conservative_from(
         frusta={**totals, "per_point": per_point},
         parameters={"base_level": base_level, "max_level": max_level, "tolerance": tolerance},
         seconds=time.perf_counter() - start,
+        at_limit=at_limit & ~in_front,
     )
 
 

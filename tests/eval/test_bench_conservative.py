@@ -55,7 +55,10 @@ def test_bench_conservative_reports_no_miss_and_caches_its_reference(tmp_path, c
     assert main([*argv, "--json", str(out)]) == 0
     again = json.loads(out.read_text())["rows"]
     assert [r["seen_faces"] for r in again] == [r["seen_faces"] for r in rows]
-    assert "mean" in capsys.readouterr().out
+    for r in again:
+        assert 0 <= r["excess_at_limit"] <= 1 and 0 <= r["excess_several_parts"] <= 1 and r["cpu_seconds"] > 0
+    # one row per viewpoint, then the scene's: mean ratios, summed frusta and times
+    assert [line.split()[1] for line in capsys.readouterr().out.splitlines()[-2:]] == ["outside", "all"]
 
 
 def test_the_viewpoints_are_inside_the_box_and_around_the_scene():

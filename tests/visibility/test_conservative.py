@@ -73,12 +73,15 @@ def test_two_coplanar_triangles_sharing_an_edge_block_together_and_a_gap_between
     soup = soup_from(blocker + hidden)
     c = conservative_from(soup, "points:0,0,0", max_level=LEVEL)
     assert c.visible.tolist() == [True, True, False]
+    assert not c.at_limit.any()  # blockers keep the square, nothing else is kept
     # the same square with a crack along its diagonal: the triangle is seen through it
     (a, b, cc), (a2, c2, d) = np.asarray(blocker)
     shift = np.array([-1e-3, 1e-3, 0.0])  # moves the second triangle off the diagonal
     cracked = soup_from([[a, b, cc], [a2 + shift, c2 + shift, d + shift]] + hidden)
     c = conservative_from(cracked, "points:0,0,0", max_level=LEVEL)
     assert c.visible.tolist() == [True, True, True]
+    # only the frusta along the crack, at the subdivision limit, keep what is behind it
+    assert c.at_limit.tolist() == [False, False, True]
 
 
 @pytest.mark.slow
