@@ -44,9 +44,19 @@ REGIONS = [
 ]
 
 
+def identifier(name: str) -> str:
+    """The Blender enum identifier of a library choice (``left-right`` -> ``LEFT_RIGHT``)."""
+    return name.upper().replace("-", "_")
+
+
+def choice(identifier_: str) -> str:
+    """The library choice of a Blender enum identifier."""
+    return identifier_.lower().replace("_", "-")
+
+
 def _enum(names, labels_: dict | None = None):
     labels_ = labels_ or {}
-    return [(n.upper(), labels_.get(n, n.title()), "") for n in names]
+    return [(identifier(n), labels_.get(n, n.replace("-", " ").title()), "") for n in names]
 
 
 def _selected_meshes(context) -> list:
@@ -260,8 +270,10 @@ class MESHVIS_OT_remove_hidden(_Background, bpy.types.Operator):
     bl_label = "Remove Hidden"
 
     action: bpy.props.EnumProperty(name="Action", items=ACTIONS, default="DELETE")
-    level: bpy.props.EnumProperty(name="Level", items=_LEVELS, default=_REMOVAL["level"].upper())
-    visibility: bpy.props.EnumProperty(name="Judged by", items=_MODES, default=_REMOVAL["visibility"].upper())
+    level: bpy.props.EnumProperty(name="Level", items=_LEVELS, default=identifier(_REMOVAL["level"]))
+    visibility: bpy.props.EnumProperty(
+        name="Judged by", items=_MODES, default=identifier(_REMOVAL["visibility"])
+    )
     region: bpy.props.EnumProperty(name="Viewers", items=REGIONS, default="OUTSIDE")
     box: bpy.props.StringProperty(name="Box empty")
     see_through: bpy.props.BoolProperty(
@@ -276,7 +288,7 @@ class MESHVIS_OT_remove_hidden(_Background, bpy.types.Operator):
         region = region_text(context, self.region, self.box)
         scene = self.snapshot(context)
         soup = scene.soup()
-        options = dict(visibility=self.visibility.lower(), region=region, level=self.level.lower())
+        options = dict(visibility=choice(self.visibility), region=region, level=choice(self.level))
         seed = self.seed
 
         def work(progress):
@@ -375,7 +387,7 @@ class MESHVIS_OT_label_parts(_Background, bpy.types.Operator):
     bl_idname = "meshvis.label_parts"
     bl_label = "Label Parts"
 
-    layout: bpy.props.EnumProperty(name="Layout", items=_LAYOUTS, default=_LABELING["layout"].upper())
+    layout: bpy.props.EnumProperty(name="Layout", items=_LAYOUTS, default=identifier(_LABELING["layout"]))
     resolution: bpy.props.IntProperty(
         name="Pixels", description="Longer side of the image the layout is made in", default=768, min=128
     )
@@ -395,7 +407,7 @@ class MESHVIS_OT_label_parts(_Background, bpy.types.Operator):
         size = labels.image_size(context.scene, self.resolution)
         cam = labels.camera(context.scene.camera, size)
         self._depth = labels.plane_depth(cam, scene.vertices, context.scene.camera.data.clip_start)
-        layout = self.layout.lower()
+        layout = choice(self.layout)
 
         def work(progress):
             from meshvis.labeling import layout as place

@@ -18,13 +18,17 @@ class MeshvisSettings(bpy.types.PropertyGroup):
     region: bpy.props.EnumProperty(name="Viewers", items=ops.REGIONS, default="OUTSIDE")
     box: bpy.props.PointerProperty(name="Box", type=bpy.types.Object, poll=_is_empty)
     action: bpy.props.EnumProperty(name="Action", items=ops.ACTIONS, default="DELETE")
-    level: bpy.props.EnumProperty(name="Level", items=ops._LEVELS, default=ops._REMOVAL["level"].upper())
+    level: bpy.props.EnumProperty(
+        name="Level", items=ops._LEVELS, default=ops.identifier(ops._REMOVAL["level"])
+    )
     visibility: bpy.props.EnumProperty(
-        name="Judged by", items=ops._MODES, default=ops._REMOVAL["visibility"].upper()
+        name="Judged by", items=ops._MODES, default=ops.identifier(ops._REMOVAL["visibility"])
     )
     see_through: bpy.props.BoolProperty(name="Transparent materials see-through", default=True)
     max_layers: bpy.props.IntProperty(name="Max layers", default=0, min=0)
-    layout: bpy.props.EnumProperty(name="Layout", items=ops._LAYOUTS, default=ops._LABELING["layout"].upper())
+    layout: bpy.props.EnumProperty(
+        name="Layout", items=ops._LAYOUTS, default=ops.identifier(ops._LABELING["layout"])
+    )
 
 
 class MESHVIS_PT_panel(bpy.types.Panel):

@@ -34,9 +34,10 @@ def test_the_defaults_are_the_librarys(bpy, installed):
     import meshvis
     import meshvis.labeling
 
+    identifier = installed.operators.identifier
     op = bpy.ops.meshvis.remove_hidden.get_rna_type().properties
     sig = inspect.signature(meshvis.remove_interior).parameters
-    assert op["visibility"].default == sig["visibility"].default.upper()
-    assert op["level"].default == sig["level"].default.upper()
+    assert op["visibility"].default == identifier(sig["visibility"].default)
+    assert op["level"].default == identifier(sig["level"].default)
     layout = bpy.ops.meshvis.label_parts.get_rna_type().properties["layout"].default
-    assert layout == inspect.signature(meshvis.labeling.layout).parameters["layout"].default.upper()
+    assert layout == identifier(inspect.signature(meshvis.labeling.layout).parameters["layout"].default)
