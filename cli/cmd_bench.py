@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|startup``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|orient-twice|real|scale|labeling|labeling-sweep|startup|conservative``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -50,9 +50,11 @@ def add_parser(sub) -> None:
         "compare",
         "scale",
         "orientation",
+        "orient-twice",
         "indoor",
         "real",
         "startup",
+        "conservative",
     ):
         try:
             mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])

@@ -1,8 +1,8 @@
 """The Blender tests run in Blender's Python (the ``bpy`` wheel) with the built extension installed.
 
-Run them with ``pytest -m blender blender/tests`` in a virtual environment holding ``bpy``,
-``pytest`` and Blender's NumPy only (``.ci/run`` makes it): meshvis comes from the wheels
-inside the extension zip, installed into a fresh Blender profile, so the tests exercise
+Run them with ``pytest -m blender blender/tests`` (without ``-m blender`` they are left
+out) in a virtual environment holding ``bpy``, ``pytest`` and Blender's NumPy only
+(``.ci/run`` makes it): meshvis comes from the wheels inside the extension zip, installed into a fresh Blender profile, so the tests exercise
 what a user installs.  The zip is ``dist/meshvis_blender-<version>.zip`` (``python
 blender/build.py``) or the path in ``MESHVIS_BLENDER_ZIP``.  The command line the operators
 are compared with is ``meshvis`` on the ``PATH`` (or ``MESHVIS_CLI``).
@@ -11,6 +11,7 @@ are compared with is ``meshvis`` on the ``PATH`` (or ``MESHVIS_CLI``).
 from __future__ import annotations
 
 import os
+import re
 import shutil
 import sys
 import tempfile
@@ -27,9 +28,13 @@ sys.path.insert(0, str(Path(__file__).parent))
 from blender_helpers import MODULE, extension_zip  # noqa: E402
 
 
-def pytest_collection_modifyitems(items):
+def pytest_collection_modifyitems(config, items):
+    """Mark every test ``blender``; leave them out unless ``-m`` names that marker."""
     for item in items:
         item.add_marker(pytest.mark.blender)
+    if not re.search(r"\bblender\b", config.getoption("markexpr") or ""):
+        config.hook.pytest_deselected(items=list(items))
+        items[:] = []
 
 
 def pytest_sessionfinish(session, exitstatus):
