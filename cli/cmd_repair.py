@@ -14,7 +14,7 @@ import time
 from meshvis.errors import ParameterError
 from meshvis.graphcut.solvers import SOLVERS
 from meshvis.io.report import write_report
-from meshvis.repair.remove_modes import LEVELS, VISIBILITY_MODES
+from meshvis.repair.remove_modes import LAYER_MODES, LEVELS, TRANSPARENT_MODES, VISIBILITY_MODES
 
 from .common import check_outputs, point, positive_int, say, staged_outputs, up_option, verbosity_options
 
@@ -190,8 +190,8 @@ def region_option(p: argparse.ArgumentParser, default: str | None, what: str) ->
 def removal_options(p: argparse.ArgumentParser) -> None:
     """Add the options of inside removal by sight to the ``remove-interior`` parser.
 
-    The options are ``--visibility``, ``--from``, ``--budget``, ``--level``,
-    ``--keep-border`` and ``--conservative``, with the defaults of
+    The options are ``--visibility``, ``--from``, ``--budget``, ``--transparent``,
+    ``--check-rays``, ``--level``, ``--keep-border`` and ``--conservative``, with the defaults of
     :func:`meshvis.remove_interior`.
 
     Parameters
@@ -204,17 +204,18 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         "--visibility",
         choices=VISIBILITY_MODES,
         default=d["visibility"],
-        help="remove what the cut calls hidden (object), what no view from --from reaches (view), "
+        help="remove what no view from --from reaches (view), what the cut calls hidden (object), "
         "or only what both call hidden",
     )
     region_option(p, d["from_region"], "where viewers are")
+    _budget_option(p, d["budget"], "stop the search for views (view and both)")
+    _transparent_option(p, d["transparent"])
     p.add_argument(
-        "--budget",
-        type=positive_int,
-        default=d["budget"],
-        metavar="RAYS",
-        help="stop the search for views (view and both) after about this many rays (default: its stop "
-        "rule ends it); fewer rays are faster and delete more visible faces",
+        "--check-rays",
+        type=int,
+        default=d["check_rays"],
+        metavar="N",
+        help="self-check: fresh random rays from every removed face, reported (0: no check)",
     )
     p.add_argument(
         "--level",
@@ -236,6 +237,57 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         help="remove only faces surely hidden from --from points:... or path:CAMERAS.json (outside the "
         "conservative set: nothing visible from there is removed; no cut, --visibility is not used)",
     )
+
+
+def _budget_option(p: argparse.ArgumentParser, default, what: str) -> None:
+    p.add_argument(
+        "--budget",
+        type=positive_int,
+        default=default,
+        metavar="RAYS",
+        help=f"{what} after about this many rays (default: its stop rule ends it); fewer rays are faster "
+        "and delete more visible faces",
+    )
+
+
+def _transparent_option(p: argparse.ArgumentParser, default: str) -> None:
+    p.add_argument(
+        "--transparent",
+        choices=TRANSPARENT_MODES,
+        default=default,
+        help="faces of see-through materials (glTF BLEND, MASK below its cutoff, transmission; MTL d < 1, "
+        "Tr > 0) let sight through, or are walls",
+    )
+
+
+def layer_options(p: argparse.ArgumentParser) -> None:
+    """Add the options of ``layers``, with the defaults of :func:`meshvis.layers`.
+
+    The options are ``--max-layers``, ``--visibility``, ``--from``, ``--budget`` and
+    ``--transparent``.
+
+    Parameters
+    ----------
+    p : argparse.ArgumentParser
+        The parser to add them to.
+    """
+    d = _defaults("layers")
+    p.add_argument(
+        "--max-layers",
+        type=positive_int,
+        default=d["max_layers"],
+        help="stop after K layers (default: peel until no face is added)",
+    )
+    p.add_argument(
+        "--visibility",
+        choices=LAYER_MODES,
+        default=d["visibility"],
+        help="peel by sight from --from: layer k is what is seen once layers 1..k-1 are gone (view), or by "
+        "the graph cut (object)",
+    )
+    region_option(p, d["from_region"], "where viewers are, for --visibility view")
+    _budget_option(p, d["budget"], "stop each layer's search for views")
+    _transparent_option(p, d["transparent"])
 
 
 def add_parser(sub) -> None:
@@ -292,12 +344,7 @@ def add_parser(sub) -> None:
 
     p = sub.add_parser("layers", help="peel the model into nested layers")
     _common(p, layers=True)
-    p.add_argument(
-        "--max-layers",
-        type=positive_int,
-        default=_defaults("layers")["max_layers"],
-        help="stop after K layers (default: peel until every face has a layer)",
-    )
+    layer_options(p)
     p.set_defaults(func=run, op="layers")
 
 

@@ -31,6 +31,7 @@ def add_parser(sub) -> None:
         The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
     """
     from meshvis.visibility.visible import METHODS
+    from meshvis.visibility.walls import TRANSPARENT_MODES
 
     def d(keyword):
         return library_default(VISIBLE_FROM, keyword)
@@ -54,6 +55,12 @@ def add_parser(sub) -> None:
         "at least 2**22, at most meshvis.limits.MAX_RAYS)",
     )
     p.add_argument("--per-side", action="store_true", help="keep looking until both sides of a face are seen")
+    p.add_argument(
+        "--transparent",
+        choices=TRANSPARENT_MODES,
+        default=d("transparent"),
+        help="faces of see-through materials let sight through, or are walls",
+    )
     p.add_argument(
         "--conservative",
         action="store_true",
@@ -98,8 +105,8 @@ def run(args: argparse.Namespace) -> int:
     ----------
     args : argparse.Namespace
         The parsed options: ``input``, ``from_region``, ``method``, ``budget``, ``per_side``,
-        ``conservative``, ``max_level``, ``up``, ``seed``, ``report``, ``preview``, ``force``,
-        ``quiet``, ``verbose``.
+        ``transparent``, ``conservative``, ``max_level``, ``up``, ``seed``, ``report``, ``preview``,
+        ``force``, ``quiet``, ``verbose``.
 
     Returns
     -------
@@ -139,6 +146,7 @@ def run(args: argparse.Namespace) -> int:
     for path in outputs:  # not over a texture of the model
         check_not_read(path, soup)
     search = dict(budget=args.budget, seed=args.seed, method=args.method, up=up, per_side=args.per_side)
+    search["transparent"] = args.transparent
     if args.conservative:  # visible_from(..., conservative=True), with the subdivision limit
         vis = bracket(soup, args.from_region, search=visible_from, max_level=args.max_level, **search)
     else:
@@ -152,6 +160,7 @@ def run(args: argparse.Namespace) -> int:
         f"{args.input}: visible: {r['seen_faces']} of {r['faces']} faces seen "
         f"({100 * r['seen_area_fraction']:.1f} % of the area) from {args.from_region}; "
         f"{r['rays']['total']} rays, stopped: {r['stopped']}"
+        + (f"; {vis.see_through} see-through faces let sight through" if vis.see_through else "")
         + (f"; wrote {' and '.join(wrote)}" if wrote else "")
         + f"; {vis.seconds:.1f} s",
     )

@@ -34,10 +34,15 @@ class Material:
     source : object, optional
         What the reader produced (e.g. the MTL lines and folder, or a trimesh material);
         only the writers interpret it.
+    see_through : bool
+        The material lets sight through (glass, cut-outs): glTF ``alphaMode`` BLEND, MASK
+        with its alpha below the cutoff, ``KHR_materials_transmission``; MTL ``d`` < 1 or
+        ``Tr`` > 0 (:func:`meshvis.io.transparency.gltf_see_through`, ``mtl_see_through``).
     """
 
     name: str
     source: Any = None
+    see_through: bool = False
 
 
 @dataclass(eq=False)
@@ -221,6 +226,19 @@ class Soup:
         ok = length > 0
         out[ok] = c[ok] / length[ok, None]
         return out
+
+    @property
+    def see_through(self) -> np.ndarray:
+        """(m,) bool: the face's material lets sight through (:attr:`Material.see_through`).
+
+        Examples
+        --------
+        >>> s = Soup(np.eye(3), [[0, 1, 2], [0, 2, 1]], material_id=[0, -1], materials=[Material("glass", see_through=True)])
+        >>> s.see_through.tolist()
+        [True, False]
+        """
+        flags = np.array([m.see_through for m in self.materials] + [False], bool)
+        return flags[self.material_id]  # -1 (no material) reads the trailing False
 
     @cached_property
     def bounds(self) -> np.ndarray:

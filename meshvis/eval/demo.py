@@ -150,7 +150,7 @@ def _run(
         f"agrees with the truth on {100 * removed_ok:.2f}% of the faces"
     )
 
-    lay = layers(soup, classification=c)
+    lay = layers(soup, classification=c, visibility="object")
     save(soup, os.path.join(folder, "layers.ply"), face_values={"layer": lay.layer})
     save_png(render_layers(soup, lay.layer, camera, size=(size, size)), os.path.join(folder, "layers.png"))
     layer_acc = float((area * (lay.layer == truth.layer) * ok).sum() / (area * ok).sum())

@@ -40,6 +40,7 @@ from meshvis.io.gltf_edit import (
 )
 from meshvis.io.mtl import describe_pbr
 from meshvis.io.scene import mesh_soup, soup_from_scene
+from meshvis.io.transparency import gltf_see_through
 from meshvis.soup import Material, Soup, SourceRecord
 
 _GLB_MAGIC = GLB_MAGIC
@@ -466,7 +467,8 @@ def read_gltf(path: str, label: str | None = None) -> Soup:
     json_mats = doc.get("materials", [])
 
     materials: list[Material] = [
-        Material(str(m.get("name") or f"material{i}"), None) for i, m in enumerate(json_mats)
+        Material(str(m.get("name") or f"material{i}"), None, see_through=gltf_see_through(m))
+        for i, m in enumerate(json_mats)
     ]
     # a material that meshvis only wrote so that UVs survive stands for "no material"
     placeholder = {

@@ -389,6 +389,8 @@ def describe_pbr(material: Material | None, name: str) -> PbrDescription:
         desc.roughness = getattr(pbr, "roughnessFactor", None)
         desc.double_sided = bool(getattr(pbr, "doubleSided", False))
         desc.alpha_mode = getattr(pbr, "alphaMode", None)
+    if material is not None and material.see_through and desc.alpha_mode not in ("BLEND", "MASK"):
+        desc.alpha_mode = "BLEND"  # glass stays glass (a transmission extension is not written)
     return desc
 
 

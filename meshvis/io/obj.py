@@ -37,6 +37,7 @@ from meshvis.io.mtl import (
     remove_created,
     write_mtl,
 )
+from meshvis.io.transparency import mtl_see_through
 from meshvis.io.triangulate import triangulate
 from meshvis.soup import Material, Soup, SourceRecord
 
@@ -542,7 +543,10 @@ def _assign_materials(usemtl, n_rec: int, src: np.ndarray, mtllibs: list[str], p
         state_to_id[s] = name_to_id.setdefault(usemtl[s][1], len(name_to_id))
     material_id = np.where(state_of_tri >= 0, state_to_id[np.maximum(state_of_tri, 0)], -1)
     lookup = _read_mtllibs(mtllibs, path)
-    materials = [Material(name, lookup.get(name)) for name in name_to_id]
+    materials = [
+        Material(name, src, see_through=src is not None and mtl_see_through(src.text))
+        for name, src in ((name, lookup.get(name)) for name in name_to_id)
+    ]
     return material_id, materials
 
 

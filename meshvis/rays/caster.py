@@ -143,6 +143,10 @@ class RayCaster:
     vertex_groups : VertexGroups, optional
         :func:`~meshvis.geometry.adjacency.group_vertices` of the model, when the caller has
         them (the classification shares them with its weld); computed here otherwise.
+    walls : (m,) bool, optional
+        The faces that stop rays (default: all).  The others enter the scene with their three
+        corners on one point, so no ray hits them (see-through materials); face indices,
+        normals and areas stay those of the model.
 
     Examples
     --------
@@ -160,6 +164,7 @@ class RayCaster:
         offset: float = DEFAULT_OFFSET,
         threads: int | None = None,
         vertex_groups: VertexGroups | None = None,
+        walls: np.ndarray | None = None,
     ):
         import embreex.mesh_construction as mc
         import embreex.rtcore_scene as rs
@@ -186,6 +191,11 @@ class RayCaster:
         v32[~np.isfinite(v32).all(axis=1)] = 0
         corners = groups.corner_groups(soup.faces, soup.n_vertices).astype(np.int32, copy=False)
         _check_copies(corners, len(groups.first), soup.path)
+        #: the faces that stop rays (None: all)
+        self.walls = None if walls is None else np.asarray(walls, bool).reshape(soup.n_faces)
+        if self.walls is not None and not self.walls.all():
+            corners = corners.copy()
+            corners[~self.walls] = corners[~self.walls, :1]  # a point: never hit
         self._scene = rs.EmbreeScene()
         self._mesh = mc.TriangleMesh(self._scene, v32, corners)
 

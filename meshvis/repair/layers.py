@@ -1,22 +1,36 @@
-"""Layer peeling (appendix H §5, "Layer Computation").
+"""Layer peeling: by sight (the default), or by the graph cut (appendix H §5).
 
-Layer 1 is every face with an outside side after the first cut.  Then the nodes of the
-layer-1 faces (in particular their inside nodes) are tied to the source and the graph is
-cut again: what becomes outside now is layer 2 — what one sees once layer 1 is gone.
-Repeat until every face has a layer or ``max_layers`` is reached.
+* ``visibility="view"``: layer 1 is every face a guided search from the region (default
+  ``outside``) sees (:func:`meshvis.visible_from`, the faces the default
+  :func:`meshvis.remove_interior` keeps); layer *k* is every face such a search sees once
+  layers 1 .. k-1 are taken out of the scene (the search asks about the remaining faces
+  only, and rays pass where the peeled faces were).  The faces no search sees form the last
+  bucket, ``n_layers + 1``.
+* ``visibility="object"`` (the paper's "Layer Computation"): layer 1 is every face with an
+  outside side after the first cut.  Then the nodes of the layer-1 faces (in particular
+  their inside nodes) are tied to the source and the graph is cut again: what becomes
+  outside now is layer 2.
+
+Both repeat until no face is added or ``max_layers`` is reached.
 """
 
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
 from meshvis import _validate
+from meshvis.errors import ParameterError
 from meshvis.graphcut.classify import Classification, classify
+from meshvis.io import as_soup
+from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
+from meshvis.repair.remove_modes import DEFAULT_LAYER_VISIBILITY, DEFAULT_TRANSPARENT, LAYER_MODES
 from meshvis.soup import Soup
+from meshvis.visibility import Visibility, visible_from
+from meshvis.visibility.walls import walls
 
 
 @dataclass
@@ -26,21 +40,28 @@ class LayerResult:
     Attributes
     ----------
     layer : (m,) int64 array
-        Layer index per input face (1 = outer); faces that no cut reached (never seen by any ray:
-        sealed off) get ``n_layers + 1`` and are counted in ``unreached``.
+        Layer index per input face (1 = outer); faces that no cut reached or no search saw
+        get ``n_layers + 1`` and are counted in ``unreached``.
     outer_side : (m,) int8 array
-        The side that is outside at the face's layer (0 front, 1 back, 2 both, -1 for unreached
-        faces).
+        The side that is outside (by the cut) or seen (by sight) at the face's layer (0 front,
+        1 back, 2 both, -1 for unreached faces).
     n_layers : int
         Number of layers found.
     soup : Soup
         The model the layers are of.
     unreached : int
         Faces that no cut reached.
-    classification : Classification
-        The classification the layers were peeled from.
+    classification : Classification or None
+        The classification the layers were peeled from (``visibility="object"``).
     seconds : float
         Time of the peeling (the classification not included).
+    mode : str
+        The ``visibility`` that peeled the layers.
+    searches : list of Visibility
+        By sight: the search of each layer (the last one found nothing new, unless
+        ``max_layers`` stopped the peeling).
+    see_through : int
+        By sight: faces that sight passed through (see-through materials).
     """
 
     soup: Soup
@@ -48,18 +69,29 @@ class LayerResult:
     outer_side: np.ndarray
     n_layers: int
     unreached: int
-    classification: Classification
+    classification: Classification | None
     seconds: float
+    mode: str = "object"
+    searches: list[Visibility] = field(default_factory=list)
+    see_through: int = 0
 
     def report(self, per_face: bool = True) -> dict:
         """The JSON report: layer counts, timings, and per face ``layer`` when ``per_face``."""
-        d = {
+        d: dict = {
+            "visibility": self.mode,
             "layers": self.n_layers,
             "faces_per_layer": np.bincount(self.layer, minlength=self.n_layers + 2)[1:].tolist(),
             "unreached_faces": self.unreached,
             "layer_seconds": self.seconds,
-            "classification": self.classification.report(per_face=False),
         }
+        if self.classification is not None:
+            d["classification"] = self.classification.report(per_face=False)
+        if self.searches:
+            d["see_through_faces"] = self.see_through
+            d["searches"] = [
+                {k: v.report(per_face=False)[k] for k in ("rays", "stopped", "seconds", "seen_faces")}
+                for v in self.searches
+            ]
         if per_face:
             d["per_face"] = {"layer": self.layer, "outer_side": self.outer_side}
         return d
@@ -100,11 +132,16 @@ def layers(
     model: Any,
     *,
     max_layers: int | None = None,
+    visibility: str = DEFAULT_LAYER_VISIBILITY,
+    region="outside",
+    budget: int | None = None,
+    up=None,
+    transparent: str = DEFAULT_TRANSPARENT,
     classification: Classification | None = None,
     progress=None,
     **classify_kw: Any,
 ) -> LayerResult:
-    """Peel the model into nested layers.
+    """Peel the model into nested layers (module notes).
 
     Parameters
     ----------
@@ -112,17 +149,34 @@ def layers(
         Anything :func:`meshvis.classify` accepts.
     max_layers : int, optional
         Stop after this many layers (the rest get layer ``max_layers + 1``).
+    visibility : {"view", "object"}
+        Peel by sight from ``region`` (default
+        :data:`~meshvis.repair.remove_modes.DEFAULT_LAYER_VISIBILITY`) or by the graph cut.
+    region : str or Region
+        Where viewers may be (by sight; see :func:`meshvis.parse_region`).
+    budget : int, optional
+        Ray budget of each layer's search (by sight; default :func:`meshvis.visible_from`'s).
+    up : None, "x", "y", "z" or (3,) float
+        Up direction of an ``"upper-hemisphere"`` region; None: the model's own (``Soup.up``).
+    transparent : {"see-through", "opaque"}
+        Whether faces of see-through materials let sight through (by sight).
     classification : Classification, optional
-        Reuse an existing classification of the same model.
+        Reuse an existing classification of the same model (by the cut).
     progress : callable, optional
-        Progress callback, passed to :func:`meshvis.classify`.
+        Called as ``progress(layer, faces with a layer, faces)`` after every layer.
     **classify_kw
-        Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...).
+        Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...); ``seed``
+        also seeds the searches.
 
     Returns
     -------
     LayerResult
         Layer and outer side of every face.
+
+    Raises
+    ------
+    ParameterError
+        Unknown ``visibility`` or ``transparent``, ``max_layers`` below 1.
 
     Examples
     --------
@@ -132,10 +186,60 @@ def layers(
     >>> r = layers((v, f), seed=0)
     >>> r.n_layers, sorted(set(r.layer.tolist()))
     (2, [1, 2])
+    >>> layers((v, f), visibility="object", seed=0).n_layers
+    2
     """
     _validate.repair_args(classification, Classification, classify_kw, classify)
     max_layers = None if max_layers is None else _validate.integer("max_layers", max_layers, 1)
+    if visibility not in LAYER_MODES:
+        raise ParameterError(f"unknown visibility {visibility!r}; choose one of {', '.join(LAYER_MODES)}")
+    if visibility == "view":
+        return _layers_by_sight(
+            model, max_layers, region, budget, up, transparent, int(classify_kw.get("seed", 0)), progress
+        )
     c = classification or classify(model, **classify_kw)
+    return _layers_by_cut(c, max_layers, progress)
+
+
+def _layers_by_sight(model, max_layers, region, budget, up, transparent, seed: int, progress) -> LayerResult:
+    """Layer k: what a search sees of the faces left once layers 1 .. k-1 are out of the scene."""
+    soup = as_soup(model)
+    t0 = time.perf_counter()
+    m = soup.n_faces
+    clear = walls(soup, transparent)
+    blocking = np.ones(m, bool) if clear is None else clear
+    layer = np.zeros(m, np.int64)
+    outer_side = np.full(m, -1, np.int8)
+    active = soup.areas > 0  # a face of zero area is never seen
+    searches: list[Visibility] = []
+    k = 0
+    while (layer[active] == 0).any() and (max_layers is None or k < max_layers):
+        left = layer == 0
+        caster = RayCaster(soup, offset=VISIBILITY_OFFSET, walls=blocking & left)
+        # layer 1 is the search of the default removal, face for face
+        asked = None if k == 0 else left & active
+        vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=asked, caster=caster)
+        searches.append(vis)
+        new = vis.seen & left & active
+        if not new.any():
+            break
+        k += 1
+        layer[new] = k
+        seen = vis.seen_side[new]
+        outer_side[new] = np.where(seen.all(axis=1), 2, np.argmax(seen, axis=1))
+        if progress is not None:
+            progress(k, int((layer > 0).sum()), m)
+    rest = layer == 0
+    unreached = int((rest & active).sum())
+    layer[rest] = k + 1
+    see_through = 0 if clear is None else int((~clear).sum())
+    return LayerResult(
+        soup, layer, outer_side, k, unreached, None, time.perf_counter() - t0, "view", searches, see_through
+    )
+
+
+def _layers_by_cut(c: Classification, max_layers: int | None, progress) -> LayerResult:
+    """Layer k: the faces outside once the nodes of layers 1 .. k-1 are tied to the source."""
     t0 = time.perf_counter()
     m = c.soup.n_faces
     layer = np.zeros(m, np.int64)
@@ -161,4 +265,4 @@ def layers(
     rest = layer == 0
     unreached = int((rest & active).sum())
     layer[rest] = k + 1
-    return LayerResult(c.soup, layer, outer_side, k, unreached, c, time.perf_counter() - t0)
+    return LayerResult(c.soup, layer, outer_side, k, unreached, c, time.perf_counter() - t0, "object")

@@ -58,9 +58,18 @@ OPERATION_OPTIONS: dict[str, dict[str, tuple[str, str]]] = {
         "keep_border": (REMOVE, "keep_border"),
         "budget": (REMOVE, "budget"),
         "up": (REMOVE, "up"),
+        "transparent": (REMOVE, "transparent"),
+        "check_rays": (REMOVE, "check_rays"),
         "conservative": (REMOVE, "conservative"),
     },
-    "layers": {"max_layers": (LAYERS, "max_layers")},
+    "layers": {
+        "max_layers": (LAYERS, "max_layers"),
+        "visibility": (LAYERS, "visibility"),
+        "from_region": (LAYERS, "region"),
+        "budget": (LAYERS, "budget"),
+        "up": (LAYERS, "up"),
+        "transparent": (LAYERS, "transparent"),
+    },
 }
 #: options that are no keyword of a library function: the hints (lists of points and boxes,
 #: :class:`meshvis.Hints`) and orient's region (given: orient toward what its viewers see)
@@ -206,7 +215,7 @@ def check_options(op: str, options: Mapping[str, Any] | Any) -> None:
     if _up(o.get("up")) is not None:
         up_vector(_up(o["up"]))
     by_region = (op == "orient" and o["from_region"]) or (
-        op == "remove-interior" and o["visibility"] != "object"
+        op in ("remove-interior", "layers") and o["visibility"] != "object"
     )
     if by_region:
         parse_region(o["from_region"])
@@ -284,6 +293,8 @@ def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[
     with warnings.catch_warnings():  # the cut was made for this removal, with the budget asked for
         warnings.filterwarnings("ignore", message="the classification given gave its sample points")
         r = remove_interior(soup, classification=c, **removal_kwargs(o, soup))
+    for text in r.summary()[1:]:  # a search ended by its budget; the self-check
+        tell(text)
     _save(r.kept, o["output"], tell)
     wrote = [o["output"]]
     if o["removed"] and r.removed.n_faces > 0:
@@ -299,6 +310,8 @@ def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[
         f"removed {report['removed_faces']} of {report['input_faces']} faces "
         f"({100 * report['removed_area_fraction']:.1f} % of the area), kept {report['kept_faces']}"
     )
+    if r.see_through:
+        line += f"; {r.see_through} faces of see-through materials let sight through"
     return report, f"{line}; wrote {' and '.join(wrote)}"
 
 
@@ -334,7 +347,7 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[
     from meshvis.rays.render import render_layers, save_image
     from meshvis.repair.layers import layers
 
-    r = layers(soup, classification=c, max_layers=o["max_layers"])
+    r = layers(soup, classification=c, **layer_kwargs(o))
     n = int(r.layer.max())
     if rebuilds_groups(o["output"]) and _same_format(soup, o["output"]):
         _check_layer_paths(layer_paths(o["output"], n), o)
@@ -353,8 +366,10 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[
         save_image(render_layers(soup, r.layer, up=up), o["preview"])
         wrote.append(o["preview"])
     per_layer = ", ".join(map(str, report["faces_per_layer"][: r.n_layers]))
-    unreached = f", {r.unreached} faces no view reaches" if r.unreached else ""
-    line = f"{r.n_layers} layers ({per_layer} faces{unreached})"
+    last = "never seen" if r.mode == "view" else "no view reaches"
+    unreached = f", {r.unreached} faces {last}" if r.unreached else ""
+    clear = f"; {r.see_through} faces of see-through materials let sight through" if r.see_through else ""
+    line = f"{r.n_layers} layers by {'sight' if r.mode == 'view' else 'the cut'} ({per_layer} faces{unreached}){clear}"
     return report, f"{line}; wrote {', '.join(wrote)}"
 
 
@@ -410,8 +425,25 @@ def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
         budget=None if o["budget"] is None else int(o["budget"]),
         up=_up(o["up"]),
         seed=int(o["seed"]),
+        transparent=o["transparent"],
+        check_rays=int(o["check_rays"]),
         conservative=bool(o["conservative"]),
     )
+
+
+def layer_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
+    """Keyword arguments of :func:`meshvis.layers` from operation options (the cut's come apart)."""
+    o = {**default_options("layers"), **_options(options)}
+    kw: dict[str, Any] = dict(max_layers=o["max_layers"], visibility=o["visibility"])
+    if o["visibility"] == "view":
+        kw.update(
+            region=o["from_region"],
+            budget=None if o["budget"] is None else int(o["budget"]),
+            up=_up(o["up"]),
+            seed=int(o["seed"]),
+            transparent=o["transparent"],
+        )
+    return kw
 
 
 #: what the face statuses of ``orient`` mean, for ``--verbose``
@@ -488,8 +520,10 @@ def run_operation(
     more = detail or (lambda text: None)
     up = up_vector(_up(o.get("up")), soup)  # of the preview
     c = None
-    by_sight = (op == "remove-interior" and (o["visibility"] == "view" or o["conservative"])) or (
-        op == "orient" and o["from_region"]
+    by_sight = (
+        (op in ("remove-interior", "layers") and o["visibility"] == "view")
+        or (op == "remove-interior" and o["conservative"])
+        or (op == "orient" and o["from_region"])
     )
     if not by_sight:  # sight alone needs no cut
         kw = classify_kwargs(o)

@@ -467,7 +467,7 @@ def _hidden_sides(
     by_parity = np.zeros(m, bool)
     if not hidden.any():
         return None, own_layer, by_parity
-    lay = layers(c.soup, classification=c)
+    lay = layers(c.soup, classification=c, visibility="object")
     side = lay.outer_side[hidden]
     own = (side == 0) | (side == 1)  # one-sided at its own layer
     own_layer[np.flatnonzero(hidden)[own]] = True

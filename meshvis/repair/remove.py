@@ -1,23 +1,30 @@
-"""Inside removal (appendix H §5, "Inside Removal"), by the cut, by sight, or by both.
+"""Inside removal (appendix H §5, "Inside Removal"), by sight, by the cut, or by both.
 
+* ``visibility="view"`` (the default): every face that no line of sight from the region
+  reached is removed (:func:`meshvis.visible_from`, DESIGN.md §9): what a viewer sees is
+  kept, and what none sees goes, also where the cut would call it outside (the inside of
+  an engine block open at one end, an inner shell joined to the outer one through holes).
 * ``visibility="object"``: one classification; every face with an outside side -- or, for
   faces classified through sample points, at least one outside sample point -- is kept.
   Of a sheet stored twice with opposite winding (:mod:`meshvis.geometry.duplicates`) whose
   one side is hidden, only the copy facing the seen side counts as kept by the cut.
-* ``visibility="view"``: every face that no line of sight from the region reached is removed
-  (:func:`meshvis.visible_from`, DESIGN.md §9).
-* ``visibility="both"`` (the default): a face is removed only when the cut calls it hidden
-  *and* a guided search for a view of it failed (seed rays aimed at these faces only,
+* ``visibility="both"``: a face is removed only when the cut calls it hidden *and* a
+  guided search for a view of it failed (seed rays aimed at these faces only,
   propagation within a few rings of them; the report counts the faces left out).
 
 In ``both`` the cut only proposes the faces that the search then tries to see, so its
 sample points get less: unless ``rays_per_point`` is given, each sample point of an
 intersecting face gets ``rays_per_node // samples_per_face`` rays, which gives a flagged
 face's side the budget of an unflagged face's
-(:func:`~meshvis.repair.remove_modes.cut_rays_per_point`).  Measured on
-the real scenes (docs/performance.md, "Rays per sample point"): ``both`` keeps its false
-pixels at 0-3 per million and removes as much of the hidden area or more, in about two
-thirds of the time.
+(:func:`~meshvis.repair.remove_modes.cut_rays_per_point`).
+
+Sight passes the faces of see-through materials unless ``transparent="opaque"``
+(:mod:`meshvis.visibility.walls`): what shows through a windshield stays.  The cut does not
+look at materials.
+
+Every removal ends with a self-check (:func:`meshvis.visibility.check.self_check`):
+``check_rays`` fresh random rays from every removed face; the report says how many removed
+faces and how much of their area one of them saw.
 
 ``level="patch"`` or ``"part"`` removes a connected patch (faces sharing edges) or a named
 part only when all its faces are hidden; ``keep_border=N`` keeps N rings of hidden faces
@@ -39,8 +46,10 @@ from meshvis.geometry.adjacency import components, edges, face_adjacency, weld
 from meshvis.geometry.duplicates import hidden_copies, opposite_copies
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.io import as_soup
-from meshvis.rays.caster import VISIBILITY_OFFSET
+from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.repair.remove_modes import (
+    CHECK_RAYS,
+    DEFAULT_TRANSPARENT,
     DEFAULT_VISIBILITY,
     LEVELS,
     VISIBILITY_MODES,
@@ -48,7 +57,9 @@ from meshvis.repair.remove_modes import (
     reuse_note,
 )
 from meshvis.soup import Soup
-from meshvis.visibility import Visibility, visible_from
+from meshvis.visibility import Visibility, parse_region, visible_from
+from meshvis.visibility.check import SelfCheck, self_check
+from meshvis.visibility.walls import walls
 
 #: reason of each face, by code
 REASONS = (
@@ -80,6 +91,8 @@ class RemovalResult:
     reason_code : (m,) int8, index into :data:`REASONS` per input face
     mode : str, the ``visibility`` used
     soup : Soup, the input model
+    check : SelfCheck or None, the self-check of the removed faces (None with ``check_rays=0``)
+    see_through : int, faces that sight passed through (see-through materials)
     """
 
     kept: Soup
@@ -90,6 +103,8 @@ class RemovalResult:
     reason_code: np.ndarray
     mode: str
     soup: Soup
+    check: SelfCheck | None = None
+    see_through: int = 0
 
     @property
     def reason(self) -> list[str]:
@@ -106,7 +121,10 @@ class RemovalResult:
             "removed_faces": int((~self.keep).sum()),
             "removed_area_fraction": float((soup.areas * ~self.keep).sum() / max(soup.total_area, 1e-300)),
             "reasons": {REASONS[c]: int(n) for c, n in zip(*np.unique(self.reason_code, return_counts=True))},
+            "see_through_faces": self.see_through,
         }
+        if self.check is not None:
+            d["self_check"] = self.check.report()
         if self.classification is not None:
             d["classification"] = self.classification.report(per_face=False)
         if self.visibility is not None:
@@ -118,7 +136,28 @@ class RemovalResult:
                 d["per_face"]["outside_back"] = self.classification.outside[:, 1]
             if self.visibility is not None:
                 d["per_face"]["seen"] = self.visibility.seen
+            if self.check is not None:
+                d["per_face"]["seen_by_check"] = self.check.seen
         return d
+
+    def summary(self) -> list[str]:
+        """The console lines: what was kept and removed, how the search stopped, the self-check."""
+        clear = (
+            f"; {self.see_through} faces of see-through materials let sight through"
+            if self.see_through
+            else ""
+        )
+        lines = [
+            f"kept {int(self.keep.sum())}, removed {int((~self.keep).sum())} of {len(self.keep)} faces{clear}"
+        ]
+        if self.visibility is not None and self.visibility.stopped == "budget":
+            lines.append(
+                f"the search for views stopped at its ray budget ({self.visibility.rays['total']} rays) "
+                "before its stop rule: some removed faces may be visible (raise --budget)"
+            )
+        if self.check is not None:
+            lines.append(self.check.summary())
+        return lines
 
 
 def remove_interior(
@@ -132,6 +171,8 @@ def remove_interior(
     budget: int | None = None,
     up=None,
     view: Visibility | None = None,
+    transparent: str = DEFAULT_TRANSPARENT,
+    check_rays: int = CHECK_RAYS,
     conservative: bool = False,
     **classify_kw: Any,
 ) -> RemovalResult:
@@ -140,13 +181,13 @@ def remove_interior(
     Parameters
     ----------
     model : anything :func:`meshvis.classify` accepts
-    classification : reuse an existing classification of the same model (in ``"both"``, one
-        whose sample points got another ray budget than this function's own cut gives them
-        is used as it is, with a warning: the faces kept can differ)
-    visibility : {"object", "view", "both"}
-        The graph cut alone, sight from ``region`` alone, or both must call a face hidden
-        (default :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`, ``"both"``; pass
-        ``"object"`` for the cut alone).
+    classification : reuse an existing classification of the same model (``"object"``,
+        ``"both"``; in ``"both"``, one whose sample points got another ray budget than this
+        function's own cut gives them is used as it is, with a warning: the faces kept can differ)
+    visibility : {"view", "object", "both"}
+        Sight from ``region`` alone (default
+        :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`), the graph cut alone, or
+        both must call a face hidden.
     region : str or Region
         Where viewers may be, for ``"view"`` and ``"both"`` (see :func:`meshvis.parse_region`).
     level : {"face", "patch", "part"}
@@ -154,12 +195,18 @@ def remove_interior(
     keep_border : int
         Rings of hidden faces (sharing an edge) kept around the kept faces.
     budget : int, optional
-        Ray budget of the from-region search (default: :func:`meshvis.visible_from`'s).
+        Ray budget of the from-region search (default: :func:`meshvis.visible_from`'s cap;
+        its stop rule ends it).  A search stopped by the budget says so in the report.
     up : None, "x", "y", "z" or (3,) float
         Up direction of an ``"upper-hemisphere"`` region; None: the model's own
         (``Soup.up``: y for glTF and OBJ files, z otherwise).
     view : Visibility, optional
         Reuse a from-region search of the same model (``"view"`` only).
+    transparent : {"see-through", "opaque"}
+        Whether faces of see-through materials let sight through
+        (:mod:`meshvis.visibility.walls`), in the search and the self-check.
+    check_rays : int
+        Fresh random rays from every removed face in the self-check (0: no check).
     conservative : bool
         Remove only the faces outside the conservative set from the viewpoints of
         ``region`` (``points:...`` or ``path:CAMERAS.json``;
@@ -167,7 +214,7 @@ def remove_interior(
         is removed.  No cut; ``visibility`` is not used.
     **classify_kw : passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
         in ``"both"`` an unset ``rays_per_point`` is ``rays_per_node // samples_per_face``
-        (module notes)
+        (module notes); ``seed`` also seeds the search
 
     Returns
     -------
@@ -176,19 +223,20 @@ def remove_interior(
     Raises
     ------
     ParameterError
-        Unknown mode or level, ``keep_border`` not an integer of at least 0, a budget below 1.
+        Unknown mode, level or ``transparent``, ``keep_border`` not an integer of at least 0,
+        a negative ``check_rays``, a budget below 1.
 
     Examples
     --------
     >>> import trimesh, numpy as np
     >>> a, b = trimesh.creation.icosphere(2), trimesh.creation.icosphere(2)
     >>> v = np.vstack([a.vertices, 0.5 * b.vertices]); f = np.vstack([a.faces, b.faces + len(a.vertices)])
-    >>> r = remove_interior((v, f), seed=0)  # visibility="both"
-    >>> r.kept.n_faces, r.removed.n_faces
-    (320, 320)
+    >>> r = remove_interior((v, f), seed=0)  # visibility="view"
+    >>> r.kept.n_faces, r.removed.n_faces, int(r.check.seen.sum())
+    (320, 320, 0)
     >>> remove_interior((v, f), visibility="object", seed=0).removed.n_faces
     320
-    >>> remove_interior((v, f), visibility="view", seed=0).removed.n_faces
+    >>> remove_interior((v, f), visibility="both", seed=0).removed.n_faces
     320
     """
     _validate.repair_args(classification, Classification, classify_kw, classify)
@@ -199,19 +247,22 @@ def remove_interior(
     if level not in LEVELS:
         raise ParameterError(f"unknown level {level!r}; choose one of {', '.join(LEVELS)}")
     _validate.removal_args(keep_border, budget)
+    check_rays = _validate.integer("check_rays", check_rays, 0)
     seed = int(classify_kw.get("seed", 0))
     c: Classification | None = None
     vis: Visibility | None = None
     if conservative:
         soup = as_soup(model)
-        vis = visible_from(soup, region, budget=budget, seed=seed, up=up, conservative=True)
+        caster = RayCaster(soup, offset=VISIBILITY_OFFSET, walls=walls(soup, transparent))
+        vis = visible_from(soup, region, budget=budget, seed=seed, up=up, conservative=True, caster=caster)
         assert vis.conservative is not None
         keep = vis.conservative.visible.copy()
         code = np.where(keep, _KEPT_MAY, _GONE_SURELY)
         visibility = "conservative"
     elif visibility == "view":
         soup = as_soup(model)
-        vis = view or visible_from(soup, region, budget=budget, seed=seed, up=up)
+        caster = RayCaster(soup, offset=VISIBILITY_OFFSET, walls=walls(soup, transparent))
+        vis = view or visible_from(soup, region, budget=budget, seed=seed, up=up, caster=caster)
         keep = vis.seen.copy()
         code = np.where(keep, _KEPT_SEEN, _GONE_VIEW)
     else:
@@ -220,19 +271,37 @@ def remove_interior(
         if note:
             warnings.warn(note, stacklevel=2)
         soup = c.soup
+        caster = _sight_caster(c, transparent)
         by_cut = _kept_by_cut(c)
         if visibility == "object":
             keep = by_cut
             code = np.where(keep, _KEPT_CUT, _GONE_CUT)
         else:
-            # the search traces the cut's Embree scene, with the search's own ray offset
-            caster = c.caster.with_offset(VISIBILITY_OFFSET)
             vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut, caster=caster)
             keep = by_cut | vis.seen
             code = np.where(by_cut, _KEPT_CUT, np.where(vis.seen, _KEPT_RESCUED, _GONE_BOTH))
     code = code.astype(np.int8)
     keep = _widen(soup, keep, code, level, int(keep_border))
-    return RemovalResult(soup.subset(keep), soup.subset(~keep), keep, c, vis, code, visibility, soup)
+    check = None
+    if check_rays:
+        bound = parse_region(region, up=up).bind(soup)
+        check = self_check(caster, bound, ~keep, rays=check_rays, seed=seed)
+    see_through = 0 if caster.walls is None else int((~caster.walls).sum())
+    return RemovalResult(
+        soup.subset(keep), soup.subset(~keep), keep, c, vis, code, visibility, soup, check, see_through
+    )
+
+
+def _sight_caster(c: Classification, transparent: str) -> RayCaster:
+    """The scene that sight is traced against: the cut's, unless see-through faces must be left out.
+
+    The cut's Embree scene is reused with the search's own ray offset; a model with
+    see-through faces gets a scene without them (the cut itself traces them as walls).
+    """
+    clear = walls(c.soup, transparent)
+    if clear is None:
+        return c.caster.with_offset(VISIBILITY_OFFSET)
+    return RayCaster(c.soup, offset=VISIBILITY_OFFSET, walls=clear, vertex_groups=c.caster.vertex_groups)
 
 
 def _cut_keywords(visibility: str, classify_kw: dict[str, Any]) -> dict[str, Any]:

@@ -1,22 +1,43 @@
-"""The choices of inside removal and their default.
+"""The choices of inside removal and layers, and their defaults.
 
 Kept apart from :mod:`~meshvis.repair.remove` so that the command line and batch read
 their defaults without importing the cut and the ray tracer.
 
-``both`` is the default: a face goes only when the graph cut calls it hidden *and* a
-guided search for a view of it failed, so that the default never deletes a face a viewer
-outside was seen to see (on real scenes the cut alone deletes visible eave undersides and
-wall strips: docs/benchmarks.md).
+``view`` is the default of removal and of layers: a face goes when a guided search from
+the region (default ``outside``) found no line of sight to it.  The cut (``object``) calls
+"outside" whatever a path that crosses no geometry reaches, so it keeps the inside of an
+engine block open at one end, which no viewer sees; ``both`` removes only what the cut
+*and* the search call hidden, so it keeps all the cut keeps (docs/removal.md).
 """
 
 from __future__ import annotations
 
+from meshvis.visibility.check import CHECK_RAYS
+from meshvis.visibility.walls import DEFAULT_TRANSPARENT, TRANSPARENT_MODES
+
 #: what decides that a face is hidden: the graph cut, lines of sight, or both together
 VISIBILITY_MODES = ("object", "view", "both")
 #: the default of :func:`meshvis.remove_interior`, ``remove-interior`` and ``meshvis batch``
-DEFAULT_VISIBILITY = "both"
+DEFAULT_VISIBILITY = "view"
+#: what peels the layers of :func:`meshvis.layers`: lines of sight, or the graph cut
+#: (appendix H §5)
+LAYER_MODES = ("view", "object")
+#: the default of :func:`meshvis.layers` and ``layers``
+DEFAULT_LAYER_VISIBILITY = "view"
 #: what is removed together: single faces, edge-connected patches, named parts
 LEVELS = ("face", "patch", "part")
+
+__all__ = [
+    "CHECK_RAYS",
+    "DEFAULT_LAYER_VISIBILITY",
+    "DEFAULT_TRANSPARENT",
+    "DEFAULT_VISIBILITY",
+    "LAYER_MODES",
+    "LEVELS",
+    "TRANSPARENT_MODES",
+    "VISIBILITY_MODES",
+    "cut_rays_per_point",
+]
 
 
 def cut_rays_per_point(

@@ -10,6 +10,8 @@ A region answers three questions for the samplers of :mod:`meshvis.visibility.sa
 * ``origin_on_line(through, direction)`` -- a viewer in the region on the line that passes
   ``through`` a point along ``direction`` (reverse sampling moves the viewer, GVS §3.3),
   or ``ok = False`` where the line misses the region.
+* ``view_lines(n, rng)`` -- random lines of sight from the region (GVS §3.1): a random
+  viewer and a random direction, like a random pixel of a random view.
 
 Two kinds of region: viewers at infinity (``outside``, ``upper-hemisphere``; the ray starts
 beyond the bounding sphere, so its first hit is what a viewer far away along the line sees)
@@ -60,12 +62,14 @@ class Region:
     # the bounding sphere of the model, set by :meth:`bind` before sampling
     center: np.ndarray = field(default_factory=lambda: np.zeros(3), repr=False)
     radius: float = field(default=1.0, repr=False)
+    half: np.ndarray = field(default_factory=lambda: np.ones(3), repr=False)  # half the box's sides
 
     def bind(self, soup) -> Region:
-        """Fix the model's bounding sphere (viewers at infinity start beyond it)."""
+        """Fix the model's bounding box and sphere (viewers at infinity start beyond the sphere)."""
         lo, hi = soup.bounds
         self.center = 0.5 * (lo + hi)
         self.radius = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-300)
+        self.half = 0.5 * (hi - lo)
         return self
 
     def far_origins(self, targets: np.ndarray, directions: np.ndarray) -> np.ndarray:
@@ -78,14 +82,20 @@ class Region:
         )
 
     # --------------------------------------------------------------- interface
-    def seed_viewers(self, points: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
-        """One random viewer per point: ``(origins, unit directions)`` of rays aimed at the points."""
-        directions = -self._view_directions(len(points), rng)
+    def seed_viewers(
+        self, points: np.ndarray, rng: np.random.Generator, plane_share: float = 0.0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """One random viewer per point: ``(origins, unit directions)`` of rays aimed at the points.
+
+        ``plane_share`` of the viewers at infinity look along a coordinate plane
+        (:func:`view_directions`); finite viewers are where the region puts them.
+        """
+        directions = -self._view_directions(len(points), rng, plane_share)
         return self.far_origins(points, directions), directions
 
-    def _view_directions(self, n: int, rng: np.random.Generator) -> np.ndarray:
+    def _view_directions(self, n: int, rng: np.random.Generator, plane_share: float = 0.0) -> np.ndarray:
         """Unit directions from the model towards viewers at infinity."""
-        return uniform_sphere(n, rng)
+        return view_directions(n, rng, plane_share)
 
     def border_origins(self, origin: np.ndarray, direction: np.ndarray, targets: np.ndarray):
         """Rays from the viewers of ``(origin, direction)`` towards ``targets``."""
@@ -102,6 +112,35 @@ class Region:
 
     def _allows(self, direction: np.ndarray) -> np.ndarray:
         return np.ones(len(direction), bool)
+
+    def view_lines(
+        self, n: int, rng: np.random.Generator, plane_share: float = 0.0
+    ) -> tuple[np.ndarray, np.ndarray]:
+        """``n`` random lines of sight ``(origins, unit directions)`` from the region (GVS §3.1).
+
+        Viewers at infinity: a random viewing direction, and a point uniform on the
+        rectangle that the bounding box projects to across it, as a random pixel of an
+        orthographic view framed on the box (a flat scene seen edge-on fills a sliver of
+        its bounding sphere's disk).  Finite viewers: a random viewer
+        (:meth:`random_viewers`) looking in a uniformly random direction.
+        """
+        if not self.at_infinity:
+            return self.random_viewers(n, rng), view_directions(n, rng, plane_share)
+        directions = -self._view_directions(n, rng, plane_share)
+        across = np.cross(directions, np.where(np.abs(directions[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
+        across /= np.linalg.norm(across, axis=1, keepdims=True)
+        other = np.cross(directions, across)
+        # half extents of the box projected on the two axes across the direction
+        reach_a = np.abs(across) @ self.half
+        reach_b = np.abs(other) @ self.half
+        u = (2 * rng.random(n) - 1) * reach_a
+        v = (2 * rng.random(n) - 1) * reach_b
+        targets = self.center + u[:, None] * across + v[:, None] * other
+        return self.far_origins(targets, directions), directions
+
+    def random_viewers(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        """(n, 3) random viewer positions (regions of finite viewers)."""
+        raise NotImplementedError
 
     def contains_faces(self, triangles: np.ndarray) -> np.ndarray:
         """(m,) bool: faces inside the region, visible without rays (none for most regions)."""
@@ -141,8 +180,8 @@ class UpperHemisphere(Region):
         self.up = up_vector(None, soup) if self._asked is None else self._asked
         return self
 
-    def _view_directions(self, n, rng):
-        d = uniform_sphere(n, rng)
+    def _view_directions(self, n, rng, plane_share=0.0):
+        d = view_directions(n, rng, plane_share)
         flip = d @ self.up < 0
         d[flip] -= 2 * np.outer(d[flip] @ self.up, self.up)
         return d
@@ -177,10 +216,13 @@ class Box(Region):
         if not (np.isfinite(self.lo).all() and np.isfinite(self.hi).all()) or (self.lo > self.hi).any():
             raise ParameterError(f"box region needs finite corners with min <= max, got {self.lo}, {self.hi}")
 
-    def seed_viewers(self, points, rng):
+    def seed_viewers(self, points, rng, plane_share=0.0):
         """One viewer per point at a uniform random place in the box, aimed at the point."""
-        origins = self.lo + rng.random((len(points), 3)) * (self.hi - self.lo)
-        return _aimed(origins, points)
+        return _aimed(self.random_viewers(len(points), rng), points)
+
+    def random_viewers(self, n, rng):
+        """(n, 3) uniform random places in the box."""
+        return self.lo + rng.random((n, 3)) * (self.hi - self.lo)
 
     def origin_on_line(self, through, direction):
         """The middle of the half line's stretch inside the box; ``(origins, ok)``, ok False if it misses."""
@@ -233,9 +275,13 @@ class Points(Region):
         if len(self.points) == 0 or not np.isfinite(self.points).all():
             raise ParameterError("a points region needs at least one finite point")
 
-    def seed_viewers(self, points, rng):
+    def seed_viewers(self, points, rng, plane_share=0.0):
         """One viewer per point, picked at random among the region's points, aimed at the point."""
         return _aimed(self._pick(len(points), rng), points)
+
+    def random_viewers(self, n, rng):
+        """(n, 3) random points of the region (:meth:`_pick`)."""
+        return self._pick(n, rng)
 
     def _pick(self, n, rng):
         return self.points[rng.integers(0, len(self.points), n)]
@@ -270,6 +316,43 @@ class CameraPath(Points):
             return np.repeat(self.points[:1], n, axis=0)
         which = rng.choice(len(seg), size=n, p=length / length.sum())
         return self.points[which] + rng.random(n)[:, None] * seg[which]
+
+
+def view_directions(n: int, rng: np.random.Generator, plane_share: float = 0.0) -> np.ndarray:
+    """``n`` random unit directions: uniform, but ``plane_share`` of them close to a coordinate plane.
+
+    Man-made models are built along their axes: a thin gap between parallel parts lies
+    along a coordinate plane, and what is behind it shows only along directions within a
+    fraction of a degree of that plane, which uniform directions almost never take (0.9 %
+    of them lie within half a degree of a given plane).  A direction of the plane share
+    lies in one of the three coordinate planes (chosen at random), tilted out of it by a
+    normal angle of :data:`PLANE_TILT` degrees.
+
+    Examples
+    --------
+    >>> d = view_directions(1000, np.random.default_rng(0), plane_share=1.0)
+    >>> bool((np.abs(d).min(axis=1) < np.sin(np.radians(5 * PLANE_TILT))).all())
+    True
+    """
+    d = uniform_sphere(n, rng)
+    k = int(round(plane_share * n))
+    if k == 0:
+        return d
+    axis = rng.integers(0, 3, k)
+    rows = np.arange(k)
+    flat = d[:k].copy()
+    flat[rows, axis] = 0.0
+    flat /= np.maximum(np.linalg.norm(flat, axis=1, keepdims=True), 1e-300)
+    tilt = np.radians(PLANE_TILT) * rng.standard_normal(k)
+    flat *= np.cos(tilt)[:, None]
+    flat[rows, axis] = np.sin(tilt)
+    d[:k] = flat
+    return d
+
+
+#: the tilt of plane directions out of their coordinate plane: normal, this many degrees
+#: (the gaps that uniform directions miss are seen within about a degree of their plane)
+PLANE_TILT = 0.5
 
 
 def _aimed(origins: np.ndarray, targets: np.ndarray) -> tuple[np.ndarray, np.ndarray]:

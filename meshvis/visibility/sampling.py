@@ -97,6 +97,7 @@ def random_seeds(
     faces: np.ndarray,
     rng: np.random.Generator,
     want: np.ndarray | None = None,
+    plane_share: float = 0.0,
 ) -> tuple[Sightings, int]:
     """One random seed ray per entry of ``faces`` (repeat a face for more rays).
 
@@ -105,6 +106,9 @@ def random_seeds(
     want : (n,) int8, optional
         The side each seed should look at (-1: either); seeds whose random viewer is on the
         other side are dropped before tracing.
+    plane_share : float
+        Share of viewers at infinity that look along a coordinate plane
+        (:func:`meshvis.visibility.regions.view_directions`).
 
     Returns
     -------
@@ -117,7 +121,7 @@ def random_seeds(
     ru, rv = rng.random(len(faces)), rng.random(len(faces))
     faces = np.asarray(faces, np.int64)
     points = ray_kernels.points_in_faces(caster.soup.triangles, faces, ru, rv)
-    origin, direction = region.seed_viewers(points, rng)
+    origin, direction = region.seed_viewers(points, rng, plane_share)
     origin = np.ascontiguousarray(np.broadcast_to(origin, points.shape), np.float64)
     direction = np.ascontiguousarray(direction, np.float64)
     side = _kernels.facing_sides(direction, caster.normals, faces)
@@ -138,6 +142,23 @@ def random_seeds(
     )
     free = ~(caster.occluded_queries(o32, d32, dist) & ok)
     return Sightings(faces[free], side[free], origin[free], direction[free], points[free]), len(faces)
+
+
+def view_lines(
+    caster: RayCaster, region: Region, n: int, rng: np.random.Generator, plane_share: float = 0.0
+) -> tuple[Sightings, int]:
+    """``n`` random lines of sight from the region (:meth:`Region.view_lines`), traced.
+
+    Returns
+    -------
+    Sightings
+        The first hit of every line that hit the model.
+    hits : int
+        Lines that hit the model.
+    """
+    origin, direction = region.view_lines(n, rng, plane_share)
+    found, hits = trace(caster, origin, direction)
+    return found, int(hits.hit.sum())
 
 
 def _int64(*arrays: np.ndarray) -> list[np.ndarray]:

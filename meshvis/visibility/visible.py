@@ -5,14 +5,16 @@ random seed rays (more per face in every round); ``method="guided"`` then propag
 new sighting by adaptive border sampling and reverse sampling (GVS §3.4) until no new face
 turns up, ``method="random"`` does not (the baseline).  The first round visits the faces in
 a random order in chunks, so that faces found by propagation from an earlier chunk need no
-seed rays at all; later rounds go from the largest unseen face to the smallest in chunks of
-about a million rays.  After every chunk of the later rounds the stop rule looks at the rays
-since its last look (at least a million): they found fewer than ``min_new`` new faces per
-million rays (GVS §3.5) or less than ``min_new_area`` of the model's area per million rays.
-When it holds, the rest of the round (its smallest faces) is left out and the next round
-starts at the largest unseen faces with more rays each; the search stops when the rule holds
-again on that round's first window (:data:`CONFIRM_NEXT_ROUND`).  It also stops when every
-face is seen, or at the ray budget (by default only a cap: :func:`default_budget`).
+seed rays at all; later rounds visit the unseen faces in a random order in chunks of about a
+million rays, with view lines (GVS §3.1) cast between the chunks.  Two rules end the
+search.  The view lines' rule: fewer than ``max_unseen`` per million of the lines that hit
+the model first hit an unseen face (an estimate of the false pixels per million of removing
+the unseen faces).  The seed rays' rule (GVS §3.5): after a chunk, the rays since its last
+look (at least a million) found fewer than ``min_new`` new faces per million rays or less
+than ``min_new_area`` of the model's area per million rays; when it holds, the rest of the
+round is left out and it must hold again on the next round's first window
+(:data:`CONFIRM_NEXT_ROUND`), after which only the view lines go on.  The search also stops
+when every face is seen, or at the ray budget (by default only a cap: :func:`default_budget`).
 
 A seen side is certain (a free line of sight was traced); an unseen one is an upper bound on
 "hidden".
@@ -32,7 +34,8 @@ from meshvis.geometry.adjacency import weld
 from meshvis.io import as_soup
 from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.visibility.regions import Region, parse_region
-from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling
+from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling, view_lines
+from meshvis.visibility.walls import DEFAULT_TRANSPARENT, walls
 
 if TYPE_CHECKING:
     from meshvis.visibility.conservative import ConservativeSet
@@ -45,26 +48,20 @@ FIRST_ROUND_CHUNKS = 16
 MIN_NEW_PER_MILLION = 50.0
 #: ... or less new visible area than this fraction of the model's area per million rays.  What
 #: a viewer misses is area, not a face count: on finely tessellated models the faces found
-#: late are small and keep the count up after the area found has dried up, while faces seen
-#: through a rare gap are mostly large ones (zdm2_level), which the later rounds reach first
-#: (:func:`_round_order`).  At 1e-4 the search on the so101 assembly stopped with 77 false
-#: pixels per million (worst view 1,546); at 1e-5 it meets 30 / 300 (docs/benchmarks.md)
+#: late are small and keep the count up after the area found has dried up.  At 1e-4 the
+#: search on the so101 assembly stopped with 77 false pixels per million (worst view 1,546)
 MIN_NEW_AREA_PER_MILLION = 1e-5
 #: the stop rule must hold twice: at the end of a window, and again on the first window of the
-#: next round, which gives the largest unseen faces 4 x the seed rays (the rest of the round,
-#: its smallest faces, is left out).  A round goes from large faces to small ones, so the rule
-#: first holds part-way through a round, among its smaller faces, while large faces seen
-#: through rare gaps have had only that round's seeds: on the so101 assembly, the rule holding once, seed 0 stopped at 9.1 false
-#: pixels per million (16 of its 21 missed visible faces 165 to 1,504 x the median face area,
-#: after 256 seeds each) and seed 3 at 43.3; holding twice, seeds 0 to 3 end at 2.0 to 2.5
-#: with 1.03 to 1.41 x the rays (docs/benchmarks.md, "Seed spread of the default search")
+#: next round, which gives the faces still unseen 4 x the seed rays (the rest of the round is
+#: left out).  Holding once, on the so101 assembly seed 0 stopped at 9.1 false pixels per
+#: million and seed 3 at 43.3: large faces seen through rare gaps had had only that round's seeds
 CONFIRM_NEXT_ROUND = True
 #: the stop rule is judged over at least this many rays (GVS counts new faces per million
 #: rays) or, on small models, this many rays per face, whichever is fewer
 STOP_WINDOW = 1_000_000
 STOP_WINDOW_PER_FACE = 64
-#: seed rounds after the first are cast in chunks of about this many rays, largest faces
-#: first, and the stop rule is judged after every chunk: a round of 1,024 or 4,096 rays per
+#: seed rounds after the first are cast in chunks of about this many rays, in a random
+#: order, and the stop rule is judged after every chunk: a round of 1,024 or 4,096 rays per
 #: face would otherwise run to its end (tens of millions of rays) before the rule is asked,
 #: and a budget would cut it off at the faces of the lowest indices
 ROUND_CHUNK_RAYS = 1 << 20
@@ -83,6 +80,21 @@ DEFAULT_MIN_BUDGET = 1 << 22
 PROPAGATE_RINGS = 3
 #: sightings propagated in one batch (bounded memory: ~100 rays each)
 PROPAGATE_BATCH = 1 << 15
+#: view lines cast per seed ray of the rounds after the first (interleaved with the seeds)
+LINES_PER_SEED_RAY = 0.5
+#: view lines traced per batch (bounded memory)
+LINE_BATCH = 1 << 18
+#: the lines' stop rule is judged over windows of this many lines that hit the model, or on
+#: small models this many per face, whichever is fewer ...
+LINE_WINDOW = 1 << 20
+LINE_WINDOW_PER_FACE = 64
+#: ... and holds when fewer than this many of those lines per million first hit a face not seen
+#: yet (an estimate of the false pixels per million of removing the unseen faces)
+MAX_UNSEEN_PER_MILLION = 10.0
+#: seed rays after the first round and view lines: this share of them looks along a coordinate
+#: plane (:func:`meshvis.visibility.regions.view_directions`); on the cycloidal drive, faces in
+#: thin horizontal slots are seen by 3e-5 of uniform seed rays and by 6e-4 of plane ones
+PLANE_SHARE = 0.25
 METHODS = ("guided", "random")
 
 
@@ -116,6 +128,8 @@ class Visibility:
     seconds : float
     stopped : str
         Why sampling stopped: ``"all seen"``, ``"few new faces"``, ``"budget"``, ``"rounds done"``.
+    see_through : int
+        Faces that sight passed through (see-through materials, :mod:`meshvis.visibility.walls`).
     conservative : ConservativeSet or None
         With ``conservative=True``: the faces that may be seen from the viewpoints
         (:mod:`meshvis.visibility.conservative`).
@@ -134,6 +148,7 @@ class Visibility:
     seed: int
     seconds: float
     stopped: str = ""
+    see_through: int = 0
     extra: dict = field(default_factory=dict)
     conservative: ConservativeSet | None = None
 
@@ -160,6 +175,7 @@ class Visibility:
             "rays": self.rays,
             "skipped": self.skipped,
             "stopped": self.stopped,
+            "see_through_faces": self.see_through,
             "seconds": self.seconds,
             "history": self.history,
         }
@@ -188,7 +204,9 @@ class _State:
         self.rays_seen = np.zeros((m, 2), np.int64)
         self.seed_rays = np.zeros(m, np.int64)
         self.first_seen = np.full(m, -1, np.int64)
-        self.rays = {"random": 0, "border": 0, "reverse": 0}
+        self.rays = {"random": 0, "lines": 0, "border": 0, "reverse": 0}
+        self.max_unseen = MAX_UNSEEN_PER_MILLION
+        self.round = 0  # the round of seed rays under way
         self.refused = 0
         self.budget = budget
         self.history: dict[str, list] = {"rays": [], "visible_area": [], "faces_seen": [], "seconds": []}
@@ -251,6 +269,8 @@ def visible_from(
     min_new: float = MIN_NEW_PER_MILLION,
     min_new_area: float = MIN_NEW_AREA_PER_MILLION,
     caster: RayCaster | None = None,
+    transparent: str = DEFAULT_TRANSPARENT,
+    max_unseen: float = MAX_UNSEEN_PER_MILLION,
     conservative: bool = False,
 ) -> Visibility:
     """Which sides of the model's faces a viewer in ``region`` can see.
@@ -285,9 +305,15 @@ def visible_from(
         Stop when a window of rays finds fewer new faces than this per million rays ...
     min_new_area : float
         ... or less new seen area than this fraction of the model's area per million rays
-        (0 for either: that rule never stops the search).
+        (0 for either: that rule never stops the seed rays).
+    max_unseen : float
+        The view lines end the search when fewer than this many per million of those that hit
+        the model first hit an unseen face (0: they go on to the budget).
     caster : RayCaster, optional
-        A caster of the same model to reuse (its offset is not changed).
+        A caster of the same model to reuse (its offset and its walls are not changed).
+    transparent : {"see-through", "opaque"}
+        Whether faces of see-through materials let sight pass (:mod:`meshvis.visibility.walls`;
+        without ``caster``).
     conservative : bool
         Also bound the search from above: the faces that may be seen from the viewpoints of
         a ``points:`` or ``path:`` region, in ``result.conservative``
@@ -320,6 +346,7 @@ def visible_from(
         return bracket(
             model, region, search=visible_from, budget=budget, seed=seed, method=method, up=up,
             per_side=per_side, faces=faces, min_new=min_new, min_new_area=min_new_area, caster=caster,
+            transparent=transparent, max_unseen=max_unseen,
         )  # fmt: skip
     soup = as_soup(model)
     region = parse_region(region, up=up).bind(soup)
@@ -330,9 +357,10 @@ def visible_from(
         if asked.shape != (soup.n_faces,):
             raise ParameterError(f"faces must be {soup.n_faces} booleans or face indices")
     budget = default_budget(int(asked.sum())) if budget is None else int(budget)
-    caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET)
+    caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET, walls=walls(soup, transparent))
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new, min_new_area)
+    state.max_unseen = float(max_unseen)
     skipped = _presee(state, soup, region)
     if faces is not None:
         state.spread = _rings(soup, asked, PROPAGATE_RINGS)
@@ -364,6 +392,7 @@ def visible_from(
         seed=int(seed),
         seconds=time.perf_counter() - state.start,
         stopped=stopped,
+        see_through=0 if caster.walls is None else int((~caster.walls).sum()),
     )
 
 
@@ -412,9 +441,11 @@ def _presee(state: _State, soup, region: Region) -> dict:
 
 
 def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool, asked: np.ndarray) -> str:
+    """The rounds of seed rays and, from the second round on, the view lines (module notes)."""
     m = len(state.area)
     usable = (state.area > 0) & asked
     window = min(STOP_WINDOW, STOP_WINDOW_PER_FACE * max(int(usable.sum()), 1))
+    lines = _Lines(state, caster, region, rng, asked, guided and LINES_PER_SEED_RAY > 0, int(usable.sum()))
 
     def unseen(faces):
         s = state.seen_side[faces]
@@ -426,9 +457,14 @@ def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool
         n = s.sum(axis=1) if per_side else s.any(axis=1)
         return int(n.sum()), float(state.area[asked] @ n)
 
-    mark = (*found(), state.cast)
-    held = ""  # the stop rule held at the end of the last round: confirm on this one's first window
+    def all_seen() -> bool:
+        return not (usable & unseen(np.arange(m))).any()
+
+    seeds = _SeedWindow(state, found)
+    held = ""  # the seeds' rule held: confirm on the first window of the next round
+    stop = ""
     for r, per_face in enumerate(SEED_ROUNDS):
+        state.round = r
         order = _round_order(state, rng, usable & unseen(np.arange(m)), r)
         if len(order) == 0:
             return "all seen"
@@ -442,46 +478,115 @@ def _run_rounds(state: _State, caster, region, rng, guided: bool, per_side: bool
             todo = todo[: max(0, state.left // per_face)]
             if len(todo) == 0:
                 return "budget"
-            _seed_chunk(state, caster, region, rng, np.sort(todo), per_face, guided, per_side)
+            cast = state.cast
+            seeds.run(
+                lambda: _seed_chunk(state, caster, region, rng, np.sort(todo), per_face, guided, per_side)
+            )
+            if r > 0:  # every face has had its first round before the lines start
+                lines.cast(int(LINES_PER_SEED_RAY * (state.cast - cast)))
+                if lines.held:
+                    return "few unseen pixels"
             if state.left <= 0:
                 return "budget"
-            # every face has had its first round before the rule may stop the search
-            if r > 0 and state.cast - mark[2] >= window:
-                stop = _few_new(state, mark, found())
-                mark = (*found(), state.cast)
+            if r > 0 and seeds.rays >= window:
+                stop = seeds.judge()
                 if stop and (held or not CONFIRM_NEXT_ROUND):
-                    return stop
-                held = stop
-                if stop:
-                    break  # leave out the round's smallest faces; confirm on the next round's largest
-        if not (usable & unseen(np.arange(m))).any():
-            return "all seen"
-    return held or "rounds done"
+                    break
+                held, stop = stop, ""
+                if held:
+                    break  # leave out the rest of the round; confirm on the next round's first window
+        if stop or all_seen():
+            break
+    # the seeds are done: the view lines go on until their own rule holds
+    while lines.active and state.left > 0 and not all_seen():
+        lines.cast(LINE_BATCH)
+    if all_seen():
+        return "all seen"
+    if state.left <= 0:
+        return "budget"
+    if lines.held:
+        return "few unseen pixels"
+    return stop or held or "rounds done"
+
+
+class _SeedWindow:
+    """The stop rule of the seed rays: new faces and area per million rays since the last look."""
+
+    def __init__(self, state: _State, found):
+        self.state = state
+        self.found = found
+        self.rays = 0  # seed rays and their propagation since the last look
+        self.mark = found()
+
+    def run(self, step) -> None:
+        """Run one seed chunk (and its propagation), counting its rays."""
+        before = self.state.cast
+        step()
+        self.rays += self.state.cast - before
+
+    def judge(self) -> str:
+        """The stop rule over the rays since the last look (a reason, or ''); start a new window."""
+        now = self.found()
+        per_million = 1e6 / max(self.rays, 1)
+        reason = ""
+        if (now[0] - self.mark[0]) * per_million < self.state.min_new:
+            reason = "few new faces"
+        elif (now[1] - self.mark[1]) * per_million < self.state.min_new_area:
+            reason = "little new area"
+        self.mark, self.rays = now, 0
+        return reason
+
+
+class _Lines:
+    """View lines (GVS §3.1): random lines of sight from the region, their first hits propagated.
+
+    A line whose first hit is a face not seen yet is a false pixel of removing the unseen
+    faces, seen from a random view: the share of such lines among the lines that hit the
+    model estimates the false pixels per million of the removal as it stands (before the
+    line's own sighting is propagated).  The lines stop when that share, over a window of
+    :data:`LINE_WINDOW` model hits, is below :data:`MAX_UNSEEN_PER_MILLION`.
+    """
+
+    def __init__(self, state: _State, caster, region, rng, asked: np.ndarray, active: bool, n_faces: int):
+        self.state, self.caster, self.region, self.rng, self.asked = state, caster, region, rng, asked
+        self.active = active
+        self.window = min(LINE_WINDOW, LINE_WINDOW_PER_FACE * max(n_faces, 1))
+        self.hits = 0  # lines that hit the model in the window
+        self.unseen = 0  # ... whose first hit was a face asked about and not seen yet
+        self.held = False  # the rule held on a window
+
+    def cast(self, n: int) -> None:
+        """Cast up to ``n`` lines (within the budget) and propagate what they find."""
+        n = min(n, self.state.left)
+        if not self.active or n <= 0:
+            return
+        for lo in range(0, n, LINE_BATCH):
+            k = min(LINE_BATCH, n - lo)
+            found, hits = view_lines(self.caster, self.region, k, self.rng, PLANE_SHARE)
+            self.state.rays["lines"] += k
+            self.hits += hits
+            fresh = self.state.record(found)
+            self.unseen += int(self.asked[fresh.face].sum())
+            self.state.snapshot()
+            _propagate(self.state, self.caster, self.region, fresh)
+            if self.hits >= self.window:
+                self.held = self.unseen * 1e6 / self.hits < self.state.max_unseen
+                self.active = not self.held
+                self.hits = self.unseen = 0
+                if not self.active:
+                    return
 
 
 def _round_order(state: _State, rng, todo: np.ndarray, r: int) -> np.ndarray:
-    """The faces still to seed in round ``r``, in the order they get their seeds.
+    """The faces still to seed in round ``r``, in a random order.
 
-    The first round visits them in a random order (propagation from earlier chunks saves
-    later ones their seeds); later rounds go from the largest face to the smallest (ties in
-    a random order): a large face seen through a rare gap hides many pixels, and the stop
-    rule judges the area found, which then falls off along the round.
+    A random order makes every window of the stop rule a fair sample of the round: in an
+    order from large faces to small, the rule judged the first windows by the largest unseen
+    faces, which in CAD assemblies are hidden inner walls, and stopped before the smaller
+    faces seen through gaps had their seeds (docs/removal.md).
     """
     faces = np.flatnonzero(todo)
-    faces = faces[rng.permutation(len(faces))]
-    if r == 0:
-        return faces
-    return faces[np.argsort(-state.area[faces], kind="stable")]
-
-
-def _few_new(state: _State, mark: tuple[int, float, int], now: tuple[int, float]) -> str:
-    """The stop rule over the window since ``mark`` (faces, area, rays): a reason, or ''."""
-    per_million = 1e6 / max(state.cast - mark[2], 1)
-    if (now[0] - mark[0]) * per_million < state.min_new:
-        return "few new faces"
-    if (now[1] - mark[1]) * per_million < state.min_new_area:
-        return "little new area"
-    return ""
+    return faces[rng.permutation(len(faces))]
 
 
 def _seed_chunk(state: _State, caster, region, rng, todo, per_face: int, guided, per_side) -> None:
@@ -490,7 +595,8 @@ def _seed_chunk(state: _State, caster, region, rng, todo, per_face: int, guided,
     # the side still to find: -1 (either) unless exactly one side is seen already
     one = state.seen_side[faces]
     want = np.where(one.any(axis=1), np.argmin(one, axis=1), -1).astype(np.int8) if per_side else None
-    found, n_traced = random_seeds(caster, region, faces, rng, want)
+    share = PLANE_SHARE if (guided and state.round > 0) else 0.0
+    found, n_traced = random_seeds(caster, region, faces, rng, want, share)
     state.rays["random"] += n_traced
     state.seed_rays[todo] += per_face
     fresh = state.record(found)

@@ -307,6 +307,8 @@ def test_single_triangle_works(tmp_path, capsys, cmd):
     per_face = data["per_face"]
     if cmd == "layers":
         assert per_face["layer"] == [1] and per_face["outer_side"] == [2]
+    elif cmd == "remove-interior":
+        assert per_face["keep"] == [True] and per_face["reason"] == ["kept: seen from the region"]
     else:
         assert per_face["outside_front"] == [1.0] and per_face["outside_back"] == [1.0]
 

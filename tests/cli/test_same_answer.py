@@ -147,9 +147,9 @@ def test_a_reused_classification_with_another_budget_says_so(recwarn):
     soup = g.overlapping_solids(subdivisions=2, cell=0.4).soup  # intersecting: sample points
     c = meshvis.classify(soup, seed=0)
     with pytest.warns(UserWarning, match="rays_per_point=8"):
-        meshvis.remove_interior(soup, classification=c, seed=0)
+        meshvis.remove_interior(soup, classification=c, seed=0, visibility="both")
     same = meshvis.classify(soup, seed=0, rays_per_point=8)  # the budget of the removal's own cut
     recwarn.clear()
-    kept = meshvis.remove_interior(soup, classification=same, seed=0).keep
+    kept = meshvis.remove_interior(soup, classification=same, seed=0, visibility="both").keep
     assert not [w for w in recwarn if "rays_per_point" in str(w.message)]
-    np.testing.assert_array_equal(kept, meshvis.remove_interior(soup, seed=0).keep)
+    np.testing.assert_array_equal(kept, meshvis.remove_interior(soup, seed=0, visibility="both").keep)

@@ -140,7 +140,7 @@ def test_remove_interior_accounts_for_every_face(soup):
 @SETTINGS
 @given(soups())
 def test_layers_give_every_face_a_layer(soup):
-    r = _run(layers, soup, **KW)
+    r = _run(layers, soup, visibility="object", **KW)
     if r is None:
         return
     m = soup.n_faces
@@ -150,7 +150,23 @@ def test_layers_give_every_face_a_layer(soup):
     visible = (r.classification.outside > 0).any(axis=1) & ~r.classification.degenerate
     assert (r.layer[visible] == 1).all()
     assert np.isin(r.outer_side, (-1, 0, 1, 2)).all()
-    assert np.array_equal(r.layer, layers(soup, **KW).layer)
+    assert np.array_equal(r.layer, layers(soup, visibility="object", **KW).layer)
+
+
+@pytest.mark.slow
+@SETTINGS
+@given(soups())
+def test_layers_by_sight_give_every_face_a_layer_and_layer_1_is_what_removal_keeps(soup):
+    r = layers(soup, seed=3)
+    m = soup.n_faces
+    assert r.layer.shape == (m,) and r.classification is None
+    assert (r.layer >= 1).all() and (r.layer <= r.n_layers + 1).all()
+    assert r.n_layers >= 1 or not (soup.areas > 0).any()  # a face with an area is seen from outside
+    assert (r.layer[soup.areas <= 0] == r.n_layers + 1).all()  # nothing to see on no area
+    assert np.isin(r.outer_side, (-1, 0, 1, 2)).all()
+    layer_1 = (r.layer == 1) & (r.n_layers >= 1)  # with no layer, 1 is the bucket of the never seen
+    assert np.array_equal(layer_1, remove_interior(soup, seed=3, check_rays=0).keep)
+    assert np.array_equal(r.layer, layers(soup, seed=3).layer)
 
 
 @SETTINGS

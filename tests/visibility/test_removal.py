@@ -33,20 +33,20 @@ def test_both_keeps_a_large_triangle_passing_into_a_closed_box(scenes):
     assert not (r.keep < obj.keep).any()  # both never removes what object keeps
 
 
-def test_both_is_the_default_of_the_library_cli_and_batch(scenes):
+def test_view_is_the_default_of_the_library_cli_and_batch(scenes):
     import inspect
 
     from meshvis.repair.operation import default_options
     from meshvis.repair.remove_modes import DEFAULT_VISIBILITY
 
-    assert DEFAULT_VISIBILITY == "both"
+    assert DEFAULT_VISIBILITY == "view"
     assert inspect.signature(remove_interior).parameters["visibility"].default == DEFAULT_VISIBILITY
     assert default_options("remove-interior")["visibility"] == DEFAULT_VISIBILITY
     soup, _, _ = scenes.slot_box()
     a = remove_interior(soup, seed=0, budget=100_000)
-    b = remove_interior(soup, seed=0, budget=100_000, visibility="both")
+    b = remove_interior(soup, seed=0, budget=100_000, visibility="view")
     np.testing.assert_array_equal(a.keep, b.keep)
-    assert a.mode == "both" and a.visibility is not None and a.classification is not None
+    assert a.mode == "view" and a.visibility is not None and a.classification is None
     obj = remove_interior(soup, seed=0, visibility="object")
     assert obj.mode == "object" and obj.visibility is None
 
@@ -79,6 +79,10 @@ def test_bad_removal_arguments(scenes):
         with pytest.raises(ParameterError):
             remove_interior(cube, **kw)
     assert len(REASONS) == 10
+    with pytest.raises(ParameterError, match="transparent"):
+        remove_interior(cube, transparent="glass")
+    with pytest.raises(ParameterError, match="check_rays"):
+        remove_interior(cube, check_rays=-1)
 
 
 def test_cli_flags_of_remove_interior_and_visible(scenes, tmp_path, capsys):
@@ -140,7 +144,7 @@ def test_both_searches_the_cuts_scene_as_a_scene_of_its_own(monkeypatch):
 
     monkeypatch.setattr(remove, "visible_from", spy)
     soup = load(MODELS / "assembly.obj")
-    r = remove_interior(soup, seed=0)
+    r = remove_interior(soup, seed=0, visibility="both")
     # the cut's Embree scene, with the search's own ray offset
     assert used[0]._scene is r.classification.caster._scene and used[0].offset == VISIBILITY_OFFSET
     by_cut = r.reason_code == REASONS.index("kept: an outside side by the cut")
@@ -159,15 +163,17 @@ def test_both_gives_the_cuts_sample_points_the_budget_of_a_one_face_side(scenes)
     }
     assert budget == {"both": 8, "object": 32}  # 32 // 4 sample points; object keeps rays_per_node
     # a budget the caller sets wins, and the default follows rays_per_node and the samples
-    given = remove_interior(soup, seed=0, rays_per_point=32).classification
-    fewer = remove_interior(soup, seed=0, rays_per_node=16, samples_per_face=2).classification
+    given = remove_interior(soup, seed=0, visibility="both", rays_per_point=32).classification
+    fewer = remove_interior(
+        soup, seed=0, visibility="both", rays_per_node=16, samples_per_face=2
+    ).classification
     assert given.params["rays_per_point"] == 32 and fewer.params["rays_per_point"] == 8
 
 
 def test_both_casts_fewer_cut_rays_where_sample_points_need_refining():
     soup = load(MODELS / "assembly.obj")  # interpenetrating parts: many flagged faces
-    default = remove_interior(soup, seed=0).classification
-    full = remove_interior(soup, seed=0, rays_per_point=32).classification
+    default = remove_interior(soup, seed=0, visibility="both").classification
+    full = remove_interior(soup, seed=0, visibility="both", rays_per_point=32).classification
     assert default.counts.rays < full.counts.rays
     assert default.params["rays_per_point"] == 8 and full.params["rays_per_point"] == 32
 
@@ -179,15 +185,15 @@ def test_the_command_gives_both_the_same_sample_point_budget(tmp_path):
         assert main([*argv, "--force", "--quiet", *flags]) == 0
         return json.loads(report.read_text())["classification"]["params"]["rays_per_point"]
 
-    assert budget() == 8  # both, the default
+    assert budget("--visibility", "both") == 8
     assert budget("--visibility", "object") == 32
-    assert budget("--rays-per-point", "16") == 16
-    assert budget("--rays-per-node", "64") == 16
+    assert budget("--visibility", "both", "--rays-per-point", "16") == 16
+    assert budget("--visibility", "both", "--rays-per-node", "64") == 16
 
 
 def test_remove_interior_budget_stops_the_search_for_views(tmp_path):
-    """``--budget`` reaches the search of ``both``: a small budget ends it on the budget, the
-    default on its stop rule."""
+    """``--budget`` reaches the search of the default removal: a small budget ends it on the
+    budget, the default on its stop rule."""
     src = MODELS / "house.obj"
     argv = ["remove-interior", str(src), "-o", str(tmp_path / "out.obj"), "-q", "--force"]
     rep = tmp_path / "r.json"

@@ -49,7 +49,7 @@ def test_outside_sees_the_front_of_every_cube_face_and_no_back(scenes):
     cube, _ = scenes.unit_cube()
     vis = visible_from(cube, "outside", seed=0, per_side=True, budget=20_000)
     assert vis.seen_side[:, 0].all() and not vis.seen_side[:, 1].any()
-    assert vis.stopped in ("few new faces", "budget", "rounds done")
+    assert vis.stopped in ("few new faces", "few unseen pixels", "all seen", "budget", "rounds done")
 
 
 def test_upper_hemisphere_does_not_see_the_bottom(scenes):
@@ -153,23 +153,26 @@ def test_the_default_budget_is_a_cap_that_the_stop_rule_ends_before(scenes, monk
     monkeypatch.undo()
     soup, strip, truth = scenes.slot_box()
     vis = visible_from(soup, seed=0, per_side=True)
-    assert vis.stopped in ("few new faces", "little new area", "all seen")
+    assert vis.stopped in ("few new faces", "little new area", "few unseen pixels", "all seen")
     np.testing.assert_array_equal(vis.seen_side, truth)
 
 
-def test_later_rounds_seed_the_largest_unseen_faces_first():
+def test_every_round_seeds_the_unseen_faces_in_a_random_order():
+    """A random order makes every window of the stop rule a fair sample of its round, whatever
+    the size of the faces (an order by size judged rounds by their largest faces)."""
     from meshvis.visibility.visible import _round_order, _State
 
-    soup = meshvis.as_soup(
-        (
-            np.array([[0, 0, 0], [1, 0, 0], [0, 1, 0], [0, 0, 1], [3, 0, 1], [0, 3, 1.0]]),
-            np.array([[0, 1, 2], [3, 4, 5]]),
-        )
-    )
+    soup = meshvis.as_soup((np.random.default_rng(0).random((300, 3)), np.arange(300).reshape(100, 3)))
     state = _State(soup, 100, 50.0, 1e-4)
     rng = np.random.default_rng(0)
-    assert _round_order(state, rng, np.array([True, True]), 1).tolist() == [1, 0]
-    assert _round_order(state, rng, np.array([True, False]), 1).tolist() == [0]
+    todo = np.ones(100, bool)
+    todo[::7] = False
+    orders = [_round_order(state, rng, todo, r) for r in (1, 1, 2)]
+    for order in orders:
+        assert sorted(order.tolist()) == np.flatnonzero(todo).tolist()
+    assert orders[0].tolist() != orders[1].tolist()
+    by_size = np.argsort(-soup.areas[orders[0]])
+    assert by_size.tolist() != list(range(len(by_size)))
 
 
 def test_the_stop_rule_is_confirmed_on_the_next_rounds_largest_faces(monkeypatch):
@@ -182,6 +185,7 @@ def test_the_stop_rule_is_confirmed_on_the_next_rounds_largest_faces(monkeypatch
     cube, ball = trimesh.creation.box(extents=(2, 2, 2)), trimesh.creation.icosphere(1, radius=0.5)
     soup = meshvis.as_soup(trimesh.util.concatenate([cube, ball]))
     inner = np.arange(12, soup.n_faces)
+    monkeypatch.setattr(visible, "LINES_PER_SEED_RAY", 0)  # the seeds' own rule, without view lines
     once = {}
     for confirm in (False, True):
         monkeypatch.setattr(visible, "CONFIRM_NEXT_ROUND", confirm)
@@ -195,3 +199,29 @@ def test_the_stop_rule_is_confirmed_on_the_next_rounds_largest_faces(monkeypatch
     seen = first.first_seen >= 0
     np.testing.assert_array_equal(confirmed.first_seen[seen], first.first_seen[seen])
     assert confirmed.seen[:12].all() and not confirmed.seen[inner].any()
+
+
+def test_view_lines_are_framed_on_the_bounding_box_and_start_in_a_box_region():
+    import trimesh
+
+    from meshvis.visibility.sampling import view_lines
+
+    rng = np.random.default_rng(0)
+    square = trimesh.Trimesh([[0, 0, 0], [10, 0, 0], [10, 10, 0], [0, 10, 0.0]], [[0, 1, 2], [0, 2, 3]])
+    flat = meshvis.as_soup(square)
+    region = parse_region("outside").bind(flat)
+    found, hits = view_lines(meshvis.RayCaster(flat), region, 4000, rng)
+    # a flat square fills much of its box's shadow; the bounding sphere's disk it fills to a third
+    assert hits > 0.6 * 4000 and len(found.face) == hits
+    box = parse_region("box:1,1,1,2,2,2").bind(flat)
+    origin, direction = box.view_lines(100, rng)
+    assert ((origin >= 1) & (origin <= 2)).all() and np.allclose(np.linalg.norm(direction, axis=1), 1)
+
+
+def test_view_lines_end_the_search_when_they_find_few_unseen_faces():
+    import trimesh
+
+    cube, ball = trimesh.creation.box(extents=(2, 2, 2)), trimesh.creation.icosphere(2, radius=0.5)
+    sealed = visible_from(meshvis.as_soup(trimesh.util.concatenate([cube, ball])), seed=0)
+    assert sealed.stopped == "few unseen pixels" and sealed.rays["lines"] > 0
+    assert sealed.seen[:12].all() and not sealed.seen[12:].any()

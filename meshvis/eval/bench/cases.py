@@ -364,7 +364,7 @@ def meshvis_run(
             r = remove_interior(soup, classification=c, visibility="object", **({} if share else kw))
             values, cl = r.keep, r.classification
         else:
-            r = layers(soup, classification=c, **({} if share else kw))
+            r = layers(soup, classification=c, visibility="object", **({} if share else kw))
             values, cl = r.layer, r.classification
         dt = time.perf_counter() - t
         out[task] = (t_c + dt, values, {"rays": cl.n_rays, "rounds": len(cl.rounds)})
