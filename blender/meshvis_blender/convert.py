@@ -66,14 +66,19 @@ class Scene:
     transparent: np.ndarray
 
     def soup(self):
-        """The :class:`meshvis.Soup`: one part per object (named for it), z up as in Blender."""
-        from meshvis.soup import Soup
+        """The :class:`meshvis.Soup`: one part per object (named for it), z up as in Blender.
+
+        Its two materials tell the library which faces are see-through (:attr:`transparent`).
+        """
+        from meshvis.soup import Material, Soup
 
         return Soup(
             self.vertices,
             self.faces,
             part_id=self.triangle_object,
             part_names=[ob.name for ob in self.objects],
+            material_id=self.transparent.astype(np.int64),
+            materials=[Material("opaque"), Material("see-through", see_through=True)],
             up=(0.0, 0.0, 1.0),
         )
 
@@ -150,12 +155,15 @@ def read_scene(objects) -> Scene:
 
 
 def is_transparent(material) -> bool:
-    """Whether a material lets one see through it: blended or clipped, or alpha below 1."""
+    """Whether a material lets one see through it.
+
+    Blended (its render method), or a Principled BSDF whose alpha is below 1 or driven by a
+    texture, or a Transparent BSDF in its nodes.
+    """
     if material is None:
         return False
-    if getattr(material, "surface_render_method", "DITHERED") == "BLENDED":
-        return True
-    if getattr(material, "blend_method", "OPAQUE") != "OPAQUE":
+    # Blender 4.2 reads the older blend_method from this: every new material is "HASHED" there
+    if material.surface_render_method == "BLENDED":
         return True
     if material.use_nodes and material.node_tree is not None:
         for node in material.node_tree.nodes:

@@ -77,16 +77,22 @@ def constant(module: str, name: str) -> Any:
             target = node.targets[0]
         if isinstance(target, ast.Name) and target.id == name and node.value is not None:
             return _value(module, node.value)
+    return _imported(module, name)
+
+
+def _imported(module: str, name: str) -> Any:
+    """The constant ``name`` that ``module`` imports from another meshvis module."""
+    for stmt in _tree(module).body:
+        if isinstance(stmt, ast.ImportFrom) and stmt.module and not stmt.level:
+            for alias in stmt.names:
+                if (alias.asname or alias.name) == name:
+                    return constant(stmt.module, alias.name)
     raise KeyError(f"{module} has no constant {name}")
 
 
 def _value(module: str, node: ast.expr) -> Any:
     """A literal, or a module-level constant of ``module`` or of a module it imports it from."""
     if isinstance(node, ast.Name):
-        for stmt in _tree(module).body:
-            if isinstance(stmt, ast.ImportFrom) and stmt.module and not stmt.level:
-                if any((a.asname or a.name) == node.id for a in stmt.names):
-                    return constant(stmt.module, node.id)
         return constant(module, node.id)
     return ast.literal_eval(node)
 
@@ -104,6 +110,7 @@ def removal() -> dict[str, Any]:
         "visibility_modes": tuple(constant(REMOVE_MODES, "VISIBILITY_MODES")),
         "level": keyword_default(REMOVE, "remove_interior", "level"),
         "levels": tuple(constant(REMOVE_MODES, "LEVELS")),
+        "transparent": keyword_default(REMOVE, "remove_interior", "transparent"),
     }
 
 

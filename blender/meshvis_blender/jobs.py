@@ -17,6 +17,8 @@ from typing import Any
 #: where each stage of :func:`meshvis.classify` starts and ends in the job's progress; what
 #: follows the classification (the repair, a search for views) fills the rest
 STAGES = {"scene": (0.0, 0.02), "preprocess": (0.02, 0.3), "sampling": (0.3, 0.85), "done": (0.85, 0.85)}
+#: the faces given a layer so far, of :func:`meshvis.layers` (the whole job)
+STAGES["layers"] = (0.0, 1.0)
 
 
 class Cancelled(Exception):

@@ -279,7 +279,7 @@ class MESHVIS_OT_remove_hidden(_Background, bpy.types.Operator):
     see_through: bpy.props.BoolProperty(
         name="Transparent materials see-through",
         description="Faces with a transparent material do not hide what is behind them",
-        default=True,
+        default=_REMOVAL["transparent"] == "see-through",
     )
     seed: bpy.props.IntProperty(name="Seed", default=0, min=0)
 
@@ -288,7 +288,12 @@ class MESHVIS_OT_remove_hidden(_Background, bpy.types.Operator):
         region = region_text(context, self.region, self.box)
         scene = self.snapshot(context)
         soup = scene.soup()
-        options = dict(visibility=choice(self.visibility), region=region, level=choice(self.level))
+        options = dict(
+            visibility=choice(self.visibility),
+            region=region,
+            level=choice(self.level),
+            transparent="see-through" if self.see_through else "opaque",
+        )
         seed = self.seed
 
         def work(progress):
@@ -300,7 +305,8 @@ class MESHVIS_OT_remove_hidden(_Background, bpy.types.Operator):
                 f"{report['removed_faces']} of {report['input_faces']} triangles hidden "
                 f"({100 * report['removed_area_fraction']:.1f} % of the area)"
             )
-            return r.keep, line
+            # the removal's own console lines after the first (the search's budget, the self-check)
+            return r.keep, "; ".join([line, *r.summary()[1:]])
 
         return work
 
@@ -341,8 +347,10 @@ class MESHVIS_OT_layers(_Background, bpy.types.Operator):
         def work(progress):
             import meshvis
 
-            c = meshvis.classify(soup, seed=seed, progress=progress)
-            return meshvis.layers(soup, classification=c, max_layers=max_layers).layer
+            def peeled(layer: int, done: int, total: int) -> None:
+                progress("layers", done / max(total, 1))
+
+            return meshvis.layers(soup, max_layers=max_layers, seed=seed, progress=peeled).layer
 
         return work
 

@@ -24,7 +24,9 @@ class MeshvisSettings(bpy.types.PropertyGroup):
     visibility: bpy.props.EnumProperty(
         name="Judged by", items=ops._MODES, default=ops.identifier(ops._REMOVAL["visibility"])
     )
-    see_through: bpy.props.BoolProperty(name="Transparent materials see-through", default=True)
+    see_through: bpy.props.BoolProperty(
+        name="Transparent materials see-through", default=ops._REMOVAL["transparent"] == "see-through"
+    )
     max_layers: bpy.props.IntProperty(name="Max layers", default=0, min=0)
     layout: bpy.props.EnumProperty(
         name="Layout", items=ops._LAYOUTS, default=ops.identifier(ops._LABELING["layout"])

@@ -85,3 +85,17 @@ def test_polygons_take_the_answer_of_their_triangles(bpy, installed, empty_scene
     layer = np.where(tri_poly == 4, 1, 2)
     layer[np.flatnonzero(tri_poly == 5)[0]] = 1
     assert scene.per_polygon(layer, "min")[0].tolist() == [2, 2, 2, 2, 1, 1]
+
+
+def test_which_materials_are_see_through(bpy, installed, empty_scene):
+    is_transparent = installed.convert.is_transparent
+    plain = bpy.data.materials.new("plain")
+    assert not is_transparent(plain) and not is_transparent(None)
+    blended = bpy.data.materials.new("blended")
+    blended.surface_render_method = "BLENDED"
+    faded = bpy.data.materials.new("faded")
+    faded.use_nodes = True
+    faded.node_tree.nodes["Principled BSDF"].inputs["Alpha"].default_value = 0.5
+    solid = bpy.data.materials.new("solid")
+    solid.use_nodes = True
+    assert is_transparent(blended) and is_transparent(faded) and not is_transparent(solid)

@@ -39,5 +39,6 @@ def test_the_defaults_are_the_librarys(bpy, installed):
     sig = inspect.signature(meshvis.remove_interior).parameters
     assert op["visibility"].default == identifier(sig["visibility"].default)
     assert op["level"].default == identifier(sig["level"].default)
+    assert op["see_through"].default == (sig["transparent"].default == "see-through")
     layout = bpy.ops.meshvis.label_parts.get_rna_type().properties["layout"].default
     assert layout == identifier(inspect.signature(meshvis.labeling.layout).parameters["layout"].default)

@@ -112,6 +112,22 @@ def test_remove_hidden_takes_out_the_inner_part_as_meshvis_remove_interior_does(
     assert np.array_equal(uv_before, uv_after)
 
 
+@pytest.mark.parametrize("see_through", [True, False])
+def test_a_glass_case_lets_the_part_inside_be_seen(bpy, installed, empty_scene, capfd, see_through):
+    box, ball = _box_around_ball(installed, bpy)
+    glass = box.data.materials[0]
+    glass.surface_render_method = "BLENDED"  # Blender 4.2's transparent material
+    balls = len(ball.data.polygons)
+    _select(bpy, [box, ball])
+    assert bpy.ops.meshvis.remove_hidden(action="SELECT", see_through=see_through) == {"FINISHED"}
+    sel = np.empty(balls, bool)
+    ball.data.polygons.foreach_get("select", sel)
+    # through the glass the ball is seen and stays; behind an opaque case it is hidden
+    assert not sel.any() if see_through else sel.all()
+    # the removal's self-check is the operator's report
+    assert "self-check: " in capfd.readouterr().out
+
+
 def test_undo_gives_back_the_faces_before_orient(bpy, installed, empty_scene):
     bpy.ops.ed.undo_push(message="empty")  # undo needs a step before the one undone
     bpy.ops.mesh.primitive_uv_sphere_add(segments=16, ring_count=8)
