@@ -30,8 +30,10 @@ def add_parser(sub) -> None:
     sub : argparse._SubParsersAction
         The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
     """
-    from meshvis.visibility.visible import METHODS
-    from meshvis.visibility.walls import TRANSPARENT_MODES
+    from meshvis._defaults import module_constant
+
+    methods = module_constant("meshvis.visibility.visible:METHODS")
+    transparent_modes = module_constant("meshvis.visibility.walls:TRANSPARENT_MODES")
 
     def d(keyword):
         return library_default(VISIBLE_FROM, keyword)
@@ -46,7 +48,7 @@ def add_parser(sub) -> None:
         help="where the viewers are: outside, upper-hemisphere[:ux,uy,uz], box:x0,y0,z0,x1,y1,z1, "
         "points:x,y,z;..., path:CAMERAS.json",
     )
-    p.add_argument("--method", choices=METHODS, default=d("method"), help="guided sampling, or random rays")
+    p.add_argument("--method", choices=methods, default=d("method"), help="guided sampling, or random rays")
     p.add_argument(
         "--budget",
         type=positive_int,
@@ -57,7 +59,7 @@ def add_parser(sub) -> None:
     p.add_argument("--per-side", action="store_true", help="keep looking until both sides of a face are seen")
     p.add_argument(
         "--transparent",
-        choices=TRANSPARENT_MODES,
+        choices=transparent_modes,
         default=d("transparent"),
         help="faces of see-through materials let sight through, or are walls",
     )
