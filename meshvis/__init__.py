@@ -107,6 +107,8 @@ _LAZY = {
     "orient_from": "meshvis.repair.orient",
     "remove_interior": "meshvis.repair.remove",
     "layers": "meshvis.repair.layers",
+    "fix_normals": "meshvis.repair.trimesh_style",
+    "remove_hidden": "meshvis.repair.trimesh_style",
     "visible_from": "meshvis.visibility.visible",
     "parse_region": "meshvis.visibility.regions",
 }
