@@ -868,11 +868,6 @@ def orient(
     # kept two-sided faces follow their patch and decisive evidence of their own; the
     # other options decided them on purpose, and degenerate faces have no side
     movable = (status != DEGENERATE) & ((status != TWO_SIDED) | (two_sided == "keep"))
-    # both copies of a sheet stored twice with opposite winding stay as they are
-    paired = in_opposite_copy(
-        np.where(given[:, None] == 1, c.pre.faces_welded[:, [0, 2, 1]], c.pre.faces_welded)
-    )
-    movable &= ~paired
     voted, n_patch = _whole_patches(c, p, status, outer, own_layer, by_parity, movable, both)
     undecided &= ~voted
     seed = int(c.params.get("seed", 0))
@@ -891,6 +886,13 @@ def orient(
     # untouched; but a sliver, whose edges join its patch, then shows the side its patch
     # shows
     untouched = both & undecided & (outer == given)
+    # both copies of a sheet stored twice with opposite winding stay as they are.  Only
+    # here: whether two copies are opposite depends on the input's winding (a first run
+    # may turn one of two copies wound alike), and the steps above, whose ray budgets
+    # count the faces they test, must not
+    paired = in_opposite_copy(
+        np.where(given[:, None] == 1, c.pre.faces_welded[:, [0, 2, 1]], c.pre.faces_welded)
+    )
     flip[untouched | paired | (status == DEGENERATE)] = False
     sliver = np.flatnonzero((status == DEGENERATE) & (p.clustering.cluster >= 0))
     side = _patch_side(p, given ^ flip, c.soup.areas, sliver)
