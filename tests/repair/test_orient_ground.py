@@ -83,3 +83,18 @@ def test_orient_on_a_ground_twice_is_once_and_the_cli_agrees(tmp_path):
     save(soup, str(path))
     assert main(["orient", str(path), "-o", str(out), "--quiet"]) == 0
     np.testing.assert_allclose(load(str(out)).normals, once.soup.normals, atol=1e-6)
+
+
+@pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6)])
+def test_the_ground_is_found_at_any_scale_and_far_away(scale, shift):
+    soup = _scene()
+    soup = Soup(soup.vertices * scale + shift, soup.faces)
+    assert stands_on_ground(soup, RayCaster(soup), UP)
+    assert orient(soup, seed=0).flipped[:2].all()
+
+
+def test_no_ground_under_nothing_or_a_wall():
+    wall = Soup(np.array([[0.0, 0, 0], [1, 0, 0], [0, 0, 1]]), np.array([[0, 1, 2]]))
+    assert not stands_on_ground(wall, RayCaster(wall), UP)
+    empty = Soup(np.zeros((0, 3)), np.zeros((0, 3), np.int64))
+    assert not stands_on_ground(empty, None, UP)  # type: ignore[arg-type]
