@@ -10,8 +10,6 @@ batch file is processed exactly as the single-file command would process it.
 from __future__ import annotations
 
 import functools
-import importlib
-import inspect
 import warnings
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -83,9 +81,9 @@ def library_default(function: str, keyword: str) -> Any:
     >>> library_default(CLASSIFY, "rays_per_node")
     32
     """
-    module, _, name = function.partition(":")
-    fn = getattr(importlib.import_module(module), name)
-    return inspect.signature(fn).parameters[keyword].default
+    from meshvis._defaults import signature_default
+
+    return signature_default(function, keyword)
 
 
 @functools.cache
