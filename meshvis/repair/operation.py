@@ -269,6 +269,7 @@ def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[
             two_sided=o["two_sided"],
             semantics=o["semantics"],
             conflicts=o["conflicts"],
+            up=_up(o["up"]),
         )
     _save(r.soup, o["output"], tell)
     report = r.report()

@@ -35,6 +35,12 @@
    back pokes out through the surface is a self-intersection, not a face turned the wrong
    way.
 
+   A scene standing on a ground (:func:`meshvis.repair.evidence.stands_on_ground`: seen
+   from below, it is mostly a floor at its lowest level) is seen from above its ground
+   only: a ray that leaves it downward does not count as seen (the ``upper-hemisphere``
+   region's viewers), so a courtyard floor whose underside opens onto the empty space
+   below the scene faces up.
+
 The evidence does not depend on how a face comes in wound: the cut and every ray are
 drawn on the canonically wound model (:func:`classify_for_orient`,
 :mod:`meshvis.geometry.winding`), each face's rays from a stream of its own
@@ -70,6 +76,7 @@ from meshvis.errors import ParameterError
 from meshvis.geometry.duplicates import in_opposite_copy
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.graphcut.clusters import Clustering
+from meshvis.io.up_axis import up_vector
 from meshvis.rays.caster import VISIBILITY_OFFSET
 from meshvis.repair.layers import LayerResult, layers
 from meshvis.soup import Soup
@@ -132,7 +139,8 @@ class OrientResult:
     visibility : dict
         The per-face visibility test: faces ``tested``, faces ``turned``
         to show the side a viewer sees, ``rays`` cast, ``pooled_patches`` (patches
-        given the side their faces' rays see, pooled)
+        given the side their faces' rays see, pooled), ``ground`` (seen from above its
+        ground only)
     double_sided : int
         Faces kept as they are because they are one copy of a sheet stored
         twice with opposite winding (:mod:`meshvis.geometry.duplicates`)
@@ -579,6 +587,7 @@ def _visible_sides(
     undecided: np.ndarray,
     both: np.ndarray,
     seed: int,
+    ground: np.ndarray | None = None,
 ) -> tuple[np.ndarray, dict]:
     """Let the side a viewer sees win (in place).
 
@@ -604,6 +613,10 @@ def _visible_sides(
     tested faces see, pooled, where that is decisive (:func:`_pooled_patches`); its faces
     seen from both sides add their rays but keep their side.
 
+    ``ground`` is the up direction of the ground a scene stands on, or None: on a ground,
+    the rays that leave the model downward do not count as seen
+    (:class:`meshvis.repair.evidence.RayStream`).
+
     ``undecided`` marks the faces that show the input's front for lack of evidence: the
     rounds treat them as showing neither side, so that which faces get more rays, and so
     every verdict, is the same however the input is wound.
@@ -622,7 +635,7 @@ def _visible_sides(
     before = outer.copy()
     # a stream of rays per face, seeded from the classification's seed: by which faces it
     # gives more rays, the test shifts no other face's rays
-    stream = evidence.RayStream(seed, c.soup.n_faces)
+    stream = evidence.RayStream(seed, c.soup.n_faces, ground)
 
     def shown() -> np.ndarray:  # the side each tested face shows; -1: none yet
         return np.where(undecided[test], -1, outer[test]).astype(np.int64)
@@ -810,6 +823,8 @@ def orient(
     two_sided: str = "keep",
     semantics: str = "layer",
     conflicts: str = "majority",
+    ground: bool | None = None,
+    up: Any = None,
     classification: Classification | None = None,
     **classify_kw: Any,
 ) -> OrientResult:
@@ -832,6 +847,12 @@ def orient(
         Hidden shells face outward at their layer, or every second layer inward.
     conflicts : {"majority", "duplicate"}
         Flagged faces whose sample points disagree: the area majority, or both orientations.
+    ground : bool or None
+        The model is a scene standing on a ground, seen from above it only (the rays of
+        the visible-sides step that leave it downward do not count); None (default):
+        where :func:`meshvis.repair.evidence.stands_on_ground` says so.
+    up : None, "x", "y", "z" or (3,) float
+        The up direction of the ground; None: the model's own (``Soup.up``).
     classification : Classification, optional
         A classification of the same model to reuse, from :func:`classify_for_orient` (or
         :func:`meshvis.classify`: then its random rays depend on the input's winding).
@@ -876,15 +897,19 @@ def orient(
     # kept two-sided faces follow their patch and decisive evidence of their own; the
     # other options decided them on purpose, and degenerate faces have no side
     movable = (status != DEGENERATE) & ((status != TWO_SIDED) | (two_sided == "keep"))
-    # both copies of a sheet stored twice with opposite winding stay as they are
-    paired = in_opposite_copy(
-        np.where(given[:, None] == 1, c.pre.faces_welded[:, [0, 2, 1]], c.pre.faces_welded)
-    )
-    movable &= ~paired
     voted, n_patch = _whole_patches(c, p, status, outer, own_layer, by_parity, movable, both)
     undecided &= ~voted
     seed = int(c.params.get("seed", 0))
-    seen, visibility = _visible_sides(c, p, status, outer, movable, undecided, both, seed)
+    # a scene standing on a ground is seen from above it only (no viewer below the ground)
+    up_dir = up_vector(up, soup)
+    if ground is None:
+        from meshvis.repair.evidence import stands_on_ground
+
+        ground = stands_on_ground(c.soup, c.caster, up_dir)
+    seen, visibility = _visible_sides(
+        c, p, status, outer, movable, undecided, both, seed, up_dir if ground else None
+    )
+    visibility["ground"] = bool(ground)
     undecided &= ~seen
     _kept_with_patch(p, outer, given, undecided, c.soup.areas)
     flip = outer != given
@@ -899,6 +924,13 @@ def orient(
     # untouched; but a sliver, whose edges join its patch, then shows the side its patch
     # shows
     untouched = both & undecided & (outer == given)
+    # both copies of a sheet stored twice with opposite winding stay as they are.  Only
+    # here: whether two copies are opposite depends on the input's winding (a first run
+    # may turn one of two copies wound alike), and the steps above, whose ray budgets
+    # count the faces they test, must not
+    paired = in_opposite_copy(
+        np.where(given[:, None] == 1, c.pre.faces_welded[:, [0, 2, 1]], c.pre.faces_welded)
+    )
     flip[untouched | paired | (status == DEGENERATE)] = False
     sliver = np.flatnonzero((status == DEGENERATE) & (p.clustering.cluster >= 0))
     side = _patch_side(p, given ^ flip, c.soup.areas, sliver)

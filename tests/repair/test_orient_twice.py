@@ -75,6 +75,25 @@ def test_orient_decides_a_face_the_same_whichever_way_it_comes_in():
     np.testing.assert_array_equal(a.normals, b.normals)
 
 
+def test_orient_tests_the_same_faces_whether_two_copies_are_wound_alike_or_not():
+    """A first run may turn one of two copies of a face wound alike (on trellis2_plant,
+    eight pairs of hidden copies with their own rays); the second run then finds them
+    stored with opposite winding, and writes them as they are.  That must change no other
+    face's evidence: the rounds' ray budgets count the faces tested (the plant's second run
+    turned one face when the copies were left out of the test)."""
+    import trimesh
+
+    box = trimesh.creation.box()
+    v, f = np.asarray(box.vertices), np.asarray(box.faces)
+    open_box = f[v[f].mean(axis=1)[:, 2] < 0.49]  # no lid: every face is tested
+    alike = np.vstack([open_box, open_box[:1]])
+    opposite = np.vstack([open_box, open_box[:1, ::-1]])
+    a, b = orient((v, alike), seed=0), orient((v, opposite), seed=0)
+    assert (a.double_sided, b.double_sided) == (0, 2)
+    assert a.visibility == b.visibility
+    np.testing.assert_array_equal(a.soup.normals[1:-1], b.soup.normals[1:-1])
+
+
 @pytest.mark.slow
 def test_orient_on_its_own_output_file_writes_the_same_file(tmp_path):
     """The command line: orient the file, then orient what it wrote; the faces are the same."""
@@ -118,19 +137,23 @@ def _back_facing(model, elevation: float) -> float:
             60.0,
             marks=pytest.mark.xfail(
                 strict=True,
-                reason="courtyard floors seen more than 4x as often from the open space below "
-                "the scene are turned down: 0.0 % back-facing pixels before, 8.8 % after",
+                reason="0.00 % back-facing pixels before, 0.17 % after: three walls (faces 116177, "
+                "116576, 116578) whose rays escape 74 : 7 through the side orient shows, seen "
+                "from above the ground; this camera sees their other side",
             ),
         ),
     ],
 )
 def test_orient_shows_the_monastery_no_more_backs_from_above(monastery, elevation):
     """The monastery stands on the ground, y up.  Seen from above the horizon, ``orient``'s
-    output shows no more back-facing pixels than the input.  Before, faces seen from both
-    sides followed their patch's vote and the majority of their sample points toward the
-    open space below the ground: 6.3 % back-facing pixels became 23 % from 20 degrees,
-    0.0 % became 42 % from 60 degrees."""
+    output shows no more back-facing pixels than the input.  Faces seen from both sides
+    once followed their patch's vote and the majority of their sample points toward the
+    open space below the ground (6.3 % back-facing pixels became 23 % from 20 degrees,
+    0.0 % became 42 % from 60 degrees), and then courtyard floors seen more than 4x as
+    often from below the scene turned down (0.0 % became 8.8 % from 60 degrees): the
+    scene is seen from above its ground only."""
     soup, r = monastery
+    assert r.visibility["ground"]
     assert (r.status == STATUS_NAMES.index("two-sided")).sum() > 1000
     before, after = _back_facing(soup, elevation), _back_facing(r.soup, elevation)
     assert after <= before, f"from {elevation} degrees: {before:.2%} back-facing before, {after:.2%} after"

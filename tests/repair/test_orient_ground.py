@@ -1,0 +1,100 @@
+"""A scene standing on a ground is seen from above its ground only.
+
+``orient``'s visible-sides step counts a ray that leaves such a scene downward as stopped
+by the ground (:class:`meshvis.repair.evidence.RayStream`), where
+:func:`meshvis.repair.evidence.stands_on_ground` detects the ground; the monastery, whose
+courtyard floors open onto the empty space below the scene, is checked from above in
+``test_orient_twice.py`` (``shared_models``).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from meshvis.cli.main import main
+from meshvis.io import load, save
+from meshvis.rays.caster import RayCaster
+from meshvis.repair.evidence import stands_on_ground
+from meshvis.repair.orient import orient
+from meshvis.soup import Soup
+
+UP = np.array([0.0, 0.0, 1.0])
+
+
+def _scene() -> Soup:
+    """A 10 x 10 ground sheet wound facing down, and a closed box standing on it (z up)."""
+    ground = np.array([[-5, -5, 0], [5, -5, 0], [5, 5, 0], [-5, 5, 0]], float)
+    box = trimesh.creation.box(extents=(2, 2, 2))
+    vertices = np.vstack([ground, np.asarray(box.vertices) + [0, 0, 1]])
+    faces = np.vstack([[[0, 2, 1], [0, 3, 2]], np.asarray(box.faces) + 4])
+    return Soup(vertices, faces)
+
+
+def test_a_ground_sheet_wound_down_faces_up():
+    """Seen from everywhere, the sheet's two sides are seen about as often and it keeps its
+    winding; seen from above its ground only, it faces up."""
+    soup = _scene()
+    assert (soup.normals[:2] @ UP < 0).all()
+    r = orient(soup, seed=0)
+    assert r.visibility["ground"] and r.flipped[:2].all()
+    assert (r.soup.normals[:2] @ UP > 0).all()
+    kept = orient(soup, seed=0, ground=False)
+    assert not kept.visibility["ground"] and not kept.flipped[:2].any()
+
+
+def test_the_ground_is_the_model_up_axis_ground():
+    """The same scene with x as its up axis stands on no ground (seen along x, it is a wall)."""
+    soup = _scene()
+    assert not orient(soup, seed=0, up="x").visibility["ground"]
+
+
+@pytest.mark.parametrize("turned", [False, True])
+def test_stands_on_ground_does_not_depend_on_the_winding(turned):
+    soup = _scene()
+    soup = soup.flipped(np.full(soup.n_faces, turned))
+    assert stands_on_ground(soup, RayCaster(soup), UP)
+
+
+def test_a_ball_and_a_car_like_object_stand_on_no_ground():
+    """An object resting on a few points is not a scene standing on a ground."""
+    ball = trimesh.creation.icosphere(2)
+    soup = Soup(np.asarray(ball.vertices), np.asarray(ball.faces))
+    assert not stands_on_ground(soup, RayCaster(soup), UP)
+    body = trimesh.creation.box(extents=(4, 2, 1))
+    wheels = [trimesh.creation.cylinder(0.4, 0.3, sections=12) for _ in range(4)]
+    parts = [body.apply_translation((0, 0, 1.2))] + [
+        w.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0))).apply_translation(
+            (x, y, 0.4)
+        )
+        for w, (x, y) in zip(wheels, [(-1.5, -1), (-1.5, 1), (1.5, -1), (1.5, 1)])
+    ]
+    car = trimesh.util.concatenate(parts)
+    soup = Soup(np.asarray(car.vertices), np.asarray(car.faces))
+    assert not stands_on_ground(soup, RayCaster(soup), UP)
+
+
+def test_orient_on_a_ground_twice_is_once_and_the_cli_agrees(tmp_path):
+    soup = _scene()
+    once = orient(soup, seed=0)
+    assert not orient(once.soup, seed=0).flipped.any()
+    path, out = tmp_path / "scene.stl", tmp_path / "oriented.stl"  # STL: z up
+    save(soup, str(path))
+    assert main(["orient", str(path), "-o", str(out), "--quiet"]) == 0
+    np.testing.assert_allclose(load(str(out)).normals, once.soup.normals, atol=1e-6)
+
+
+@pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6)])
+def test_the_ground_is_found_at_any_scale_and_far_away(scale, shift):
+    soup = _scene()
+    soup = Soup(soup.vertices * scale + shift, soup.faces)
+    assert stands_on_ground(soup, RayCaster(soup), UP)
+    assert orient(soup, seed=0).flipped[:2].all()
+
+
+def test_no_ground_under_nothing_or_a_wall():
+    wall = Soup(np.array([[0.0, 0, 0], [1, 0, 0], [0, 0, 1]]), np.array([[0, 1, 2]]))
+    assert not stands_on_ground(wall, RayCaster(wall), UP)
+    empty = Soup(np.zeros((0, 3)), np.zeros((0, 3), np.int64))
+    assert not stands_on_ground(empty, None, UP)  # type: ignore[arg-type]
