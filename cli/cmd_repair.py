@@ -328,6 +328,15 @@ def add_parser(sub) -> None:
         default=od["conflicts"],
         help="intersected faces whose samples disagree: area majority or both orientations",
     )
+    from meshvis.repair.operation import GROUND_CHOICES
+
+    ground_name = {v: k for k, v in GROUND_CHOICES.items()}[od["ground"]]
+    p.add_argument(
+        "--ground",
+        choices=tuple(GROUND_CHOICES),
+        default=ground_name,
+        help="a scene standing on a ground is seen from above it only: yes, no, or auto (where one is found)",
+    )
     region_option(
         p,
         od["from_region"],

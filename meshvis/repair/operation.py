@@ -26,6 +26,8 @@ OPERATIONS = ("classify", "orient", "remove-interior", "layers")
 CLASSIFY = "meshvis.graphcut.classify:classify"
 ORIENT = "meshvis.repair.orient:orient"
 ORIENT_FROM = "meshvis.repair.orient:orient_from"
+#: orient's ``ground`` as the command line names it (``--ground auto|yes|no``)
+GROUND_CHOICES: dict[str, bool | None] = {"auto": None, "yes": True, "no": False}
 REMOVE = "meshvis.repair.remove:remove_interior"
 LAYERS = "meshvis.repair.layers:layers"
 
@@ -47,6 +49,7 @@ OPERATION_OPTIONS: dict[str, dict[str, tuple[str, str]]] = {
         "two_sided": (ORIENT, "two_sided"),
         "semantics": (ORIENT, "semantics"),
         "conflicts": (ORIENT, "conflicts"),
+        "ground": (ORIENT, "ground"),
         "up": (ORIENT_FROM, "up"),
     },
     "remove-interior": {
@@ -269,6 +272,7 @@ def _orient_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[
             two_sided=o["two_sided"],
             semantics=o["semantics"],
             conflicts=o["conflicts"],
+            ground=GROUND_CHOICES.get(o["ground"], o["ground"]),
             up=_up(o["up"]),
         )
     _save(r.soup, o["output"], tell)

@@ -823,7 +823,7 @@ def orient(
     two_sided: str = "keep",
     semantics: str = "layer",
     conflicts: str = "majority",
-    ground: bool | None = None,
+    ground: bool | None = False,
     up: Any = None,
     classification: Classification | None = None,
     **classify_kw: Any,
@@ -848,9 +848,10 @@ def orient(
     conflicts : {"majority", "duplicate"}
         Flagged faces whose sample points disagree: the area majority, or both orientations.
     ground : bool or None
-        The model is a scene standing on a ground, seen from above it only (the rays of
-        the visible-sides step that leave it downward do not count); None (default):
-        where :func:`meshvis.repair.evidence.stands_on_ground` says so.
+        True: the model is a scene standing on a ground, seen from above it only (the rays
+        of the visible-sides step that leave it downward do not count); None: where
+        :func:`meshvis.repair.evidence.stands_on_ground` says so; False (default): seen
+        from every direction, as the graph cut sees it.
     up : None, "x", "y", "z" or (3,) float
         The up direction of the ground; None: the model's own (``Soup.up``).
     classification : Classification, optional

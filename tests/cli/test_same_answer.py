@@ -18,7 +18,7 @@ from helpers import real_model
 
 import meshvis
 from meshvis.cli.main import build_parser, main
-from meshvis.repair.operation import default_options
+from meshvis.repair.operation import GROUND_CHOICES, default_options
 
 #: small models of three formats: y-up glTF, y-up OBJ, z-up STL
 MODELS = ["nested.glb", "wallhole.obj", "soup.stl"]
@@ -88,13 +88,19 @@ def _options(parser: argparse.ArgumentParser, command: str) -> argparse.Argument
     return sub.choices[command]
 
 
+#: the command line's words for library values
+CLI_NAMES = {"up": {"auto": None}, "ground": GROUND_CHOICES}
+
+
 @pytest.mark.parametrize("op", ["classify", "orient", "remove-interior", "layers"])
 def test_cli_defaults_are_the_librarys(op):
     """Every option of a repair command defaults to the keyword default of the library."""
     args = build_parser(op).parse_args([op, "m.obj", *([] if op == "classify" else ["-o", "x.obj"])])
     for key, value in default_options(op).items():
         cli = getattr(args, key)
-        assert cli == value or (key == "up" and value is None and cli == "auto"), key
+        if key in CLI_NAMES:  # options the command line names by words
+            cli = CLI_NAMES[key].get(cli, cli)
+        assert cli == value, key
 
 
 def test_cli_defaults_follow_a_changed_library_default(monkeypatch):

@@ -37,17 +37,17 @@ def test_a_ground_sheet_wound_down_faces_up():
     winding; seen from above its ground only, it faces up."""
     soup = _scene()
     assert (soup.normals[:2] @ UP < 0).all()
-    r = orient(soup, seed=0)
+    r = orient(soup, seed=0, ground=None)
     assert r.visibility["ground"] and r.flipped[:2].all()
     assert (r.soup.normals[:2] @ UP > 0).all()
-    kept = orient(soup, seed=0, ground=False)
+    kept = orient(soup, seed=0)  # the default: seen from every direction
     assert not kept.visibility["ground"] and not kept.flipped[:2].any()
 
 
 def test_the_ground_is_the_model_up_axis_ground():
     """The same scene with x as its up axis stands on no ground (seen along x, it is a wall)."""
     soup = _scene()
-    assert not orient(soup, seed=0, up="x").visibility["ground"]
+    assert not orient(soup, seed=0, up="x", ground=None).visibility["ground"]
 
 
 @pytest.mark.parametrize("turned", [False, True])
@@ -77,11 +77,12 @@ def test_a_ball_and_a_car_like_object_stand_on_no_ground():
 
 def test_orient_on_a_ground_twice_is_once_and_the_cli_agrees(tmp_path):
     soup = _scene()
-    once = orient(soup, seed=0)
-    assert not orient(once.soup, seed=0).flipped.any()
+    once = orient(soup, seed=0, ground=None)
+    assert once.visibility["ground"]
+    assert not orient(once.soup, seed=0, ground=None).flipped.any()
     path, out = tmp_path / "scene.stl", tmp_path / "oriented.stl"  # STL: z up
     save(soup, str(path))
-    assert main(["orient", str(path), "-o", str(out), "--quiet"]) == 0
+    assert main(["orient", str(path), "-o", str(out), "--ground", "auto", "--quiet"]) == 0
     np.testing.assert_allclose(load(str(out)).normals, once.soup.normals, atol=1e-6)
 
 
@@ -90,7 +91,7 @@ def test_the_ground_is_found_at_any_scale_and_far_away(scale, shift):
     soup = _scene()
     soup = Soup(soup.vertices * scale + shift, soup.faces)
     assert stands_on_ground(soup, RayCaster(soup), UP)
-    assert orient(soup, seed=0).flipped[:2].all()
+    assert orient(soup, seed=0, ground=None).flipped[:2].all()
 
 
 def test_no_ground_under_nothing_or_a_wall():

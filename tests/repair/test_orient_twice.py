@@ -113,9 +113,10 @@ def test_orient_twice_is_orient_once_on_every_shared_model(path):
 
 @pytest.fixture(scope="module")
 def monastery():
-    """The monastery and ``orient``'s output of it (seed 0)."""
+    """The monastery and ``orient``'s outputs of it (seed 0): by default, and with its
+    ground found (``ground=None``)."""
     soup = load(real_model(MONASTERY))
-    return soup, orient(soup, seed=0)
+    return soup, {False: orient(soup, seed=0), None: orient(soup, seed=0, ground=None)}
 
 
 def _back_facing(model, elevation: float) -> float:
@@ -130,10 +131,22 @@ def _back_facing(model, elevation: float) -> float:
 @pytest.mark.slow
 @pytest.mark.shared_models
 @pytest.mark.parametrize(
-    "elevation",
+    "ground, elevation",
     [
-        20.0,
+        (False, 20.0),
         pytest.param(
+            False,
+            60.0,
+            marks=pytest.mark.xfail(
+                strict=True,
+                reason="seen from every direction, courtyard floors seen more than 4x as often "
+                "from the open space below the scene are turned down (0.0 % back-facing "
+                "pixels before, 8.7 % after)",
+            ),
+        ),
+        (None, 20.0),
+        pytest.param(
+            None,
             60.0,
             marks=pytest.mark.xfail(
                 strict=True,
@@ -144,16 +157,13 @@ def _back_facing(model, elevation: float) -> float:
         ),
     ],
 )
-def test_orient_shows_the_monastery_no_more_backs_from_above(monastery, elevation):
+def test_orient_shows_the_monastery_no_more_backs_from_above(monastery, ground, elevation):
     """The monastery stands on the ground, y up.  Seen from above the horizon, ``orient``'s
-    output shows no more back-facing pixels than the input.  Faces seen from both sides
-    once followed their patch's vote and the majority of their sample points toward the
-    open space below the ground (6.3 % back-facing pixels became 23 % from 20 degrees,
-    0.0 % became 42 % from 60 degrees), and then courtyard floors seen more than 4x as
-    often from below the scene turned down (0.0 % became 8.8 % from 60 degrees): the
-    scene is seen from above its ground only."""
-    soup, r = monastery
-    assert r.visibility["ground"]
+    output shows no more back-facing pixels than the input, by default and with its ground
+    found (``ground=None``: the scene is seen from above its ground only)."""
+    soup, results = monastery
+    r = results[ground]
+    assert r.visibility["ground"] == (ground is None)  # found where asked for
     assert (r.status == STATUS_NAMES.index("two-sided")).sum() > 1000
     before, after = _back_facing(soup, elevation), _back_facing(r.soup, elevation)
     assert after <= before, f"from {elevation} degrees: {before:.2%} back-facing before, {after:.2%} after"
