@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|startup``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|startup|pvs``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -51,6 +51,7 @@ def add_parser(sub) -> None:
         "indoor",
         "real",
         "startup",
+        "pvs",
     ):
         try:
             mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])

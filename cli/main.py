@@ -24,6 +24,7 @@ COMMANDS = {
     "remove-interior": "meshvis.cli.cmd_repair",
     "layers": "meshvis.cli.cmd_repair",
     "visible": "meshvis.cli.cmd_visible",
+    "pvs": "meshvis.cli.cmd_pvs",
     "label": "meshvis.cli.cmd_label",
     "batch": "meshvis.cli.cmd_batch",
     "bench": "meshvis.cli.cmd_bench",

@@ -36,3 +36,5 @@ MAX_PIXELS = 4096 * 4096
 #: absolute value of a coordinate: products of up to six coordinates (squared areas of
 #: cross products, squared lengths of Newell normals) must stay below the float64 maximum 1.8e308
 MAX_COORDINATE = 1e50
+#: bits of the PVS of all view cells together (cells x faces, a bit each): 2**34 bits are 2 GiB
+MAX_PVS_BITS = 1 << 34
