@@ -144,7 +144,8 @@ def remove_interior(
         (default :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`, ``"both"``; pass
         ``"object"`` for the cut alone).
     region : str or Region
-        Where viewers may be, for ``"view"`` and ``"both"`` (see :func:`meshvis.parse_region`).
+        Where viewers may be, for ``"view"`` and ``"both"`` (see :func:`meshvis.parse_region`),
+        or ``cells:PVS.npz``: the view cells of a PVS file (:func:`meshvis.pvs`).
     level : {"face", "patch", "part"}
         Remove single faces, or whole edge-connected patches / named parts whose faces are all hidden.
     keep_border : int
@@ -196,7 +197,7 @@ def remove_interior(
     vis: Visibility | None = None
     if visibility == "view":
         soup = as_soup(model)
-        vis = view or visible_from(soup, region, budget=budget, seed=seed, up=up)
+        vis = view or _sight(soup, region, budget=budget, seed=seed, up=up)
         keep = vis.seen.copy()
         code = np.where(keep, _KEPT_SEEN, _GONE_VIEW)
     else:
@@ -212,12 +213,21 @@ def remove_interior(
         else:
             # the search traces the cut's Embree scene, with the search's own ray offset
             caster = c.caster.with_offset(VISIBILITY_OFFSET)
-            vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut, caster=caster)
+            vis = _sight(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut, caster=caster)
             keep = by_cut | vis.seen
             code = np.where(by_cut, _KEPT_CUT, np.where(vis.seen, _KEPT_RESCUED, _GONE_BOTH))
     code = code.astype(np.int8)
     keep = _widen(soup, keep, code, level, int(keep_border))
     return RemovalResult(soup.subset(keep), soup.subset(~keep), keep, c, vis, code, visibility, soup)
+
+
+def _sight(soup: Soup, region, **search: Any) -> Visibility:
+    """The from-region search, or what the view cells of a PVS file see (``cells:PVS.npz``)."""
+    if isinstance(region, str) and region.strip().lower().startswith("cells:"):
+        from meshvis.viewcells.removal import cells_visibility
+
+        return cells_visibility(soup, region)
+    return visible_from(soup, region, **search)
 
 
 def _cut_keywords(visibility: str, classify_kw: dict[str, Any]) -> dict[str, Any]:

@@ -114,8 +114,6 @@ def pvs(
     target_error = _validate.real("target_error", target_error, 0.0)
     _validate.callback("progress", progress)
     soup = as_soup(model)
-    if soup.n_faces == 0:
-        raise ParameterError("the model has no faces: nothing to see")
     caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET)
     vs = default_view_space(soup, view_space, up=up, caster=caster)
     spec = parse_cells(cells, vs)

@@ -96,7 +96,7 @@ def split_space():
     return soup_of(groups)
 
 
-@pytest.fixture
+@pytest.fixture(scope="session")
 def levels():
     """This module: ``levels.two_rooms()``, ``levels.split_space()``, ..."""
     return sys.modules[__name__]

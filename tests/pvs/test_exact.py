@@ -65,3 +65,29 @@ def test_same_seed_same_pvs_other_seed_other_samples(levels):
     assert one.summary["rays"] == two.summary["rays"]
     assert one.summary["history"]["estimate_per_million"] == two.summary["history"]["estimate_per_million"]
     assert not all(np.array_equal(a, b) for a, b in zip(one.log, other.log))
+
+
+@pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6), (3.7, -2.5e3)])
+def test_the_wall_holds_at_any_scale_and_place(levels, scale, shift):
+    soup, idx = levels.split_space()
+    moved = type(soup)(soup.vertices * scale + shift, soup.faces)
+    lo, hi = np.zeros(3) * scale + shift, np.array([4.0, 2.0, 2.0]) * scale + shift
+    box = "box:" + ",".join(f"{x:.17g}" for x in np.concatenate([lo, hi]))
+    result = pvs(moved, "grid:2,1,1", view_space=box, budget=600_000, target_error=0)
+    left, right = set(result.faces(0)), set(result.faces(1))
+    assert set(idx["left"]) <= left and not set(idx["left"]) & right
+    assert set(idx["right"]) <= right and not set(idx["right"]) & left
+    assert np.isfinite(result.summary["estimate"]["per_million"])
+
+
+def test_one_triangle_and_no_faces():
+    from meshvis.errors import ModelError, ParameterError
+    from meshvis.soup import Soup
+
+    one = Soup(np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]]), np.array([[0, 1, 2]]))
+    with pytest.raises(ParameterError, match="no volume"):
+        pvs(one, "grid:1,1,1")
+    result = pvs(one, "grid:2,2,2", view_space="box:-1,-1,-1,2,2,2", budget=100_000, target_error=0)
+    assert result.sizes().tolist() == [1] * 8
+    with pytest.raises(ModelError, match="no faces"):
+        pvs(Soup(np.zeros((0, 3)), np.zeros((0, 3), np.int64)), "grid:1,1,1", view_space="box:0,0,0,1,1,1")
