@@ -233,63 +233,6 @@ def count_rows(bits):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True)
-def face_ranges(face, lo, hi, scratch_lo, scratch_hi):  # pragma: no cover - compiled
-    """Per distinct face of ``face`` (-1 skipped): the least ``lo`` and the greatest ``hi``.
-
-    ``scratch_lo`` must be all ``inf`` and ``scratch_hi`` all ``-inf`` (length: the model's
-    faces); both are left that way.  Returns ``(faces, lo_f, hi_f)`` in first-seen order.
-    """
-    n = len(face)
-    seen = np.empty(n, np.int64)
-    m = 0
-    for k in range(n):
-        f = face[k]
-        if f < 0:
-            continue
-        if scratch_lo[f] == np.inf and scratch_hi[f] == -np.inf:
-            seen[m] = f
-            m += 1
-        if lo[k] < scratch_lo[f]:
-            scratch_lo[f] = lo[k]
-        if hi[k] > scratch_hi[f]:
-            scratch_hi[f] = hi[k]
-    out_lo = np.empty(m)
-    out_hi = np.empty(m)
-    for j in range(m):
-        f = seen[j]
-        out_lo[j] = scratch_lo[f]
-        out_hi[j] = scratch_hi[f]
-        scratch_lo[f] = np.inf
-        scratch_hi[f] = -np.inf
-    return seen[:m].copy(), out_lo, out_hi
-
-
-@numba.njit(cache=True, nogil=True)
-def pick_neighbours(face, cell, ptr, nbr, bits, draw):  # pragma: no cover - compiled
-    """For each (face, cell): a neighbour of the face not yet in the cell's PVS, else -1.
-
-    The neighbours of face f are ``nbr[ptr[f]:ptr[f + 1]]``; the search starts at a random
-    one (``draw`` in [0, 1)) and goes round them.
-    """
-    n = len(face)
-    out = np.full(n, -1, np.int64)
-    for k in range(n):
-        f = face[k]
-        a, b = ptr[f], ptr[f + 1]
-        m = b - a
-        if m == 0:
-            continue
-        first = int(draw[k] * m)
-        c = cell[k]
-        for j in range(m):
-            g = nbr[a + (first + j) % m]
-            if not (bits[c, g >> 6] >> np.uint64(g & 63)) & np.uint64(1):
-                out[k] = g
-                break
-    return out
-
-
-@numba.njit(cache=True, nogil=True)
 def vertex_neighbours(faces_welded, n_vertices, fan_cap):  # pragma: no cover - compiled
     """CSR ``(ptr, nbr)`` of the faces sharing a (welded) vertex with each face.
 
@@ -332,3 +275,57 @@ def vertex_neighbours(faces_welded, n_vertices, fan_cap):  # pragma: no cover - 
         n += len(u)
         ptr[f + 1] = n
     return ptr, out[:n].copy()
+
+
+@numba.njit(cache=True, nogil=True)
+def clip_segments(origin, direction, t0, t1, idx, lo, hi):  # pragma: no cover - compiled
+    """The part of segments ``idx`` inside the box ``[lo, hi]``: (k, 2) parameters (a > b: none)."""
+    k = len(idx)
+    out = np.empty((k, 2))
+    for j in range(k):
+        i = idx[j]
+        a, b = _clip(origin[i], direction[i], lo, hi, t0[i], t1[i])
+        out[j, 0], out[j, 1] = a, b
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
+def node_faces(origin, direction, ab, idx, face_back, face_fwd, scratch_lo, scratch_hi):  # pragma: no cover
+    """Per distinct face at the ends of segments ``idx`` (clipped to ``ab``): per axis the least
+    and the greatest coordinate of its segments' parts, ``(faces, lo (f, 3), hi (f, 3))``.
+
+    ``scratch_lo`` / ``scratch_hi`` are (m, 3), all ``inf`` / ``-inf``, and are left so.
+    """
+    k = len(idx)
+    seen = np.empty(2 * k, np.int64)
+    m = 0
+    for j in range(k):
+        a, b = ab[j, 0], ab[j, 1]
+        if a > b:
+            continue
+        i = idx[j]
+        for end in range(2):
+            f = face_back[i] if end == 0 else face_fwd[i]
+            if f < 0:
+                continue
+            if scratch_lo[f, 0] == np.inf:
+                seen[m] = f
+                m += 1
+            for c in range(3):
+                pa = origin[i, c] + a * direction[i, c]
+                pb = origin[i, c] + b * direction[i, c]
+                low, high = (pa, pb) if pa <= pb else (pb, pa)
+                if low < scratch_lo[f, c]:
+                    scratch_lo[f, c] = low
+                if high > scratch_hi[f, c]:
+                    scratch_hi[f, c] = high
+    out_lo = np.empty((m, 3))
+    out_hi = np.empty((m, 3))
+    for j in range(m):
+        f = seen[j]
+        for c in range(3):
+            out_lo[j, c] = scratch_lo[f, c]
+            out_hi[j, c] = scratch_hi[f, c]
+            scratch_lo[f, c] = np.inf
+            scratch_hi[f, c] = -np.inf
+    return seen[:m].copy(), out_lo, out_hi

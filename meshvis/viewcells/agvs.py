@@ -27,7 +27,7 @@ from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.viewcells import strategies as st
 from meshvis.viewcells.cells import ViewCells, parse_cells
 from meshvis.viewcells.estimate import ErrorEstimate
-from meshvis.viewcells.hierarchy import COARSE_SAMPLES, Segments, auto_cells
+from meshvis.viewcells.hierarchy import COARSE_SAMPLES, Segments, auto_cells, clipped
 from meshvis.viewcells.mixture import Mixture
 from meshvis.viewcells.result import PVS, model_key
 from meshvis.viewcells.sampler import GlobalSampler
@@ -300,9 +300,8 @@ def _auto(vs: ViewSpace, soup, coarse: st.Samples, n: int, caster, rng):
     hits = caster.intersect(np.concatenate([o, o]), np.concatenate([d, -d]))
     traced = Traced(hits.face[:k], hits.face[k:], hits.distance[:k], hits.distance[k:], hits.side)
     segments = Segments(o, d, -traced.t_back, traced.t_fwd, traced.face_back, traced.face_fwd)
-    from meshvis.viewcells.hierarchy import _clipped
-
-    t0, t1 = _clipped(segments, np.arange(k), vs.lo, vs.hi)
+    ab = clipped(segments, np.arange(k), vs.lo, vs.hi)
+    t0, t1 = ab[:, 0], ab[:, 1]
     valid = (t0 <= t1) & ((traced.face_back >= 0) | (traced.face_fwd >= 0))
     segs = Segments(o[valid], d[valid], t0[valid], t1[valid], traced.face_back[valid], traced.face_fwd[valid])
     cells, info = auto_cells(vs, segs, o, n, n_faces=soup.n_faces, rng=rng)

@@ -34,9 +34,11 @@ from meshvis.viewcells.viewspace import ViewSpace
 
 #: view space-direction samples of the coarse pass (two rays each; 002 §6.2 finds a coarse
 #: pass enough for a stable estimate of the cost)
-COARSE_SAMPLES = 1 << 18
+COARSE_SAMPLES = 1 << 20
+#: coarse samples' starting points that estimate the share of each node in the view space
+VOLUME_POINTS = 1 << 18
 #: candidate planes per axis and node (random segment ends inside the node, 002 §4.2)
-CANDIDATES = 32
+CANDIDATES = 64
 #: weight of a leaf's own cost in its priority (002 §4.2: 1 % suffices)
 ABSOLUTE_WEIGHT = 0.01
 #: a split below this share of the root's cost is small ...
@@ -114,14 +116,17 @@ def auto_cells(
         ``coarse_segments``, ``expected_cost`` (Σ P·|PVS| of the coarse PVS) of the root and
         of the cells, ``cost_by_cells`` (the cost after each split), ``stopped``.
     """
-    scratch_lo = np.full(n_faces, np.inf)
-    scratch_hi = np.full(n_faces, -np.inf)
+    scratch_lo = np.full((n_faces, 3), np.inf)
+    scratch_hi = np.full((n_faces, 3), -np.inf)
+    points = points[:VOLUME_POINTS]
     n_pts = max(len(points), 1)
     min_side = MIN_SIDE * (view_space.hi - view_space.lo)
 
     def make(lo, hi, seg, pts) -> _Node:
-        node = _Node(lo, hi, seg, pts, len(pts) / n_pts, 0)
-        _evaluate(node, segments, points, n_pts, min_side, scratch_lo, scratch_hi, rng)
+        ab = clipped(segments, seg, lo, hi)
+        inside = ab[:, 0] <= ab[:, 1]
+        node = _Node(lo, hi, seg[inside], pts, len(pts) / n_pts, 0)
+        _evaluate(node, ab[inside], segments, points, n_pts, min_side, scratch_lo, scratch_hi, rng)
         return node
 
     root = make(
@@ -155,7 +160,7 @@ def auto_cells(
         for below in (True, False):
             lo, hi = node.lo.copy(), node.hi.copy()
             (hi if below else lo)[a] = s
-            seg = node.seg[_crosses(segments, node.seg, lo, hi)]
+            seg = node.seg
             p = points[node.pts, a]
             pts = node.pts[p <= s] if below else node.pts[p > s]
             child = make(lo, hi, seg, pts)
@@ -212,51 +217,40 @@ def _live(nodes: dict, leaves: set, view_space: ViewSpace) -> int:
     return sum(1 for i in leaves if nodes[i].share > 0 or _volume(nodes[i], view_space) > MIN_VOLUME_SHARE)
 
 
-def _clipped(
-    segments: Segments, idx: np.ndarray, lo: np.ndarray, hi: np.ndarray
-) -> tuple[np.ndarray, np.ndarray]:
-    """The parameters ``[a, b]`` of each segment's part inside the box (a > b: none)."""
-    o, d = segments.origin[idx], segments.direction[idx]
-    a, b = segments.t0[idx].copy(), segments.t1[idx].copy()
-    with np.errstate(divide="ignore", invalid="ignore"):
-        ta = (lo - o) / d
-        tb = (hi - o) / d
-    near = np.where(d != 0, np.minimum(ta, tb), -np.inf)
-    far = np.where(d != 0, np.maximum(ta, tb), np.inf)
-    outside = ((d == 0) & ((o < lo) | (o > hi))).any(axis=1)
-    a = np.maximum(a, near.max(axis=1))
-    b = np.minimum(b, far.min(axis=1))
-    b[outside] = -np.inf
-    return a, b
+def clipped(segments: Segments, idx: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
+    """(k, 2): the parameters ``[a, b]`` of the part of segments ``idx`` inside the box (a > b: none)."""
+    return _kernels.clip_segments(
+        segments.origin,
+        segments.direction,
+        segments.t0,
+        segments.t1,
+        np.ascontiguousarray(idx, np.int64),
+        lo,
+        hi,
+    )
 
 
-def _crosses(segments: Segments, idx: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> np.ndarray:
-    a, b = _clipped(segments, idx, lo, hi)
-    return a <= b
-
-
-def _evaluate(node: _Node, segments: Segments, points, n_pts, min_side, scratch_lo, scratch_hi, rng) -> None:
-    """The node's PVS size and its best split (``node.best``)."""
-    idx = node.seg
-    a, b = _clipped(segments, idx, node.lo, node.hi)
-    o, d = segments.origin[idx], segments.direction[idx]
-    pa, pb = o + a[:, None] * d, o + b[:, None] * d
-    faces = np.concatenate([segments.face_back[idx], segments.face_fwd[idx]])
-    seg_lo = np.concatenate([np.minimum(pa, pb)] * 2)
-    seg_hi = np.concatenate([np.maximum(pa, pb)] * 2)
-    node.pvs = 0
+def _evaluate(
+    node: _Node, ab, segments: Segments, points, n_pts, min_side, scratch_lo, scratch_hi, rng
+) -> None:
+    """The node's PVS size and its best split (``node.best``); ``ab`` clips its segments to it."""
+    _, f_lo3, f_hi3 = _kernels.node_faces(
+        segments.origin,
+        segments.direction,
+        ab,
+        np.ascontiguousarray(node.seg, np.int64),
+        segments.face_back,
+        segments.face_fwd,
+        scratch_lo,
+        scratch_hi,
+    )
+    node.pvs = len(f_lo3)
     best = (0.0, -1, 0.0, 0.0, 0.0)
+    if node.pvs == 0 or node.share <= 0:
+        node.best = best
+        return
     for axis in range(3):
-        _, f_lo, f_hi = _kernels.face_ranges(
-            faces,
-            np.ascontiguousarray(seg_lo[:, axis]),
-            np.ascontiguousarray(seg_hi[:, axis]),
-            scratch_lo,
-            scratch_hi,
-        )
-        node.pvs = len(f_lo)
-        if len(f_lo) == 0 or node.share <= 0:
-            continue
+        f_lo, f_hi = np.sort(f_lo3[:, axis]), np.sort(f_hi3[:, axis])
         lo_edge, hi_edge = node.lo[axis] + min_side[axis], node.hi[axis] - min_side[axis]
         if lo_edge >= hi_edge:
             continue
@@ -267,15 +261,13 @@ def _evaluate(node: _Node, segments: Segments, points, n_pts, min_side, scratch_
         x = np.unique(ends)
         if len(x) == 0:
             continue
-        f_lo.sort()
-        f_hi.sort()
         below = np.searchsorted(f_lo, x, side="left")  # faces reaching below x
         above = len(f_hi) - np.searchsorted(f_hi, x, side="right")  # faces reaching above x
         p = np.sort(points[node.pts, axis])
         share_below = np.searchsorted(p, x, side="right") / n_pts
         share_above = node.share - share_below
         after = share_below * below + share_above * above
-        reduction = node.share * len(f_lo) - after
+        reduction = node.share * node.pvs - after
         k = int(np.argmax(reduction))
         if reduction[k] > best[0]:
             best = (

@@ -25,7 +25,7 @@ MEMORY = 0.5
 #: least share of the samples of every available distribution
 FLOOR = 0.02
 #: least share of the view space-direction distribution (the error estimate's cameras)
-UNIFORM_FLOOR = 0.2
+UNIFORM_FLOOR = 0.1
 
 
 class Mixture:

@@ -252,8 +252,13 @@ class GlobalSampler:
 
     def _keep(self, o, d, t_back, t_fwd, face_back, face_fwd, clip, useful, origin_cell) -> None:
         """Store the segments with a new entry as mutation candidates: one per end that found one."""
-        back_end = o + np.where(face_back >= 0, -t_back, clip[:, 0])[:, None] * d
-        fwd_end = o + np.where(face_fwd >= 0, t_fwd, clip[:, 1])[:, None] * d
+        keep = np.flatnonzero(useful)
+        if len(keep) == 0:
+            return
+        o, d, useful, origin_cell = o[keep], d[keep], useful[keep], origin_cell[keep]
+        face_back, face_fwd, clip = face_back[keep], face_fwd[keep], clip[keep]
+        back_end = o + np.where(face_back >= 0, -t_back[keep], clip[:, 0])[:, None] * d
+        fwd_end = o + np.where(face_fwd >= 0, t_fwd[keep], clip[:, 1])[:, None] * d
         mean_cell = float(self.cell_radius.mean())
         cell_r = np.where(origin_cell >= 0, self.cell_radius[np.maximum(origin_cell, 0)], mean_cell)
         parts = []

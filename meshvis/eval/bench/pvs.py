@@ -28,6 +28,7 @@ from __future__ import annotations
 
 import argparse
 import hashlib
+import json
 import os
 import time
 
@@ -47,6 +48,8 @@ GVS_SHARES = (0.25, 1.0)
 SNAPSHOTS = 10
 #: the estimate is compared with the measured error below this (wrong pixels per million)
 COMPARE_BELOW = 100.0
+#: bump when the sampler changes, so that cached runs are not reused
+RUN_VERSION = 1
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -73,8 +76,13 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         default=GVS_CELLS,
         help="cells of the converged per-cell guided search (0: none)",
     )
-    p.add_argument("--no-baselines", action="store_true", help="skip per-cell random and guided sampling")
-    p.add_argument("--no-grid", action="store_true", help="skip the uniform grid of the same cell count")
+    p.add_argument(
+        "--parts",
+        default=",".join(PARTS),
+        help="what to measure: agvs (the run and its curve), random, gvs (guided on every cell), converged "
+        "(guided to its stop rule on --gvs-cells cells), grid (a uniform grid of the same count); the AGVS run "
+        "is cached in --cache, so the parts can run one at a time",
+    )
     p.add_argument(
         "--cache",
         default=os.path.join(os.path.expanduser("~"), ".cache", "meshvis"),
@@ -92,7 +100,7 @@ def main(args: argparse.Namespace) -> int:
     base = os.path.dirname(os.path.abspath(models_folder(args.models_dir)))
     paths = args.levels or [os.path.join(base, m) for m in MODELS]
     os.makedirs(args.cache, exist_ok=True)
-    print(f"load {open('/proc/loadavg').read().split()[:3] if os.path.exists('/proc/loadavg') else '?'}")
+    print(f"load {_load()}")
     results = []
     for path in paths:
         r = run_level(path, args)
@@ -113,39 +121,46 @@ def _since(start: tuple[float, float]) -> tuple[float, float]:
     return time.perf_counter() - start[0], time.process_time() - start[1]
 
 
+#: the parts of the benchmark (each needs the AGVS run, cached in ``--cache`` by the first)
+PARTS = ("agvs", "random", "gvs", "converged", "grid")
+#: the random-sampling curve stops at this many seconds (its points are at AGVS's times)
+RANDOM_SECONDS = 120.0
+#: the grid of the same count gets this share of AGVS's rays (and is compared with the auto
+#: cells' PVS after as many rays)
+GRID_SHARE = 0.25
+
+
 def run_level(path: str, args: argparse.Namespace) -> dict:
-    """Every measurement of the module notes on one level."""
+    """The parts ``args.parts`` of the module notes on one level."""
     import warnings
 
     from meshvis.io import load
     from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
-    from meshvis.viewcells import judge, pvs
+    from meshvis.viewcells import judge
 
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         soup = load(path)
     caster = RayCaster(soup, offset=VISIBILITY_OFFSET)
-    out: dict = {"level": os.path.basename(path), "faces": int(soup.n_faces)}
-    start = _clock()
-    run_args = {"budget": args.rays, "target_error": 0.0} if args.rays else {"seconds": args.time}
-    result = pvs(soup, args.cells, seed=args.seed, caster=caster, **run_args)
-    wall, cpu = _since(start)
+    parts = set(args.parts.split(","))
+    unknown = parts - set(PARTS)
+    if unknown:
+        from meshvis.errors import ParameterError
+
+        raise ParameterError(f"unknown parts {sorted(unknown)}; choose from {', '.join(PARTS)}")
+    result, run = _agvs_run(soup, args, caster)
     cells = result.cells
+    out: dict = {"level": os.path.basename(path), "faces": int(soup.n_faces), "parts": sorted(parts), **run}
     out.update(
         cells=cells.n_cells,
         cells_kind=cells.kind,
         view_space=cells.view_space.describe(),
-        seconds=wall,
-        cpu_seconds=cpu,
-        rays=int(result.summary["rays"]["total"]),
-        stopped=result.summary["stopped"],
         mean_pvs=float(result.sizes().mean()),
         expected_cost=result.expected_cost(),
     )
     table = _views(soup, cells.view_space, args, caster)
     out["views"] = int(table.n_views)
-    errors = judge.pixel_errors(table, cells, result.bits)
-    out["final"] = judge.summary(errors, table)
+    out["final"] = judge.summary(judge.pixel_errors(table, cells, result.bits), table)
     out["agvs_curve"] = _agvs_curve(result, table)
     out["estimate_vs_measured"] = [
         {"seconds": p["seconds"], "estimate": p["estimate"], "measured": p["mean"]}
@@ -153,19 +168,80 @@ def run_level(path: str, args: argparse.Namespace) -> dict:
         if p["mean"] < COMPARE_BELOW
     ]
     total = out["rays"]
-    if not args.no_baselines:
-        out["random_curve"] = _random_curve(
-            soup, cells, caster, table, [p["seconds"] for p in out["agvs_curve"]], args.seed
-        )
+    if "random" in parts:
+        times = [p["seconds"] for p in out["agvs_curve"] if p["seconds"] <= RANDOM_SECONDS]
+        out["random_curve"] = _random_curve(soup, cells, caster, table, times, args.seed)
+    if "gvs" in parts:
         out["gvs_curve"] = [
-            _gvs_all(soup, cells, caster, table, int(total * s / cells.n_cells), args.seed)
-            for s in GVS_SHARES
+            _gvs_all(soup, cells, caster, table, int(total * share / cells.n_cells), args.seed)
+            for share in GVS_SHARES
         ]
-        if args.gvs_cells > 0:
-            out["gvs_converged"] = _gvs_converged(soup, result, caster, args.gvs_cells, args.seed)
-    if not args.no_grid and cells.kind.startswith("auto"):
-        out["grid"] = _grid(soup, result, caster, table, total, args.seed)
+    if "converged" in parts and args.gvs_cells > 0:
+        out["gvs_converged"] = _gvs_converged(soup, result, caster, args.gvs_cells, args.seed)
+    if "grid" in parts and cells.kind.startswith("auto"):
+        out["grid"] = _grid(soup, result, caster, table, int(total * GRID_SHARE), args.seed)
     return out
+
+
+def _agvs_run(soup, args, caster):
+    """The AGVS run of this level and options: computed and cached, or read from the cache.
+
+    Returns the result (with its log) and the run's measures: seconds, CPU seconds, rays,
+    why it stopped and the machine's load when it ran.
+    """
+    from meshvis.io import atomic_write
+    from meshvis.viewcells import PVS, pvs
+    from meshvis.viewcells.result import model_key
+
+    key = hashlib.sha256(
+        repr(
+            (model_key(soup), args.cells, args.rays, None if args.rays else args.time, args.seed, RUN_VERSION)
+        ).encode()
+    ).hexdigest()[:20]
+    path = os.path.join(args.cache, f"pvs-run-{key}.npz")
+    log_path = os.path.join(args.cache, f"pvs-run-{key}.log.npz")
+    if os.path.isfile(path) and os.path.isfile(log_path):
+        result = PVS.load(path, soup)
+        with np.load(log_path) as d:
+            result.log = (d["cell"], d["face"], d["batch"])
+            result.batches = {"seconds": d["seconds"].tolist(), "rays": d["rays"].tolist()}
+            run = json.loads(str(d["run"]))
+        return result, run
+    load = _load()
+    start = _clock()
+    run_args = {"budget": args.rays, "target_error": 0.0} if args.rays else {"seconds": args.time}
+    result = pvs(soup, args.cells, seed=args.seed, caster=caster, **run_args)
+    wall, cpu = _since(start)
+    run = {
+        "seconds": wall,
+        "cpu_seconds": cpu,
+        "rays": int(result.summary["rays"]["total"]),
+        "stopped": result.summary["stopped"],
+        "load_before": load,
+        "load_after": _load(),
+    }
+    result.save(path)
+    assert result.log is not None and result.batches is not None
+    with atomic_write(log_path, "wb") as fh:
+        np.savez_compressed(
+            fh,
+            cell=result.log[0],
+            face=result.log[1],
+            batch=result.log[2],
+            seconds=np.asarray(result.batches["seconds"]),
+            rays=np.asarray(result.batches["rays"]),
+            run=np.array(json.dumps(run)),
+        )
+    return result, run
+
+
+def _load() -> list[float]:
+    """The machine's load averages (1, 5, 15 minutes); empty where /proc is missing."""
+    try:
+        with open("/proc/loadavg") as fh:
+            return [float(x) for x in fh.read().split()[:3]]
+    except OSError:
+        return []
 
 
 def _views(soup, view_space, args, caster):
@@ -342,7 +418,7 @@ def _gvs_converged(soup, result, caster, k: int, seed: int) -> dict:
 
 
 def _grid(soup, result, caster, table, rays: int, seed: int) -> dict:
-    """AGVS on a uniform grid of the same cell count with the same rays: render cost and error."""
+    """AGVS on a uniform grid of the same cell count with ``rays``, next to the auto cells after as many."""
     from meshvis.viewcells import judge, pvs
     from meshvis.viewcells.cells import ViewCells, grid_shape
 
@@ -352,16 +428,24 @@ def _grid(soup, result, caster, table, rays: int, seed: int) -> dict:
     start = _clock()
     g = pvs(soup, grid, budget=rays, target_error=0.0, seed=seed, caster=caster)
     wall, cpu = _since(start)
+    done = int(g.summary["rays"]["total"])
+    at = int(np.searchsorted(np.asarray(result.batches["rays"]), done))
+    at = min(at, len(result.batches["rays"]) - 1)
+    auto_bits = result.bits_at(at)
     s = judge.summary(judge.pixel_errors(table, g.cells, g.bits), table)
+    a = judge.summary(judge.pixel_errors(table, result.cells, auto_bits), table)
     return {
         "shape": list(shape),
         "cells": g.cells.n_cells,
-        "rays": int(g.summary["rays"]["total"]),
+        "rays": done,
         "seconds": wall,
         "cpu_seconds": cpu,
         "expected_cost": g.expected_cost(),
-        "auto_expected_cost": result.expected_cost(),
         "mean_pvs": float(g.sizes().mean()),
+        "auto_rays": int(result.batches["rays"][at]),
+        "auto_expected_cost": result.expected_cost(auto_bits),
+        "auto_mean": a["mean"],
+        "auto_worst": a["worst"],
         **s,
     }
 
@@ -371,7 +455,8 @@ def format_level(r: dict) -> str:
     lines = [
         f"\n{r['level']}: {r['faces']} faces, {r['cells']} cells ({r['cells_kind']}), view space {r['view_space']['kind']}"
         + (" above the ground" if "ground" in r["view_space"] else ""),
-        f"AGVS: {r['seconds']:.1f} s ({r['cpu_seconds']:.1f} s CPU), {r['rays']} rays, stopped: {r['stopped']}; "
+        f"AGVS: {r['seconds']:.1f} s ({r['cpu_seconds']:.1f} s CPU; load {r['load_before']} before, "
+        f"{r['load_after']} after), {r['rays']} rays, stopped: {r['stopped']}; "
         f"mean PVS {r['mean_pvs']:.0f}; {r['views']} views: mean {r['final']['mean']:.2f}, worst "
         f"{r['final']['worst']:.0f} wrong pixels per million (walkthrough: mean "
         f"{r['final'].get('walkthrough_mean', 0):.2f}, worst {r['final'].get('walkthrough_worst', 0):.0f})",
@@ -417,8 +502,9 @@ def format_level(r: dict) -> str:
     gr = r.get("grid")
     if gr:
         lines.append(
-            f"render cost Σ P·|PVS|: auto cells {gr['auto_expected_cost']:.0f}, grid {'x'.join(map(str, gr['shape']))} "
-            f"{gr['expected_cost']:.0f} (same {gr['rays']} rays; grid error mean {gr['mean']:.2f}, worst {gr['worst']:.0f})"
+            f"render cost Σ P·|PVS|: auto cells {gr['auto_expected_cost']:.0f} after {gr['auto_rays']} rays "
+            f"(error mean {gr['auto_mean']:.2f}, worst {gr['auto_worst']:.0f}); grid {'x'.join(map(str, gr['shape']))} "
+            f"{gr['expected_cost']:.0f} after {gr['rays']} rays (error mean {gr['mean']:.2f}, worst {gr['worst']:.0f})"
         )
     return "\n".join(lines)
 
