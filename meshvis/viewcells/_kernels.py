@@ -233,6 +233,31 @@ def count_rows(bits):  # pragma: no cover - compiled
 
 
 @numba.njit(cache=True, nogil=True)
+def pick_neighbours(face, cell, ptr, nbr, bits, draw):  # pragma: no cover - compiled
+    """For each (face, cell): a neighbour of the face not yet in the cell's PVS, else -1.
+
+    The neighbours of face f are ``nbr[ptr[f]:ptr[f + 1]]``; the search starts at a random
+    one (``draw`` in [0, 1)) and goes round them.
+    """
+    n = len(face)
+    out = np.full(n, -1, np.int64)
+    for k in range(n):
+        f = face[k]
+        a, b = ptr[f], ptr[f + 1]
+        m = b - a
+        if m == 0:
+            continue
+        first = int(draw[k] * m)
+        c = cell[k]
+        for j in range(m):
+            g = nbr[a + (first + j) % m]
+            if not (bits[c, g >> 6] >> np.uint64(g & 63)) & np.uint64(1):
+                out[k] = g
+                break
+    return out
+
+
+@numba.njit(cache=True, nogil=True)
 def vertex_neighbours(faces_welded, n_vertices, fan_cap):  # pragma: no cover - compiled
     """CSR ``(ptr, nbr)`` of the faces sharing a (welded) vertex with each face.
 

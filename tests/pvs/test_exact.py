@@ -91,3 +91,13 @@ def test_one_triangle_and_no_faces():
     assert result.sizes().tolist() == [1] * 8
     with pytest.raises(ModelError, match="no faces"):
         pvs(Soup(np.zeros((0, 3)), np.zeros((0, 3), np.int64)), "grid:1,1,1", view_space="box:0,0,0,1,1,1")
+
+
+def test_every_distribution_is_drawn_and_counted(levels):
+    soup, _ = levels.two_rooms()
+    result = pvs(soup, "grid:2,1,1", view_space=levels.VIEW_SPACE, budget=2_500_000, target_error=0)
+    stats = result.summary["strategies"]
+    assert set(stats) == {"uniform", "object", "two-point", "mutation", "silhouette", "border"}
+    assert all(s["rays"] > 0 for s in stats.values()), stats
+    assert sum(s["contribution"] for s in stats.values()) == int(result.sizes().sum())
+    assert sum(s["rays"] for s in stats.values()) == result.summary["rays"]["total"]
