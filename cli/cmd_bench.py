@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|startup|pvs``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|startup|conservative|pvs``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -45,12 +45,15 @@ def add_parser(sub) -> None:
         "stability",
         "labeling",
         "labeling-sweep",
+        "labeling-orbit",
+        "labeling-page",
         "compare",
         "scale",
         "orientation",
         "indoor",
         "real",
         "startup",
+        "conservative",
         "pvs",
     ):
         try:

@@ -5,7 +5,7 @@ from __future__ import annotations
 import argparse
 import os
 
-from .common import check_output, positive_int, say, staged_outputs, verbosity_options
+from .common import check_outputs, positive_int, say, staged_outputs, verbosity_options
 
 UP_AXES = ("auto", "x", "y", "z")
 
@@ -46,7 +46,9 @@ def add_parser(sub) -> None:
         default="fuzzy",
         help="fuzzy-greedy layout (default) or the classic two-step baseline",
     )
-    p.add_argument("--json", metavar="FILE", help="also write labels, metrics and timings as JSON")
+    p.add_argument(
+        "--json", metavar="FILE", help="also write labels, metrics and timings as JSON ('-': standard output)"
+    )
     p.add_argument("--png", metavar="FILE", help="also write a PNG of the (first) frame")
     p.add_argument(
         "--texts", metavar="FILE", help="JSON object or 2-column CSV mapping part names to label texts"
@@ -110,8 +112,13 @@ def _optimisation_arguments(opt: argparse._ArgumentGroup) -> None:
     opt.add_argument(
         "--font-size", type=positive_int, help="label font size in pixels (default: from the image size)"
     )
+    from meshvis.labeling.pipeline import MIN_PIXELS
+
     opt.add_argument(
-        "--min-pixels", type=positive_int, default=1, help="parts with fewer visible pixels are not labelled"
+        "--min-pixels",
+        type=positive_int,
+        default=MIN_PIXELS,
+        help=f"parts with fewer visible pixels are not labelled (default {MIN_PIXELS})",
     )
 
 
@@ -145,11 +152,9 @@ def _frame_paths(output: str, n: int) -> list[str]:
 
 def _cameras(args: argparse.Namespace, soup) -> list:
     """Build the cameras of the frames: an orbit, a camera path, one camera file or one fitted view."""
-    import json
-
-    from meshvis.errors import ParameterError
     from meshvis.labeling import frames as fr
-    from meshvis.rays.camera import Camera
+    from meshvis.labeling.inputs import read_camera
+    from meshvis.labeling.pipeline import fit_camera
 
     up = _up(args)
     if args.orbit:
@@ -163,17 +168,14 @@ def _cameras(args: argparse.Namespace, soup) -> list:
             up=up,
             fit_margin=args.fit_margin,
             distance=args.distance,
+            size=tuple(args.size),
         )
     if args.camera_path:
         return fr.read_camera_path(args.camera_path)
     if args.camera:
-        try:
-            with open(args.camera, encoding="utf-8") as fh:
-                return [Camera.from_json(json.load(fh))]
-        except (OSError, ValueError, TypeError) as exc:
-            raise ParameterError(f"{args.camera}: cannot read the camera: {exc}") from None
+        return [read_camera(args.camera)]
     return [
-        Camera.fit(
+        fit_camera(
             soup,
             azimuth=args.azimuth,
             elevation=args.elevation,
@@ -182,6 +184,7 @@ def _cameras(args: argparse.Namespace, soup) -> list:
             orthographic=args.orthographic,
             margin=args.fit_margin,
             up=up,
+            size=tuple(args.size),
         )
     ]
 
@@ -229,8 +232,15 @@ def _report(args: argparse.Namespace, results: list, paths: list[str]) -> None:
     )
     if first.invisible:
         detail(args, f"not visible, not labelled: {', '.join(n for _, n in first.invisible)}")
-    if first.unplaced:
-        detail(args, f"no room found for: {', '.join(n for _, n in first.unplaced)}")
+    outside = set(first.params.get("outside_image", []))
+    if outside:
+        detail(
+            args,
+            f"left out, no room inside the image even at {first.font_size} px: {', '.join(sorted(outside))}",
+        )
+    rest = [n for _, n in first.unplaced if n not in outside]
+    if rest:
+        detail(args, f"no room found for: {', '.join(rest)}")
     if len(results) > 1:
         s = sequence_metrics(results)
         detail(
@@ -273,6 +283,8 @@ def run(args: argparse.Namespace) -> int:
         A model cannot be read (see :func:`meshvis.load`).
     """
     from meshvis.errors import OutputError
+    from meshvis.io.jsonfile import STDOUT
+    from meshvis.io.writing import check_not_read
     from meshvis.labeling import frames as fr
     from meshvis.labeling.inputs import load_models, read_texts
 
@@ -282,9 +294,13 @@ def run(args: argparse.Namespace) -> int:
     soup = load_models(args.inputs if len(args.inputs) > 1 else args.inputs[0])
     cameras = _cameras(args, soup)
     paths = _frame_paths(args.output, len(cameras))
-    for path in paths + [p for p in (args.json, args.png) if p]:
-        check_output(path, args.inputs, args.force)
-    texts = read_texts(args.texts) if args.texts else None
+    outputs = paths + [p for p in (args.json, args.png) if p and p != STDOUT]
+    check_outputs(outputs, args.inputs, args.force)
+    for path in outputs:  # not over a texture of a model
+        check_not_read(path, soup)
+    if args.json == STDOUT:
+        args.quiet = True  # standard output carries the JSON alone
+    texts = read_texts(args.texts, soup.part_names) if args.texts else None
     options = dict(
         layout=args.layout,
         area=args.area,

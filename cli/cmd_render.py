@@ -79,6 +79,7 @@ def run(args: argparse.Namespace) -> int:
     """
     from meshvis.io import load
     from meshvis.io.up_axis import up_vector
+    from meshvis.io.writing import check_not_read
     from meshvis.rays.camera import Camera
     from meshvis.rays.render import check_image_format, render, render_layers, save_image
 
@@ -87,6 +88,7 @@ def run(args: argparse.Namespace) -> int:
     up = None if args.up == "auto" else up_vector(args.up)
     check_output(args.output, [args.input], args.force)
     soup = load(args.input)
+    check_not_read(args.output, soup)  # not over a texture of the model
     camera = Camera.fit(soup, azimuth=args.azimuth, elevation=args.elevation, up=up)
     size = tuple(args.size)
     if args.color_by == "layer":

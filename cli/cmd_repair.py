@@ -16,7 +16,7 @@ from meshvis.graphcut.solvers import SOLVERS
 from meshvis.io.report import write_report
 from meshvis.repair.remove_modes import LEVELS, VISIBILITY_MODES
 
-from .common import check_output, point, positive_int, say, staged_outputs, up_option, verbosity_options
+from .common import check_outputs, point, positive_int, say, staged_outputs, up_option, verbosity_options
 
 
 def _defaults(op: str) -> dict:
@@ -190,8 +190,9 @@ def region_option(p: argparse.ArgumentParser, default: str | None, what: str) ->
 def removal_options(p: argparse.ArgumentParser) -> None:
     """Add the options of inside removal by sight to the ``remove-interior`` parser.
 
-    The options are ``--visibility``, ``--from``, ``--budget``, ``--level`` and
-    ``--keep-border``, with the defaults of :func:`meshvis.remove_interior`.
+    The options are ``--visibility``, ``--from``, ``--budget``, ``--level``,
+    ``--keep-border`` and ``--conservative``, with the defaults of
+    :func:`meshvis.remove_interior`.
 
     Parameters
     ----------
@@ -227,6 +228,13 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         default=d["keep_border"],
         metavar="N",
         help="keep N rings of hidden faces next to kept ones",
+    )
+    p.add_argument(
+        "--conservative",
+        action="store_true",
+        default=d["conservative"],
+        help="remove only faces surely hidden from --from points:... or path:CAMERAS.json (outside the "
+        "conservative set: nothing visible from there is removed; no cut, --visibility is not used)",
     )
 
 
@@ -317,14 +325,16 @@ def run(args: argparse.Namespace) -> int:
     Raises
     ------
     ParameterError
-        Two outputs share one path, ``--per-face`` without ``--report``, or an option out of
-        its range (a malformed ``--from`` region, ...).
+        ``--per-face`` without ``--report``, or an option out of its range (a malformed
+        ``--from`` region, ...).
     OutputError
-        An output path or format is refused (see :func:`meshvis.io.check_output`).
+        An output path or format is refused (see :func:`meshvis.io.check_outputs`): two
+        outputs share one path, or one would replace the input, its MTL or a texture.
     ModelError
         The model cannot be read (see :func:`meshvis.load`).
     """
     from meshvis.io import load
+    from meshvis.io.writing import check_not_read
     from meshvis.repair.operation import check_options
 
     from .common import detail
@@ -343,16 +353,15 @@ def run(args: argparse.Namespace) -> int:
         )
         if x
     ]
-    if len(set(map(os.path.abspath, outputs))) != len(outputs):
-        raise ParameterError("two outputs share one path")
     if args.per_face and not args.report:
         raise ParameterError("--per-face needs --report")
     check_options(args.op, args)
-    for path in outputs:
-        check_output(path, [args.input], args.force)
+    check_outputs(outputs, [args.input], args.force)
     if args.report == "-":
         args.quiet = True  # standard output carries the report alone
     soup = load(args.input)
+    for path in outputs:  # nor over the MTL or a texture the model reads
+        check_not_read(path, soup)
     detail(args, f"{args.input}: {soup.n_faces} faces, {soup.n_parts} parts")
     removed = getattr(args, "removed", None)
     # every output appears at the end, together, or none does (an error, Ctrl-C, SIGTERM)

@@ -17,6 +17,13 @@ def check_output(path: str, inputs: list[str], force: bool) -> None:
     check(path, inputs, force)
 
 
+def check_outputs(paths: list[str], inputs: list[str], force: bool) -> None:
+    """:func:`meshvis.io.check_outputs`."""
+    from meshvis.io import check_outputs as check
+
+    check(paths, inputs, force)
+
+
 def staged_outputs():
     """:func:`meshvis.io.staged_outputs`."""
     from meshvis.io import staged_outputs as staged
@@ -195,6 +202,7 @@ def stderr(*text: Any) -> None:
 __all__ = [
     "point",
     "check_output",
+    "check_outputs",
     "staged_outputs",
     "write_json",
     "say",

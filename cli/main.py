@@ -26,6 +26,7 @@ COMMANDS = {
     "visible": "meshvis.cli.cmd_visible",
     "pvs": "meshvis.cli.cmd_pvs",
     "label": "meshvis.cli.cmd_label",
+    "view": "meshvis.cli.cmd_view",
     "batch": "meshvis.cli.cmd_batch",
     "bench": "meshvis.cli.cmd_bench",
 }
@@ -105,6 +106,9 @@ def main(argv: list[str] | None = None) -> int:
     from meshvis.errors import MeshvisError
 
     argv = sys.argv[1:] if argv is None else list(argv)
+    # a file name that is not UTF-8 must not stop a message about it: print such bytes escaped
+    if getattr(sys.stdout, "errors", None) == "strict" and hasattr(sys.stdout, "reconfigure"):
+        sys.stdout.reconfigure(errors="backslashreplace")
     # the top level has only -h and --version, so a command is the first argument; the
     # version needs no subcommand (building them all imports labeling and the kernels)
     first = argv[0] if argv else None

@@ -156,11 +156,19 @@ def _window(full: np.ndarray) -> tuple[int, int, int, int]:
     return 0, hp, 0, wp
 
 
-def _shortest(area: InternalArea, sides: tuple[int, ...], window: tuple[int, int, int, int]) -> tuple:
+def _shortest(
+    area: InternalArea,
+    sides: tuple[int, ...],
+    window: tuple[int, int, int, int],
+    prefer: np.ndarray | None = None,
+    keep: float = 1.0,
+) -> tuple:
     """Find the shortest leader over ``sides`` for each pixel of the window.
 
     Returns its length, endpoint, endpoint key on the padded grid and side code; the first
-    side listed wins ties.
+    side listed wins ties.  A pixel whose ``prefer`` (window-sized side codes, -1: none)
+    names one of ``sides`` keeps that side while its leader is at most ``keep`` times the
+    shortest.
     """
     full = area.mask
     hp, wp = full.shape
@@ -182,7 +190,10 @@ def _shortest(area: InternalArea, sides: tuple[int, ...], window: tuple[int, int
     side = np.full((hb, wb), -1, np.int8)
     key = np.full((hb, wb), -1, np.int64)
 
+    offers = []
+
     def offer(code: int, length: np.ndarray, bx: np.ndarray, by: np.ndarray, k: np.ndarray) -> None:
+        offers.append((code, length, bx, by, k))
         # strictly shorter wins, so the first direction listed wins ties
         better = mask & (length < best)
         best[better] = length[better]
@@ -206,17 +217,50 @@ def _shortest(area: InternalArea, sides: tuple[int, ...], window: tuple[int, int
                 # the EDT ran on the box: back to the padded grid's pixel indices
                 k = (k // wb + r0) * wp + k % wb + c0
                 offer(code, length, bx, by, 2 * hp + 2 * wp + k.reshape(hb, wb))
+    if prefer is not None and len(sides) > 1:
+        shortest = best.copy()
+        for code, length, bx, by, k in offers:
+            # hysteresis: a pixel of a label that left on this side last frame stays on it
+            # unless another side is clearly shorter
+            stay = mask & (prefer == code) & (side != code) & (length <= keep * shortest)
+            best[stay] = length[stay]
+            ex[stay] = np.broadcast_to(bx, (hb, wb))[stay]
+            ey[stay] = np.broadcast_to(by, (hb, wb))[stay]
+            key[stay] = np.broadcast_to(k, (hb, wb))[stay]
+            side[stay] = code
     best[~mask] = np.nan
     return mask, best, ex, ey, side, key
 
 
-def leader_candidates(area: InternalArea, layout: str) -> Candidates:
+def _dense_ids(keys: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """``np.unique(keys, return_index=True, return_inverse=True)[1:]`` for small non-negative keys.
+
+    The keys are pixel indices of a grid, so a lookup table replaces the sort.
+    """
+    if len(keys) == 0:
+        return np.zeros(0, np.int64), np.zeros(0, np.int64)
+    present = np.zeros(int(keys.max()) + 1, bool)
+    present[keys] = True
+    dense = np.cumsum(present) - 1
+    inv = dense[keys]
+    first = np.full(int(dense[-1]) + 1, len(keys), np.int64)
+    np.minimum.at(first, inv, np.arange(len(keys)))
+    return first, inv
+
+
+def leader_candidates(
+    area: InternalArea, layout: str, prefer: np.ndarray | None = None, keep: float = 1.0
+) -> Candidates:
     """Compute the candidate endpoint, length and side of every pixel of ``A_I``.
 
     Parameters
     ----------
     area : InternalArea
     layout : a key of :data:`LAYOUTS`
+    prefer : (h, w) int, optional: a side code per image pixel (-1: none) that the pixel
+        keeps while its leader on that side is at most ``keep`` times its shortest one
+        (frame-to-frame hysteresis of the sides)
+    keep : float, the length ratio of ``prefer``
 
     Returns
     -------
@@ -229,7 +273,12 @@ def leader_candidates(area: InternalArea, layout: str) -> Candidates:
     p = area.pad
     # work on the bounding box of A_I only (plus a pixel); keys keep the padded grid's indices
     r0, r1, c0, c1 = window = _window(area.mask)
-    mask, best, ex, ey, side, key = _shortest(area, sides, window)
+    pref = None
+    if prefer is not None:
+        padded = np.full((hp, wp), -1, np.int8)
+        padded[p : hp - p, p : wp - p] = prefer
+        pref = padded[r0:r1, c0:c1]
+    mask, best, ex, ey, side, key = _shortest(area, sides, window, pref, keep)
     d_max = float(np.nanmax(best)) if mask.any() else 1.0
     # out to the image: the part of the box inside it (the padding is cut off)
     H, W = hp - 2 * p, wp - 2 * p
@@ -245,7 +294,7 @@ def leader_candidates(area: InternalArea, layout: str) -> Candidates:
     exi, eyi, length = image(ex, np.nan), image(ey, np.nan), image(best, np.nan)
     side_img, key_img = image(side, -1), image(key, -1)
     inside = key_img >= 0
-    _, first, inv = np.unique(key_img[inside], return_index=True, return_inverse=True)
+    first, inv = _dense_ids(key_img[inside])
     eid = np.full(key_img.shape, -1, np.int64)
     eid[inside] = inv
     endpoints = np.column_stack([exi[inside][first], eyi[inside][first]])

@@ -9,16 +9,15 @@ predecessor.
 
 from __future__ import annotations
 
-import json
-import os
-from collections.abc import Mapping, Sequence
+import inspect
+from collections.abc import Sequence
 from typing import Any
 
-from meshvis.errors import ParameterError
+from meshvis import _validate
 from meshvis.rays.camera import Camera
 from meshvis.rays.caster import RayCaster
 
-from .inputs import load_models
+from .inputs import load_models, read_camera_path  # noqa: F401  (read_camera_path: re-exported)
 from .metrics import motion_metrics
 from .result import LayoutResult
 
@@ -34,51 +33,32 @@ def orbit(
     up: Sequence[float] = (0.0, 0.0, 1.0),
     fit_margin: float = 1.6,
     distance: float | None = None,
+    size: tuple[int, int] | None = None,
 ) -> list[Camera]:
-    """``n_frames`` cameras turning once around the model, framed for labels (see ``fit_margin``)."""
-    if int(n_frames) < 1:
-        raise ParameterError(f"an orbit needs at least 1 frame, got {n_frames}")
-    soup = load_models(model)
-    return Camera.orbit(
-        soup,
-        int(n_frames),
-        elevation=elevation,
-        start=start,
-        fov=fov,
-        orthographic=orthographic,
-        margin=fit_margin,
-        up=up,
-        distance=distance,
-    )
+    """``n_frames`` cameras turning once around the model, framed for labels.
 
-
-def read_camera_path(path: str | os.PathLike) -> list[Camera]:
-    """Cameras from a JSON file: a list of camera objects, or ``{"cameras": [...]}``.
-
-    Each camera object has the keys of :meth:`Camera.to_json` (``position``, ``target``,
-    optional ``up``, ``fov``, ``orthographic``, ``ortho_height``).
+    Each is :func:`meshvis.labeling.pipeline.fit_camera` at an azimuth ``start + 360 k / n``
+    (``fit_margin`` is its margin; ``size`` makes a portrait image fit its width too).  At
+    most ``MAX_FRAMES`` of :mod:`meshvis.limits`.
     """
-    path = os.fspath(path)
-    try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
-    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
-        raise ParameterError(f"{path}: cannot read the camera path: {exc}") from None
-    if isinstance(data, Mapping) and "cameras" in data:
-        data = data["cameras"]
-    if isinstance(data, Mapping):
-        data = [data]
-    if not isinstance(data, list) or not data:
-        raise ParameterError(f"{path}: expected a list of cameras")
-    cams = []
-    for i, d in enumerate(data):
-        if not isinstance(d, Mapping):
-            raise ParameterError(f"{path}: camera {i} is not an object")
-        try:
-            cams.append(Camera.from_json(dict(d)))
-        except (TypeError, ValueError) as exc:
-            raise ParameterError(f"{path}: camera {i}: {exc}") from None
-    return cams
+    from .pipeline import fit_camera
+
+    n_frames = _validate.frames(n_frames)
+    soup = load_models(model)
+    return [
+        fit_camera(
+            soup,
+            azimuth=start + 360.0 * k / int(n_frames),
+            elevation=elevation,
+            distance=distance,
+            fov=fov,
+            orthographic=orthographic,
+            up=up,
+            margin=fit_margin,
+            size=size,
+        )
+        for k in range(int(n_frames))
+    ]
 
 
 def layout_frames(
@@ -105,6 +85,7 @@ def layout_frames(
     """
     from .pipeline import layout
 
+    _validate.frames(len(cameras), options.get("size", inspect.signature(layout).parameters["size"].default))
     soup = load_models(model)
     caster = caster or RayCaster(soup)
     results: list[LayoutResult] = []

@@ -3,18 +3,27 @@
 Every candidate ``l`` of every labelled area carries its feasibility ``F(l)`` (Eq. 12).
 The loop
 
-1. computes the priority ``P_i = sum_{l in A_i} (1 - F(l))`` of every unlabelled area (Eq. 14),
+1. computes the priority of every unlabelled area: how few feasible candidates it has,
+   ``P_i = -sum_{l in A_i} F(l)`` (see below),
 2. takes the area with the highest priority,
-3. takes its most feasible candidate as the leader,
+3. takes its most feasible candidate as the leader (or, along a camera path, the candidate
+   at last frame's anchor while nothing is clearly better: hysteresis),
 4. updates the anchor- and endpoint-distance memberships ``f4``, ``f5`` (Eq. 4–7) of the
    candidates of the remaining areas, and the priorities with them,
 
 until every area has its leader.  No backtracking, no wall-clock rule.
 
+Priority.  §5.4 of appendix I wants "the areas with a low number of feasible leader line
+candidates" first, so that parts hard to label are placed before others take their room.
+Eq. 14 written out, ``sum (1 - F) = n_i - sum F``, grows with the pixel count ``n_i`` and
+so ranks the largest areas first, the opposite.  The fuzzy count of feasible candidates
+``sum F`` is what the text describes; the area with the least of it goes first.
+
 Speed.  ``F(l) = s(l) f4(l)^w4 f5(e(l))^w5`` where ``s`` collects the memberships that do
 not change (f2, f3, f6, f7) and ``f5`` depends on the endpoint only, which many candidates
-share (a row, a column, a boundary pixel).  So ``P_i = n_i - sum_e S[i, e] f5(e)^w5`` with
-``S[i, e] = sum of s f4^w4 over the candidates of area i with endpoint e``: a small dense
+share (a row, a column, a boundary pixel).  So with
+``S[i, e] = sum of s f4^w4 over the candidates of area i with endpoint e``, and
+``sum F = S @ f5^w5``: a small dense
 matrix (areas x distinct endpoints).  ``f5`` is updated per endpoint; ``f4`` changes only for
 candidates within ``d_a`` of the new anchor (found through a grid of buckets), and ``S``
 takes the change of those few.  One step costs O(areas x endpoints + touched candidates).
@@ -72,7 +81,7 @@ class GreedyResult:
     area_order : (k,) int, areas in the order they were labelled
     pick : (k,) int, chosen candidate (index into the candidate arrays) of each of them
     feasibility : (k,) float, ``F`` of the chosen candidate when it was chosen
-    priority : (k,) float, ``P_i`` of the area when it was chosen
+    priority : (k,) float, ``P_i = -sum F`` of the area when it was chosen
     """
 
     area_order: np.ndarray
@@ -95,6 +104,24 @@ def _infeasible_pick(rest: np.ndarray, f5a: np.ndarray, w5: float, d_e: float) -
     tie = rest * np.maximum(f5a, _F5_FLOOR) ** w5
     tie = np.where(f5a > 0, tie + 1.0, tie) if d_e > 0 else tie
     return int(np.argmax(tie))
+
+
+def _priority(S: np.ndarray, f5w: np.ndarray, count: np.ndarray) -> np.ndarray:
+    """``P_i = -sum F`` of every area: the fuzzy count of its feasible candidates, negated."""
+    return -(S @ f5w)
+
+
+def _near_pick(F: np.ndarray, dx: np.ndarray, dy: np.ndarray, drift: float, keep: float, best: int) -> int:
+    """Hysteresis: the best candidate within ``drift`` of the followed anchor (offsets ``dx``, ``dy``).
+
+    It wins unless the overall best ``F[best]`` is more than ``keep`` times its ``F``; with
+    no feasible candidate that near, ``best`` does.
+    """
+    near = np.flatnonzero(dx * dx + dy * dy <= drift * drift)
+    if len(near) == 0:
+        return best
+    j = int(near[np.argmax(F[near])])
+    return j if F[j] > 0 and F[best] <= keep * F[j] else best
 
 
 def _lower_f4(
@@ -131,6 +158,9 @@ def greedy_layout(
     d_e: float,
     w4: float = 1.0,
     w5: float = 1.0,
+    follow: np.ndarray | None = None,
+    drift: float = 0.0,
+    keep: float = 1.0,
 ) -> GreedyResult:
     """Run the greedy loop over candidates grouped by area.
 
@@ -145,6 +175,11 @@ def greedy_layout(
     n_areas : int, number of areas
     d_a, d_e : float, distance thresholds of Eq. 4 and Eq. 6, pixels (0 disables)
     w4, w5 : weights of f4 and f5
+    follow : (n_areas, 2) float, optional: per area the previous frame's anchor moved with
+        the model (NaN: none).  The area takes its best candidate within ``drift`` pixels
+        of it unless the best candidate overall has more than ``keep`` times its ``F``
+    drift : float, pixels, how far an anchor may slide from ``follow`` in one frame
+    keep : float, the hysteresis ratio of ``follow``
 
     Returns
     -------
@@ -168,11 +203,13 @@ def greedy_layout(
     order, picks, feas, prio = [], [], [], []
     while alive.any():
         f5w = f5**w5 if w5 != 1 else f5
-        P = count - S @ f5w
+        P = _priority(S, f5w, count)
         i = int(np.argmax(np.where(alive, P, -np.inf)))
         lo, hi = start[i], start[i + 1]
         F = static[lo:hi] * f4w[lo:hi] * f5w[eid[lo:hi]]
         j = int(np.argmax(F))
+        if follow is not None and np.isfinite(follow[i, 0]):
+            j = _near_pick(F, ax[lo:hi] - follow[i, 0], ay[lo:hi] - follow[i, 1], drift, keep, j)
         if F[j] <= 0.0:
             j = _infeasible_pick(static[lo:hi] * f4w[lo:hi], f5[eid[lo:hi]], w5, d_e)
         pick = lo + j

@@ -40,7 +40,7 @@ class InternalArea:
     mask : (h + 2 pad, w + 2 pad) bool, pixel centres inside the polygon (padded grid)
     left, right : (h + 2 pad,) float, x of the boundary on each padded row (NaN: row empty)
     top, bottom : (w + 2 pad,) float, y of the boundary on each padded column (NaN: empty)
-    integral : (h + 2 pad + 1, w + 2 pad + 1) int64 summed-area table of ``mask``
+    integral : (h + 2 pad + 1, w + 2 pad + 1) int32 summed-area table of ``mask``
     """
 
     kind: str
@@ -69,8 +69,11 @@ class InternalArea:
     @property
     def centroid(self) -> np.ndarray:
         """Centre of the pixels of the area, image coordinates."""
-        r, c = np.nonzero(self.mask)
-        return np.array([c.mean() + 0.5 - self.pad, r.mean() + 0.5 - self.pad])
+        rows, cols = self.mask.sum(axis=1), self.mask.sum(axis=0)
+        n = max(int(rows.sum()), 1)
+        r = float(rows @ np.arange(len(rows))) / n
+        c = float(cols @ np.arange(len(cols))) / n
+        return np.array([c + 0.5 - self.pad, r + 0.5 - self.pad])
 
     def boxes_hit(self, boxes: np.ndarray) -> np.ndarray:
         """Number of area pixels (centres) inside each box ``(n, 4)`` = (x0, y0, x1, y1).
@@ -95,7 +98,10 @@ def _hull(points: np.ndarray) -> np.ndarray:
     """Convex hull of 2D points, its corners in order (scipy's Qhull)."""
     from scipy.spatial import ConvexHull
 
-    pts = np.unique(np.round(np.asarray(points, np.float64), 9), axis=0)
+    pts = np.asarray(points, np.float64).reshape(-1, 2)
+    # drop repeated points (sorting complex numbers is much faster than np.unique(axis=0))
+    z = np.unique(np.round(pts[:, 0], 9) + 1j * np.round(pts[:, 1], 9))
+    pts = np.column_stack([z.real, z.imag])
     if len(pts) < 3:
         return pts
     try:
@@ -146,6 +152,31 @@ def _disc(k: int = 16) -> np.ndarray:
     return np.column_stack([np.cos(ang), np.sin(ang)]) / np.cos(np.pi / k)
 
 
+def _grown_corners(hull: np.ndarray, margin: float, k: int) -> np.ndarray:
+    """The points whose convex hull is ``hull`` grown by ``margin`` (corners plus a ``k``-gon).
+
+    Only the offsets that can lie on the grown hull are kept: at each corner those whose
+    direction is within one step of the ``k``-gon of the cone between the normals of the
+    corner's two edges.  The hull of these is the hull of all ``len(hull) * k`` points.
+    """
+    disc = _disc(k)
+    if len(hull) < 3:
+        return (hull[:, None, :] + margin * disc[None]).reshape(-1, 2)
+    e = np.roll(hull, -1, axis=0) - hull
+    after = np.arctan2(-e[:, 0], e[:, 1])  # direction of each edge's right-hand normal
+    before = np.roll(after, 1)
+    nxt = np.roll(e, -1, axis=0)
+    if (e[:, 0] * nxt[:, 1] - e[:, 1] * nxt[:, 0]).sum() < 0:
+        # clockwise corners: outward are the left-hand normals, and they turn the other way
+        after, before = before + np.pi, after + np.pi
+    phi = np.arctan2(disc[:, 1], disc[:, 0])
+    step = 2 * np.pi / k
+    turn = np.mod(after - before, 2 * np.pi)
+    rel = np.mod(phi[None, :] - before[:, None] + step, 2 * np.pi)
+    near = rel <= turn[:, None] + 2 * step
+    return (hull[:, None, :] + margin * disc[None])[near]
+
+
 def internal_area(
     model_mask: np.ndarray,
     kind: str = "hull",
@@ -182,7 +213,7 @@ def internal_area(
     corners = _row_extremes(model_mask)
     hull = _hull(corners)
     if kind == "hull":
-        polygon = _hull((hull[:, None, :] + margin * _disc(64)[None]).reshape(-1, 2)) if margin > 0 else hull
+        polygon = _hull(_grown_corners(hull, margin, 64)) if margin > 0 else hull
     elif kind == "circle":
         lo, hi = hull.min(axis=0), hull.max(axis=0)
         center = 0.5 * (lo + hi)
@@ -191,7 +222,8 @@ def internal_area(
     else:
         lo, hi = hull.min(axis=0) - margin, hull.max(axis=0) + margin
         polygon = np.array([[lo[0], lo[1]], [lo[0], hi[1]], [hi[0], hi[1]], [hi[0], lo[1]]])
-    polygon = _hull(polygon)
+    if kind != "hull" or margin <= 0:
+        polygon = _hull(polygon)
     # the padded grid holds the whole polygon
     lo, hi = polygon.min(axis=0), polygon.max(axis=0)
     pad = int(max(2, np.ceil(max(-lo.min(), hi[0] - w, hi[1] - h, 0.0)) + 2))
@@ -201,8 +233,8 @@ def internal_area(
     xc = np.arange(wp) + 0.5 - pad
     with np.errstate(invalid="ignore"):
         mask = (xc[None, :] >= left[:, None]) & (xc[None, :] <= right[:, None])
-    integral = np.zeros((hp + 1, wp + 1), np.int64)
-    integral[1:, 1:] = mask.cumsum(axis=0).cumsum(axis=1)
+    integral = np.zeros((hp + 1, wp + 1), np.int32)
+    integral[1:, 1:] = mask.cumsum(axis=0, dtype=np.int32).cumsum(axis=1, dtype=np.int32)
     return InternalArea(
         kind=kind,
         margin=margin,

@@ -207,3 +207,86 @@ def is_clean(metrics: dict[str, Any]) -> bool:
         and metrics["label_over_model"] == 0
         and metrics["invalid_anchors"] == 0
     )
+
+
+#: a label whose box centre moves more than this between two frames (pixels) has jumped
+JUMP_PX = 50.0
+
+
+def _side_changed(a, b) -> bool:
+    """The label left on another side; a radial one: its box turned > 90 degrees about its anchor."""
+    if a.side != b.side:
+        return True
+    if a.side != "radial":
+        return False
+    da = (a.box[:2] + a.box[2:]) / 2 - a.anchor
+    db = (b.box[:2] + b.box[2:]) / 2 - b.anchor
+    return bool(np.dot(da, db) < 0)
+
+
+def orbit_coherence(results: Sequence[LayoutResult], jump: float = JUMP_PX) -> dict[str, Any]:
+    """How well the labels of a frame sequence follow the model.
+
+    For every pair of consecutive frames and every label both frames have, the *surface
+    motion* is how far the surface point under the earlier anchor moved on the screen
+    (the point ``anchor_3d`` of the earlier frame projected with the later camera), and the
+    *label motion* how far the box centre moved.  A transition is *jumpy* when one of its
+    labels moves more than ``jump`` pixels or changes side (for the silhouette layout:
+    its box turns by more than 90 degrees around its anchor).
+
+    Parameters
+    ----------
+    results : sequence of LayoutResult
+        The frames, in order.
+    jump : float
+        The label motion (pixels) that counts as a jump.
+
+    Returns
+    -------
+    dict
+        ``transitions``, ``jumpy_transitions``, ``jumpy_fraction``, ``jumps`` and
+        ``side_changes`` (labels), ``label_motion_mean`` and ``surface_motion_mean``
+        (pixels per label and transition) and ``motion_ratio`` (their quotient; 0 without a
+        shared label).
+
+    Examples
+    --------
+    >>> orbit_coherence([])["transitions"]
+    0
+    """
+    label_motion, surface_motion = [], []
+    jumpy = jumps = side_changes = 0
+    for prev, cur in zip(results[:-1], results[1:]):
+        a, b = prev.by_part(), cur.by_part()
+        common = sorted(set(a) & set(b))
+        if not common:
+            continue
+        w, h = cur.size
+        p3 = np.array([a[p].anchor_3d for p in common], np.float64).reshape(-1, 3)
+        moved, _ = cur.camera.project(p3, w, h)
+        was = np.array([a[p].anchor for p in common])
+        surface = np.hypot(*(moved - was).T)
+        centre = np.array(
+            [[(b[p].box[:2] + b[p].box[2:]) / 2, (a[p].box[:2] + a[p].box[2:]) / 2] for p in common]
+        )
+        label = np.hypot(*(centre[:, 0] - centre[:, 1]).T)
+        flips = np.array([_side_changed(a[p], b[p]) for p in common])
+        ok = np.isfinite(surface)
+        label_motion.extend(label[ok])
+        surface_motion.extend(surface[ok])
+        jumps += int((label > jump).sum())
+        side_changes += int(flips.sum())
+        jumpy += int(bool((label > jump).any() or flips.any()))
+    n = max(len(results) - 1, 0)
+    lm = float(np.mean(label_motion)) if label_motion else 0.0
+    sm = float(np.mean(surface_motion)) if surface_motion else 0.0
+    return {
+        "transitions": n,
+        "jumpy_transitions": jumpy,
+        "jumpy_fraction": jumpy / n if n else 0.0,
+        "jumps": jumps,
+        "side_changes": side_changes,
+        "label_motion_mean": lm,
+        "surface_motion_mean": sm,
+        "motion_ratio": lm / sm if sm > 0 else 0.0,
+    }

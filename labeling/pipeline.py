@@ -43,6 +43,11 @@ from .text import TextStyle, default_font_size
 
 METHODS = ("fuzzy", "two-step")
 
+#: default of ``min_pixels``: a part seen by fewer pixels is not labelled.  An anchor needs
+#: a few pixels around it to be told apart from its neighbours (and to stay on its part
+#: from frame to frame); parts of a handful of pixels flicker in and out along a path
+MIN_PIXELS = 10
+
 #: stages that make up the per-frame layout time
 LAYOUT_STAGES = ("area", "candidates", "salience", "memberships", "greedy", "boxes")
 
@@ -57,12 +62,29 @@ def fit_camera(
     orthographic: bool = False,
     up: Sequence[float] | None = None,
     margin: float = 1.6,
+    size: tuple[int, int] | None = None,
 ) -> Camera:
     """The default labeling camera: like :meth:`Camera.fit` but with room around the model.
 
-    ``margin`` 1.6 leaves about a fifth of the image on each side for the labels.
+    ``margin`` 1.6 leaves about a fifth of the image on each side for the labels.  ``fov``
+    is the vertical field of view; with ``size`` = (width, height) of a portrait image the
+    narrower horizontal field of view decides the distance, so that the model fits both.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> soup = Soup(trimesh.creation.box().vertices, trimesh.creation.box().faces)
+    >>> wide, tall = fit_camera(soup, size=(400, 200)), fit_camera(soup, size=(200, 400))
+    >>> bool(np.linalg.norm(tall.position - tall.target) > np.linalg.norm(wide.position - wide.target))
+    True
     """
-    return Camera.fit(
+    aspect = 1.0 if size is None else float(size[0]) / float(size[1])
+    if aspect < 1.0 and distance is None and not orthographic:
+        # the bounding sphere (times margin) must fit the horizontal field of view too
+        radius = 0.5 * soup.diagonal or 1.0
+        half = np.arctan(np.tan(np.radians(fov) / 2) * aspect)
+        distance = margin * radius / np.sin(half)
+    cam = Camera.fit(
         soup,
         azimuth=azimuth,
         elevation=elevation,
@@ -72,6 +94,9 @@ def fit_camera(
         margin=margin,
         up=up,
     )
+    if orthographic and aspect < 1.0 and cam.ortho_height is not None:
+        cam = Camera(cam.position, cam.target, cam.up, cam.fov, True, cam.ortho_height / aspect)
+    return cam
 
 
 def _fit_font(
@@ -87,26 +112,88 @@ def _fit_font(
     return style
 
 
-def _previous_frame(
-    previous: LayoutResult, slot: np.ndarray, n: int
-) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The previous frame's anchor, endpoint and box centres of every label of this frame.
+#: hysteresis along a camera path: a label keeps last frame's anchor (followed on the
+#: surface) unless a candidate is more than ANCHOR_KEEP times as feasible, and keeps its
+#: side unless the other side's leader is shorter by more than the factor SIDE_KEEP
+ANCHOR_KEEP = 4.0
+SIDE_KEEP = 3.0
+#: how far an anchor may slide over its part from one frame to the next, as a fraction of
+#: ``d_S`` (and at least ANCHOR_DRIFT_PX): it creeps towards better places instead of jumping
+ANCHOR_DRIFT = 0.01
+ANCHOR_DRIFT_PX = 2.0
 
-    Anchor and endpoint are (n, 2); the box centre along each of the west, east, north and
-    south sides is (n, 4; y for west/east, x for north/south). Entries are NaN where the
-    label was absent or on another side.
+
+@dataclass
+class _Previous:
+    """The previous frame's labels, moved with the model into this frame.
+
+    Every array has a row per label of this frame (NaN / -1 where the label was absent).
+    The anchor is the previous anchor's surface point seen by this frame's camera; the
+    endpoint and box centres are moved by the same screen offset, so that a label that
+    follows its anchor counts as not having moved.
+
+    Attributes
+    ----------
+    anchor, endpoint : (n, 2) float
+    box : (n, 4) float, the box centre along the west, east, north and south sides (y for
+        west/east, x for north/south; NaN on the other sides)
+    side : (n,) int, side code (-1: absent)
+    centre : (n, 2) float, the box centre
+    leader : n polylines (k, 2) (None: absent), the leader without its anchor point
+    lines : (4,) float, the x of the west and east columns, the y of the north and south
+        rows (NaN: no label there); not moved
     """
+
+    anchor: np.ndarray
+    endpoint: np.ndarray
+    box: np.ndarray
+    side: np.ndarray
+    centre: np.ndarray
+    lines: np.ndarray
+    leader: list
+
+
+def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n: int) -> _Previous:
+    """Where the previous frame's labels are now (see :class:`_Previous`)."""
     anchor, endpoint, box = np.full((n, 2), np.nan), np.full((n, 2), np.nan), np.full((n, 4), np.nan)
+    side = np.full(n, -1, np.int64)
+    centre = np.full((n, 2), np.nan)
+    leader: list = [None] * n
+    lines = np.full(4, np.nan)
     for lab in previous.labels:
-        s = slot[lab.part] if lab.part < len(slot) else -1
-        if s < 0:
-            continue
-        anchor[s], endpoint[s] = lab.anchor, lab.endpoint
         code = SIDE_NAMES.index(lab.side)
+        if code < 4 and lab.tier == 0:
+            # the column's x is the box edge facing the model, the row's y the leader port's
+            lines[code] = {0: lab.box[2], 1: lab.box[0]}.get(
+                code, lab.leader[-1][1] if lab.tier == 0 else np.nan
+            )
+    labs = [lab for lab in previous.labels if lab.part < len(slot) and slot[lab.part] >= 0]
+    if not labs:
+        return _Previous(anchor, endpoint, box, side, centre, lines, leader)
+    h, w = idbuf.shape
+    moved, _ = idbuf.camera.project(np.array([lab.anchor_3d for lab in labs], np.float64), w, h)
+    for lab, now in zip(labs, moved):
+        s = slot[lab.part]
+        delta = now - lab.anchor if np.all(np.isfinite(now)) else np.zeros(2)
+        anchor[s], endpoint[s] = lab.anchor + delta, lab.endpoint + delta
+        code = SIDE_NAMES.index(lab.side)
+        side[s] = code
+        centre[s] = 0.5 * (lab.box[:2] + lab.box[2:]) + delta
+        leader[s] = lab.leader[1:] + delta
         if code < 4:
             axis = 1 if code < 2 else 0
-            box[s, code] = 0.5 * (lab.box[axis] + lab.box[axis + 2])
-    return anchor, endpoint, box
+            box[s, code] = 0.5 * (lab.box[axis] + lab.box[axis + 2]) + delta[axis]
+    return _Previous(anchor, endpoint, box, side, centre, lines, leader)
+
+
+def _preferred_sides(idbuf: IdBuffer, labelled: np.ndarray, prev: _Previous | None) -> np.ndarray | None:
+    """(h, w) side code of the previous frame's label of each pixel's part (-1: none)."""
+    if prev is None:
+        return None
+    of_part = np.full(len(idbuf.part_names) + 1, -1, np.int8)
+    known = prev.side >= 0
+    of_part[labelled[known]] = prev.side[known]
+    return of_part[idbuf.ids]  # background (-1) reads the last entry: -1
 
 
 class _Stopwatch:
@@ -272,7 +359,7 @@ def _fuzzy_picks(
     px: _Pixels,
     cand,
     weights: Weights,
-    previous: LayoutResult | None,
+    previous: _Previous | None,
     n: int,
     d_s: float,
     da_px: float,
@@ -282,19 +369,34 @@ def _fuzzy_picks(
 ) -> tuple[tuple[np.ndarray, ...], float]:
     """Compute the memberships and run the greedy loop.
 
-    The memberships follow Eq. 11, with the coherence terms f6, f7 given ``previous``.
+    The memberships follow Eq. 11, with the coherence terms f6, f7 given ``previous``
+    (measured from the previous anchors and endpoints moved with the model).
     Returns the area order, each area's pick, feasibility and priority, and the clock.
     """
     static = weighted(f2_length(px.length, cand.d_max), weights.w2) * weighted(
         f3_salience(px.sal, cand.d_max), weights.w3
     )
+    follow = None
     if previous is not None:
-        prev_a, prev_e, _ = _previous_frame(previous, px.slot, n)
-        static = static * weighted(f_coherence(px.ax, px.ay, prev_a[px.area_of], d_s), weights.w6)
-        static = static * weighted(f_coherence(px.ex, px.ey, prev_e[px.area_of], d_s), weights.w7)
+        static = static * weighted(f_coherence(px.ax, px.ay, previous.anchor[px.area_of], d_s), weights.w6)
+        static = static * weighted(f_coherence(px.ex, px.ey, previous.endpoint[px.area_of], d_s), weights.w7)
+        follow = previous.anchor
     t = clock.tick("memberships", t)
     g = greedy_layout(
-        px.area_of, px.ax, px.ay, px.eid, cand.endpoints, static, n, da_px, de_px, weights.w4, weights.w5
+        px.area_of,
+        px.ax,
+        px.ay,
+        px.eid,
+        cand.endpoints,
+        static,
+        n,
+        da_px,
+        de_px,
+        weights.w4,
+        weights.w5,
+        follow=follow,
+        drift=max(ANCHOR_DRIFT * d_s, ANCHOR_DRIFT_PX),
+        keep=ANCHOR_KEEP,
     )
     t = clock.tick("greedy", t)
     return (g.area_order, g.pick, g.feasibility, g.priority), t
@@ -334,7 +436,7 @@ def _place_labels(
     ia,
     image_size: tuple[int, int],
     spacing: Spacing,
-    previous: LayoutResult | None,
+    previous: _Previous | None,
     layout: str,
 ) -> tuple:
     """Place the boxes and leaders of the picked candidates (Step 8).
@@ -351,7 +453,7 @@ def _place_labels(
     anchors = np.column_stack([px.ax[pick_of], px.ay[pick_of]])
     endpoints = np.column_stack([px.ex[pick_of], px.ey[pick_of]])
     sides = px.side[pick_of].astype(np.int64)
-    prev_box = None if previous is None else _previous_frame(previous, px.slot, n)[2]
+    prev_box = None if previous is None else previous.box
     placements, stats = place_boxes(
         anchors,
         endpoints,
@@ -364,12 +466,77 @@ def _place_labels(
         spacing,
         prev_box,
         LAYOUTS[layout],
+        centres=None if previous is None else previous.centre,
+        leaders=None if previous is None else previous.leader,
+        lines=None if previous is None else previous.lines,
     )
     return rank, anchors, endpoints, placements, stats
 
 
+#: the smallest font a label is shrunk to to keep the boxes inside the image (pixels)
+MIN_FONT_SIZE = 6
+#: a camera fitted by :func:`layout` moves back by this factor, at most this many times,
+#: while labels do not fit the image
+ZOOM_OUT = 1.3
+ZOOM_OUT_STEPS = 3
+
+
+def _off_image(placements: list, size: tuple[int, int]) -> list[int]:
+    """Indices of the placed boxes that reach beyond the image."""
+    w, h = size
+    return [
+        k
+        for k, p in enumerate(placements)
+        if p is not None and (p.box[0] < 0 or p.box[1] < 0 or p.box[2] > w or p.box[3] > h)
+    ]
+
+
+def _inside_image(place, style: TextStyle, size: tuple[int, int], start: int | None = None) -> tuple:
+    """Place the boxes with the largest font (down to :data:`MIN_FONT_SIZE`) that keeps them in the image.
+
+    ``place(style)`` returns what :func:`_place_labels` does.  The sizes are searched by
+    bisection (a smaller font never needs more room), starting from ``start`` (the previous
+    frame's size along a camera path, so that it stays while it fits).  The boxes still
+    outside at the smallest size are left out (the labels become ``unplaced``;
+    ``params["outside_image"]`` names them).  Returns the style used, the placement and
+    the indices of the labels left out for this reason.
+    """
+    tried: dict[int, tuple] = {}
+
+    def fits(font: int) -> bool:
+        if font not in tried:
+            tried[font] = place(TextStyle(font))
+        return not _off_image(tried[font][3], size)
+
+    hi = style.font_size
+    lo = MIN_FONT_SIZE
+    if start is not None and lo <= start < hi and fits(start):
+        best = start
+    elif hi <= lo or fits(hi):
+        best = hi
+    elif not fits(lo):
+        best = lo
+    else:  # lo fits, hi does not
+        while hi - lo > 1:
+            mid = (lo + hi) // 2
+            lo, hi = (mid, hi) if fits(mid) else (lo, mid)
+        best = lo
+    fits(best)
+    placed = tried[best]
+    off = _off_image(placed[3], size)
+    for k in off:
+        placed[3][k] = None
+    return TextStyle(best), placed, off
+
+
 def _view_maps(
-    idbuf: IdBuffer, area: str, margin: float | None, layout: str, clock: _Stopwatch, t: float
+    idbuf: IdBuffer,
+    area: str,
+    margin: float | None,
+    layout: str,
+    prefer: np.ndarray | None,
+    clock: _Stopwatch,
+    t: float,
 ) -> tuple:
     """Compute the internal area, the leader candidates and the salience, timing each stage.
 
@@ -379,7 +546,7 @@ def _view_maps(
     """
     ia = internal_area(idbuf.model_mask, area, margin)
     t = clock.tick("area", t)
-    cand = leader_candidates(ia, layout)
+    cand = leader_candidates(ia, layout, prefer, SIDE_KEEP)
     t = clock.tick("candidates", t)
     dist_sil = silhouette_distance(idbuf.ids)
     t = clock.tick("salience", t)
@@ -487,9 +654,10 @@ def solve(
     previous: LayoutResult | None = None,
     method: str = "fuzzy",
     font_size: int | None = None,
-    min_pixels: int = 1,
+    min_pixels: int = MIN_PIXELS,
     spacing: Spacing | None = None,
     compute_metrics: bool = True,
+    inside: bool = True,
 ) -> LayoutResult:
     """Lay out the labels of a view whose ID buffer is known.
 
@@ -510,9 +678,14 @@ def solve(
         each area, then its candidate leader, then the same box corrections)
     font_size : label font size in pixels (default: :func:`labeling.text.default_font_size`;
         reduced for west/east layouts until the columns fit the image)
-    min_pixels : parts with fewer visible pixels are treated as invisible
+    min_pixels : parts with fewer visible pixels are treated as invisible (default
+        :data:`MIN_PIXELS`)
     spacing : Spacing of the boxes
     compute_metrics : measure the result (:func:`labeling.metrics.frame_metrics`)
+    inside : keep every box inside the image: shrink the font (down to
+        :data:`MIN_FONT_SIZE`), then leave out the labels that still do not fit
+        (``unplaced``, named in ``params["outside_image"]``); False lets boxes reach beyond
+        the image (the pictures' canvas grows to hold them)
 
     Returns
     -------
@@ -528,7 +701,11 @@ def solve(
     if len(labelled) == 0 or not idbuf.model_mask.any():
         empty = dict(layout=layout, method=method, area=area, margin=margin, font_size=font_size)
         return _nothing_to_label(idbuf, invisible, skipped, **empty, timings=clock.timings)
-    ia, cand, dist_sil, t = _view_maps(idbuf, area, margin, layout, clock, t)
+    slot = np.full(len(names), -1, np.int64)
+    slot[labelled] = np.arange(len(labelled))
+    prev = None if previous is None else _previous_frame(previous, idbuf, slot, len(labelled))
+    prefer = _preferred_sides(idbuf, labelled, prev)
+    ia, cand, dist_sil, t = _view_maps(idbuf, area, margin, layout, prefer, clock, t)
     px = _pixels(idbuf, cand, dist_sil, labelled, len(names))
     (h, w), d_s = idbuf.shape, idbuf.sphere_diameter
     style = _fit_font(len(labelled), layout, h, int(font_size or default_font_size(h)))
@@ -536,17 +713,26 @@ def solve(
     de_px = _endpoint_threshold(d_e, d_s, style, widths, layout, spacing)
     da_px = d_a * d_s
     if method == "fuzzy":
-        order, t = _fuzzy_picks(px, cand, weights, previous, len(labelled), d_s, da_px, de_px, clock, t)
+        order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t)
     else:
         order, t = _two_step_picks(px, len(labelled), clock, t)
-    rank, anchors, endpoints, placements, stats = _place_labels(
-        px, order, widths, style, ia, (w, h), spacing, previous, layout
-    )
+    label_texts_ = [texts[p] for p in labelled]
+
+    def place(st: TextStyle) -> tuple:
+        return _place_labels(px, order, st.box_widths(label_texts_), st, ia, (w, h), spacing, prev, layout)
+
+    if inside:
+        start = None if previous is None else int(previous.font_size)
+        style, placed, off_image = _inside_image(place, style, (w, h), start)
+    else:
+        placed, off_image = place(style), []
+    rank, anchors, endpoints, placements, stats = placed
     t = clock.tick("boxes", t)
     labels, unplaced = _collect_labels(idbuf, texts, labelled, order, rank, anchors, endpoints, placements)
     clock.timings["layout_ms"] = 1000.0 * sum(clock.timings.get(k, 0.0) for k in LAYOUT_STAGES)
     thresholds = _thresholds(d_a, d_e, d_s, da_px, de_px, cand.d_max)
     params = _params(layout, area, ia.margin, method, weights, thresholds, min_pixels, stats)
+    params["outside_image"] = [names[int(labelled[k])] for k in off_image]
     found = dict(labels=labels, invisible=invisible, unplaced=unplaced, skipped=skipped)
     result = _layout_result(
         idbuf, ia, style, **found, layout=layout, method=method, params=params, clock=clock
@@ -624,12 +810,15 @@ def layout(
     caster : a RayCaster of the same model to reuse (frames, benchmarks)
     color_by : colouring of the shaded picture
     **options : passed to :func:`solve` (area, margin, weights, d_a, d_e, previous, method,
-        font_size, min_pixels, spacing)
+        font_size, min_pixels, spacing, inside)
 
     Returns
     -------
     LayoutResult
-        ``timings`` has ``setup`` and ``idbuffer`` besides the layout stages.
+        ``timings`` has ``setup`` and ``idbuffer`` besides the layout stages.  With the
+        camera fitted here (``camera`` None), a view whose boxes do not fit the image is
+        taken again from up to :data:`ZOOM_OUT_STEPS` times farther away (by
+        :data:`ZOOM_OUT` each), until every label fits.
 
     Examples
     --------
@@ -647,8 +836,9 @@ def layout(
     warm_up()
     soup = load_models(model)
     caster = caster or RayCaster(soup)
+    fitted = camera is None
     if camera is None:
-        camera = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up, margin=fit_margin)
+        camera = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up, margin=fit_margin, size=size)
     if texts is None or isinstance(texts, Mapping):
         text_list = label_texts(soup.part_names, texts)
     else:
@@ -657,5 +847,13 @@ def layout(
     idbuf = id_buffer(soup, camera, size, caster=caster, color_by=color_by)
     t2 = time.perf_counter()
     result = solve(idbuf, text_list, layout=layout, **options)
+    for _ in range(ZOOM_OUT_STEPS if fitted else 0):
+        if not result.params.get("outside_image"):
+            break
+        # a camera fitted here leaves more room around the model instead of dropping labels
+        fit_margin *= ZOOM_OUT
+        camera = fit_camera(soup, azimuth=azimuth, elevation=elevation, up=up, margin=fit_margin, size=size)
+        idbuf = id_buffer(soup, camera, size, caster=caster, color_by=color_by)
+        result = solve(idbuf, text_list, layout=layout, **options)
     result.timings = {"setup": t1 - t0, "idbuffer": t2 - t1, **result.timings}
     return result

@@ -17,6 +17,8 @@ EXTRA_OF = {
     "adjustText": "bench",
     "distributed": "dask",
     "networkx": "graphml",
+    "anywidget": "notebook",
+    "playwright.sync_api": "browser",
 }
 
 

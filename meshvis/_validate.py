@@ -48,7 +48,10 @@ def real(
     """``value`` as a finite float in [lo, hi] (``(lo, hi]`` with ``open_lo``)."""
     if isinstance(value, (bool, np.bool_)) or not isinstance(value, (numbers.Real, np.floating, np.integer)):
         raise ParameterError(f"{name} must be a number, got {_shown(value)}")
-    v = float(value)
+    try:
+        v = float(value)
+    except OverflowError:  # an integer past the float range
+        v = float("inf")
     if not np.isfinite(v):
         raise ParameterError(f"{name} must be finite, got {v}")
     if lo is not None and (v <= lo if open_lo else v < lo):
@@ -69,6 +72,39 @@ def choice(name: str, value: Any, allowed: tuple) -> Any:
 def seed(value: Any) -> int:
     """A seed for :func:`numpy.random.default_rng`: an integer in [0, 2**128)."""
     return integer("seed", value, 0, _MAX_SEED - 1)
+
+
+def flag(name: str, value: Any) -> bool:
+    """``value`` when it is a boolean (``True``, ``False`` or a numpy bool; not ``"yes"``, not 1)."""
+    if not isinstance(value, (bool, np.bool_)):
+        raise ParameterError(f"{name} must be True or False, got {_shown(value)}")
+    return bool(value)
+
+
+def budget(value: Any) -> int | None:
+    """A ray budget: None (the default rule) or an integer of at least 1 (0 rays would call
+    every face unseen), at most ``MAX_RAYS``."""
+    if value is None:
+        return None
+    return integer("budget", value, 1, limits.MAX_RAYS, "MAX_RAYS")
+
+
+def visibility_args(
+    budget_value: Any, seed_value: Any, per_side: Any, min_new: Any, min_new_area: Any
+) -> None:
+    """The arguments of :func:`meshvis.visible_from` (see its docstring)."""
+    budget(budget_value)
+    seed(seed_value)
+    flag("per_side", per_side)
+    real("min_new", min_new, 0.0)
+    real("min_new_area", min_new_area, 0.0)
+
+
+def removal_args(keep_border: Any, budget_value: Any) -> None:
+    """The numeric arguments of :func:`meshvis.remove_interior`: rings kept (an integer of
+    at least 0) and the ray budget of the search for views."""
+    integer("keep_border", keep_border, 0)
+    budget(budget_value)
 
 
 def instance(name: str, value: Any, kind: type | tuple, optional: bool = False) -> Any:
@@ -97,6 +133,8 @@ def points(name: str, value: Any, shape: tuple[int, ...] = (3,)) -> np.ndarray:
     """Finite float64 array of shape ``(k, *shape)`` (one item of ``shape`` is taken as k = 1)."""
     try:
         a = np.asarray(value, dtype=np.float64)
+    except OverflowError:  # an integer past the float range
+        raise ParameterError(f"{name} must be finite") from None
     except (TypeError, ValueError):
         raise ParameterError(f"{name} must be numbers of shape (k, {', '.join(map(str, shape))})") from None
     if a.size == 0:
@@ -120,6 +158,20 @@ def image_size(size: Any) -> tuple[int, int]:
             f"size {w}x{h} is {w * h} pixels, more than the cap MAX_PIXELS of meshvis.limits ({limits.MAX_PIXELS})"
         )
     return w, h
+
+
+def frames(n_frames: Any, size: Any = None) -> int:
+    """The number of frames of a labelled sequence: an integer in [1, ``MAX_FRAMES``] whose
+    pictures of ``size`` (width, height) hold at most ``MAX_SEQUENCE_PIXELS`` together."""
+    n = integer("the number of frames", n_frames, 1, limits.MAX_FRAMES, "MAX_FRAMES")
+    if size is not None:
+        w, h = image_size(size)
+        if n * w * h > limits.MAX_SEQUENCE_PIXELS:
+            raise ParameterError(
+                f"{n} frames of {w}x{h} are {n * w * h} pixels, more than the cap MAX_SEQUENCE_PIXELS of "
+                f"meshvis.limits ({limits.MAX_SEQUENCE_PIXELS}); use fewer frames or smaller pictures"
+            )
+    return n
 
 
 def classify_args(
@@ -246,8 +298,11 @@ def names(name: str, value: Any) -> list[str]:
 
 
 def operation_options(options: Mapping[str, Any]) -> None:
-    """The classification options of a repair operation (``seed``, ``rays_per_node``,
-    ``rays_per_point``, ``samples_per_face``), checked once before a batch starts."""
+    """The numeric options of a repair operation, checked once before a batch starts: the
+    classification's (``seed``, ``rays_per_node``, ``rays_per_point``,
+    ``samples_per_face``) and, when given, inside removal's (``keep_border``, ``budget``)."""
+    if "keep_border" in options or "budget" in options:
+        removal_args(options.get("keep_border", 0), options.get("budget"))
     seed(options.get("seed", 0))
     integer(
         "rays_per_node", options.get("rays_per_node", 32), 1, limits.MAX_RAYS_PER_NODE, "MAX_RAYS_PER_NODE"
@@ -263,10 +318,50 @@ def operation_options(options: Mapping[str, Any]) -> None:
     )
 
 
-def ray_budget(total: int, n_nodes: int, rays_per_node: int) -> None:
-    """Refuse a classification whose ray budget exceeds :data:`meshvis.limits.MAX_RAYS`."""
-    if total > limits.MAX_RAYS:
+def ray_budget(soup, rays_per_node: int, rays_per_point: int, samples_per_face: int) -> None:
+    """Refuse a classification that may ask for more rays than its input's size allows.
+
+    The bound is taken before any work: every face flagged, ``2 x samples_per_face x
+    rays_per_point`` rays and as many reverse rays per face, or ``2 x rays_per_node``,
+    whichever is more.  The cap is :data:`meshvis.limits.RAYS_PER_INPUT_BYTE` rays per byte
+    of the input (:func:`input_bytes`), at least :data:`meshvis.limits.MIN_RAY_CAP`: a small
+    file that places many faces cannot ask for unbounded work, a large model may ask for
+    as much as its size.
+    """
+    per_face = 2 * max(int(rays_per_node), 2 * int(samples_per_face) * int(rays_per_point))
+    asked = soup.n_faces * per_face
+    size = input_bytes(soup)
+    cap = max(limits.RAYS_PER_INPUT_BYTE * size, limits.MIN_RAY_CAP)
+    if asked > cap:
+        where = f"{soup.path}: " if soup.path else ""
         raise ParameterError(
-            f"the ray budget is {total} rays ({n_nodes} nodes at rays_per_node={rays_per_node}), more than "
-            f"the cap MAX_RAYS of meshvis.limits ({limits.MAX_RAYS}); lower rays_per_node or samples_per_face"
+            f"{where}{soup.n_faces} faces may ask for {asked} rays ({per_face} per face at rays_per_node="
+            f"{rays_per_node}, rays_per_point={rays_per_point}, samples_per_face={samples_per_face}), more than "
+            f"the {cap} an input of {size} bytes may (RAYS_PER_INPUT_BYTE of meshvis.limits, "
+            f"{limits.RAYS_PER_INPUT_BYTE}); lower rays_per_node, rays_per_point or samples_per_face"
         )
+
+
+def input_bytes(soup) -> int:
+    """Bytes of a model's input: its file (a ``.gltf``'s external buffers too), or its arrays.
+
+    Examples
+    --------
+    >>> import numpy as np
+    >>> from meshvis.soup import Soup
+    >>> input_bytes(Soup(np.eye(3), np.array([[0, 1, 2]])))
+    96
+    """
+    path = soup.path
+    if path is None or not os.path.isfile(path):
+        return int(soup.vertices.nbytes + soup.faces.nbytes)
+    size = os.path.getsize(path)
+    data = getattr(soup.source, "data", None)
+    doc, folder = getattr(data, "doc", None), getattr(data, "folder", None)
+    if isinstance(doc, dict) and isinstance(folder, str):  # a .gltf and its .bin files
+        for buf in doc.get("buffers", []):
+            uri = buf.get("uri") if isinstance(buf, dict) else None
+            if isinstance(uri, str) and not uri.startswith("data:"):
+                other = os.path.join(folder, uri)
+                size += os.path.getsize(other) if os.path.isfile(other) else 0
+    return int(size)

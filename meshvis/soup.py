@@ -66,6 +66,24 @@ class SourceRecord:
     data: Any = None
 
 
+def _shaped(name: str, value: Any, dtype: type, shape: tuple[int, ...]) -> np.ndarray:
+    """``value`` as a contiguous ``dtype`` array of ``shape`` (-1: any length).
+
+    Anything else raises a :class:`ModelError` naming the attribute.
+    """
+    try:
+        return np.ascontiguousarray(value, dtype=dtype).reshape(shape)
+    except (TypeError, ValueError, OverflowError):
+        shown = (
+            "(" + ", ".join("k" if n < 0 else str(n) for n in shape) + ("," if len(shape) == 1 else "") + ")"
+        )
+        try:
+            got = f"shape {np.shape(value)}"
+        except ValueError:  # ragged
+            got = f"a ragged {type(value).__name__}"
+        raise ModelError(f"{name} must be numbers of shape {shown}, got {got}") from None
+
+
 @dataclass(eq=False)
 class Soup:
     """A triangle soup with per-face attributes.
@@ -128,29 +146,35 @@ class Soup:
     up: tuple[float, float, float] = (0.0, 0.0, 1.0)
 
     def __post_init__(self) -> None:
-        self.vertices = np.ascontiguousarray(self.vertices, dtype=np.float64).reshape(-1, 3)
-        self.faces = np.ascontiguousarray(self.faces, dtype=np.int64).reshape(-1, 3)
+        self.vertices = _shaped("vertices", self.vertices, np.float64, (-1, 3))
+        self.faces = _shaped("faces", self.faces, np.int64, (-1, 3))
         m = len(self.faces)
         if self.part_id is None:
             self.part_id = np.zeros(m, np.int64)
-        self.part_id = np.asarray(self.part_id, np.int64).reshape(m)
+        self.part_id = _shaped("part_id", self.part_id, np.int64, (m,))
+        if m and self.part_id.min() < 0:
+            raise ModelError(f"part_id must be at least 0, got {int(self.part_id.min())}")
         if not self.part_names:
             n_parts = int(self.part_id.max()) + 1 if m else 1
             self.part_names = [f"part{i}" for i in range(n_parts)]
+        if m and self.part_id.max() >= len(self.part_names):
+            raise ModelError(
+                f"part_id {int(self.part_id.max())} names no part (there are {len(self.part_names)} part names)"
+            )
         if self.source_face is None:
             self.source_face = np.arange(m, dtype=np.int64)
-        self.source_face = np.asarray(self.source_face, np.int64).reshape(m)
+        self.source_face = _shaped("source_face", self.source_face, np.int64, (m,))
         if self.material_id is None:
             self.material_id = np.full(m, -1, np.int64)
-        self.material_id = np.asarray(self.material_id, np.int64).reshape(m)
+        self.material_id = _shaped("material_id", self.material_id, np.int64, (m,))
         if self.origin is None:
             self.origin = np.arange(m, dtype=np.int64)
-        self.origin = np.asarray(self.origin, np.int64).reshape(m)
+        self.origin = _shaped("origin", self.origin, np.int64, (m,))
         if self.uv is not None:
-            self.uv = np.asarray(self.uv, np.float64).reshape(m, 3, 2)
+            self.uv = _shaped("uv", self.uv, np.float64, (m, 3, 2))
         if self.colors is not None:
-            self.colors = np.asarray(self.colors, np.uint8).reshape(m, 3, 4)
-        up = np.asarray(self.up, np.float64).reshape(3)
+            self.colors = _shaped("colors", self.colors, np.uint8, (m, 3, 4))
+        up = _shaped("up", self.up, np.float64, (3,))
         norm = float(np.linalg.norm(up))
         if not np.isfinite(norm) or norm == 0:
             raise ModelError(f"the up direction must be a finite non-zero vector, got {up.tolist()}")

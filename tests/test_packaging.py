@@ -78,3 +78,11 @@ def test_wheel_has_one_top_level_name(tmp_path):
     # every module of the source tree is in the wheel (a new subpackage needs its pyproject entry)
     assert {n for n in names if n.endswith(".py")} >= set(_source_modules())
     assert any(n.endswith(".dist-info/licenses/LICENSE") for n in names)
+    # the page of `meshvis view` and the three.js it loads, with three.js's licence
+    web = [
+        p.relative_to(ROOT / "labeling").as_posix()
+        for p in (ROOT / "labeling" / "web").rglob("*")
+        if p.is_file()
+    ]
+    assert web and {f"meshvis/labeling/{p}" for p in web} <= set(names)
+    assert "meshvis/labeling/web/vendor/three/LICENSE" in names

@@ -23,6 +23,21 @@ NEAR_REACH = 0.4
 RAY_REACHES = 2.0
 #: floor of a tangent length (pixels) where boundary points coincide
 _TINY = 1e-12
+#: hysteresis of the columns and rows along a camera path: a column (row) stays where it
+#: was last frame while it is still clear of ``A_I`` and at most this fraction of the
+#: image's smaller side farther out than needed
+LINE_SLACK = 0.06
+
+
+def _sticky(needed: float, before: float, outward: float, slack: float) -> float:
+    """The column (row) coordinate: ``before`` while valid and within ``slack``, else ``needed``.
+
+    ``outward`` is -1 for west/north (smaller coordinates are farther out), +1 otherwise.
+    """
+    if not np.isfinite(before):
+        return needed
+    extra = (before - needed) * outward
+    return float(before) if 0.0 <= extra <= slack else needed
 
 
 class Context:
@@ -41,6 +56,8 @@ class Context:
         rank,
         previous=None,
         directions=None,
+        centres=None,
+        lines=None,
     ):
         self.anchors = np.asarray(anchors, np.float64).reshape(-1, 2)
         # per label: its box centre along each side in the previous frame (NaN: elsewhere)
@@ -59,13 +76,20 @@ class Context:
         self.rank = np.asarray(rank, np.int64)
         self.placed: list[Placement | None] = [None] * len(self.anchors)
         x0, y0, x1, y1 = area.bbox
+        # per label: where its box centre would be had it followed its anchor since the
+        # previous frame (NaN: no previous frame), for the silhouette layout's search
+        self.centres = (
+            np.full((len(self.anchors), 2), np.nan) if centres is None else np.asarray(centres, np.float64)
+        )
+        before = np.full(4, np.nan) if lines is None else np.asarray(lines, np.float64)
+        slack = LINE_SLACK * min(self.W, self.H)
         self.col_x = {
-            WEST: float(np.nanmin(area.left)) - spacing.clearance,
-            EAST: float(np.nanmax(area.right)) + spacing.clearance,
+            WEST: _sticky(float(np.nanmin(area.left)) - spacing.clearance, before[WEST], -1.0, slack),
+            EAST: _sticky(float(np.nanmax(area.right)) + spacing.clearance, before[EAST], 1.0, slack),
         }
         self.row_y = {
-            NORTH: float(np.nanmin(area.top)) - spacing.clearance,
-            SOUTH: float(np.nanmax(area.bottom)) + spacing.clearance,
+            NORTH: _sticky(float(np.nanmin(area.top)) - spacing.clearance, before[NORTH], -1.0, slack),
+            SOUTH: _sticky(float(np.nanmax(area.bottom)) + spacing.clearance, before[SOUTH], 1.0, slack),
         }
         self.center = area.centroid
         self.stats = BoxStats()

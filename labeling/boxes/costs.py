@@ -15,6 +15,9 @@ SHIFTED = 0.5
 #: a north/south flag box one tier further out costs twice the tier's pitch of leader: it
 #: lengthens its own leader and stands in the way of its neighbours' leaders
 ROW_TIER_COST = 2.0
+#: cost per pixel between a silhouette box and its place in the previous frame moved with
+#: its anchor (frame-to-frame coherence of the boxes)
+COHERENCE_COST = 1.0
 #: penalty of a box outside the image: taken only where no box inside the image is valid
 OUTSIDE_IMAGE_COST = 1e4
 #: penalty per later label whose push-out ray a silhouette box blocks

@@ -9,7 +9,7 @@ from ..geometry2d import boxes_overlap, segment_hits_box, segments_intersect
 from ..internal_area import InternalArea
 from .context import Context
 from .search import _search
-from .silhouette import _place_ring
+from .silhouette import _keep_previous, _place_ring
 from .spacing import BoxStats, Placement, Spacing
 from .stacking import _place_column, _place_row
 
@@ -49,6 +49,25 @@ def _conflicting(ctx: Context) -> list[int]:
     return sorted(redo, key=lambda i: (ctx.rank[i], i))
 
 
+def _place_radial(ctx: Context, ring: np.ndarray, endpoints_in: np.ndarray, leaders: list | None) -> None:
+    """Silhouette boxes: keep last frame's valid boxes (hysteresis), search places for the others.
+
+    When that leaves a label without room, every box of the ring is searched for afresh
+    (the search still prefers the places the boxes had, :data:`~.costs.COHERENCE_COST`).
+    """
+    state = (ctx.stats.shifted, ctx.stats.swaps, len(ctx.stats.unplaced))
+    kept = _keep_previous(ctx, ring, leaders)
+    _place_ring(ctx, ring[~np.isin(ring, kept)])
+    if kept and len(ctx.stats.unplaced) > state[2]:
+        ctx.stats.shifted, ctx.stats.swaps = state[:2]
+        del ctx.stats.unplaced[state[2] :]
+        for k in ring:
+            ctx.placed[k] = None
+        ctx.endpoints[ring] = endpoints_in[ring]
+        ctx._rays = None
+        _place_ring(ctx, ring)
+
+
 def place_boxes(
     anchors: np.ndarray,
     endpoints: np.ndarray,
@@ -61,6 +80,10 @@ def place_boxes(
     spacing: Spacing | None = None,
     previous: np.ndarray | None = None,
     directions: tuple[int, ...] | None = None,
+    *,
+    centres: np.ndarray | None = None,
+    leaders: list | None = None,
+    lines: np.ndarray | None = None,
 ) -> tuple[list[Placement | None], BoxStats]:
     """Lay out the boxes and leaders of all labels of one frame.
 
@@ -78,6 +101,13 @@ def place_boxes(
         NaN where it was not on that side), for :func:`coherent_order`
     directions : side codes of the layout (default: those in ``sides``); a label with no
         room on its side may move to another one of them
+    centres : (n, 2) float, optional: each label's box centre in the previous frame moved
+        with its anchor (NaN: none); silhouette boxes prefer places near it
+    leaders : n polylines or None, optional: each label's leader in the previous frame
+        moved with its anchor, without the anchor point; a silhouette box is kept with it
+    lines : (4,) float, optional: the x of the west and east columns and the y of the north
+        and south rows in the previous frame (NaN: none); a column or row stays there while
+        that is still valid and not much farther out than needed
 
     Returns
     -------
@@ -98,12 +128,15 @@ def place_boxes(
         rank,
         previous,
         directions,
+        centres,
+        lines,
     )
+    endpoints_in = ctx.endpoints.copy()
     for side in (WEST, EAST):
         _place_column(ctx, np.flatnonzero(ctx.sides == side), side)
     for side in (NORTH, SOUTH):
         _place_row(ctx, np.flatnonzero(ctx.sides == side), side)
-    _place_ring(ctx, np.flatnonzero(ctx.sides == RADIAL))
+    _place_radial(ctx, np.flatnonzero(ctx.sides == RADIAL), endpoints_in, leaders)
     for _ in range(REPAIR_ROUNDS):
         redo = _conflicting(ctx)
         if not redo:

@@ -9,9 +9,10 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry2d import boxes_overlap, polyline_length, segment_hits_box
+from ._kernels import first_free
 from .collisions import _boxes_free, _leaders_free, _outside_image, _place, _placed_arrays
 from .context import NEAR_REACH, Context
-from .costs import BEHIND_PORT_COS, BEHIND_PORT_COST, BLOCKED_RAY_COST, OUTSIDE_IMAGE_COST
+from .costs import BEHIND_PORT_COS, BEHIND_PORT_COST, BLOCKED_RAY_COST, COHERENCE_COST, OUTSIDE_IMAGE_COST
 from .stacking import pack_1d, uncross
 
 #: push-out tiers of a silhouette box are half a box height (plus the gap) apart: boxes of
@@ -100,9 +101,16 @@ def _radial_candidates(
     half = np.array([w / 2, h / 2])
     boxes = np.concatenate([c - half, c + half], axis=1)
     cost = cost[ie, it, ia] + OUTSIDE_IMAGE_COST * _outside_image(ctx, boxes)
+    if np.isfinite(ctx.centres[k, 0]):
+        # along a camera path: a pixel of distance from where the box was (moved with its
+        # anchor) costs as much as a pixel of leader
+        cost = cost + COHERENCE_COST * np.hypot(*(c - ctx.centres[k]).T)
     keep = cost < below
     lid = (ie * n_t + it)[keep]
-    used, lid = np.unique(lid, return_inverse=True)
+    # np.nonzero walks (endpoint, tier, attach) in order, so lid is sorted: number its runs
+    new = np.ones(len(lid), bool)
+    new[1:] = lid[1:] != lid[:-1]
+    used, lid = lid[new], np.cumsum(new) - 1
     ue, ut = np.divmod(used, n_t)
     leaders = np.stack([np.broadcast_to(a, (len(used), 2)), E[ue], port[ut, ue]], axis=1)
     return boxes[keep], leaders, lid.ravel(), cost[keep], it[keep], moved[ie[keep]]
@@ -123,16 +131,23 @@ def _cheapest(
     """
     boxes, leaders, leader_of, cost = cands[:4]
     pboxes, psegs = _placed_arrays(ctx, k)
-    idx = np.argsort(cost, kind="stable")
-    idx = idx[_boxes_free(ctx, boxes[idx], pboxes, psegs)]
-    used, inverse = np.unique(leader_of[idx], return_inverse=True)
-    idx = idx[_leaders_free(leaders[used], pboxes, psegs, paths)[inverse.ravel()]]
-    if len(idx) == 0:
-        return None, None
-    blocks = segment_hits_box(rays, boxes[idx]).sum(axis=0) if len(rays) else np.zeros(len(idx))
-    if (blocks == 0).any():
-        return int(idx[np.argmax(blocks == 0)]), None
-    return None, int(idx[np.argmin(cost[idx] + BLOCKED_RAY_COST * blocks)])
+    order = np.argsort(cost, kind="stable")
+    free, fallback = first_free(
+        order,
+        np.ascontiguousarray(boxes, np.float64),
+        np.ascontiguousarray(leader_of, np.int64),
+        np.ascontiguousarray(leaders, np.float64),
+        np.ascontiguousarray(cost, np.float64),
+        ctx.area.integral,
+        int(ctx.area.pad),
+        np.ascontiguousarray(pboxes, np.float64),
+        np.ascontiguousarray(psegs, np.float64).reshape(-1, 2, 2),
+        np.zeros((0, 2, 2)) if paths is None else np.ascontiguousarray(paths, np.float64).reshape(-1, 2, 2),
+        np.ascontiguousarray(rays, np.float64).reshape(-1, 2, 2),
+        float(ctx.sp.gap),
+        float(BLOCKED_RAY_COST),
+    )
+    return (int(free) if free >= 0 else None), (int(fallback) if fallback >= 0 else None)
 
 
 def _search_radial(ctx: Context, k: int) -> bool:
@@ -280,6 +295,59 @@ def _run_order(ctx: Context, ring: np.ndarray) -> list[int]:
             order.extend(int(k) for k in dict.fromkeys((run[lo], run[hi])))
             lo, hi = lo + 1, hi - 1
     return order
+
+
+#: a box kept from the previous frame must hang off its leader within this angle of the
+#: boundary's outward normal at the leader's endpoint (cosine): not behind the leader
+KEEP_COS = 0.5
+
+
+def _kept_leaders(ctx: Context, k: int, c: np.ndarray, half: np.ndarray, before: np.ndarray | None) -> list:
+    """Leaders a kept box may hang off: last frame's moved with the anchor, then one from this frame's endpoint."""
+    out = []
+    if before is not None:
+        out.append(np.vstack([ctx.anchors[k][None], before]))
+    e, n = ctx.endpoints[k], ctx.ray_direction(k)
+    ports = c - _ATTACH * half  # the attach points of the box
+    d = ports - e
+    length = np.maximum(np.hypot(d[:, 0], d[:, 1]), 1e-9)
+    facing = (d @ n) / length >= KEEP_COS
+    if facing.any():
+        out.append(np.array([ctx.anchors[k], e, ports[np.flatnonzero(facing)[np.argmin(length[facing])]]]))
+    return out
+
+
+def _keep_previous(ctx: Context, idx: np.ndarray, leaders: list | None = None) -> list[int]:
+    """Hysteresis of the silhouette layout: keep last frame's boxes where they are still valid.
+
+    Each label (in greedy order) whose box moved with its anchor (``ctx.centres``) still
+    covers no model pixel, no placed box or leader, stays inside the image, and can be
+    reached from this frame's endpoint through one of its attach points without crossing
+    a placed leader or the path of another label, is placed there.  Returns the labels
+    placed; the others go through the search.
+    """
+    known = [int(k) for k in idx if np.isfinite(ctx.centres[k, 0])]
+    if not known:
+        return []
+    kept: list[int] = []
+    insides = np.stack([ctx.anchors[idx], ctx.endpoints[idx]], axis=1)
+    for k in sorted(known, key=lambda k: (ctx.rank[k], k)):
+        half = np.array([ctx.widths[k] / 2, ctx.height / 2])
+        c = ctx.centres[k]
+        box = np.concatenate([c - half, c + half])[None]
+        if _outside_image(ctx, box)[0]:
+            continue
+        pboxes, psegs = _placed_arrays(ctx, k)
+        if not _boxes_free(ctx, box, pboxes, psegs)[0]:
+            continue
+        others = insides[idx != k]
+        before = None if leaders is None else leaders[k]
+        for leader in _kept_leaders(ctx, k, c, half, before):
+            if _leaders_free(leader[None], pboxes, psegs, others)[0]:
+                _place(ctx, k, leader, box[0], 0, float(np.hypot(*(leader[1] - ctx.endpoints[k]))))
+                kept.append(k)
+                break
+    return kept
 
 
 def _place_in_order(ctx: Context, order: list[int]) -> list[int]:

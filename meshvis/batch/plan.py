@@ -4,10 +4,13 @@ from __future__ import annotations
 
 import glob
 import os
+import warnings
 from collections.abc import Sequence
 
 from meshvis.errors import ParameterError
 from meshvis.io import READ_FORMATS, WRITE_FORMATS
+from meshvis.io.mtl import inside_folder
+from meshvis.repair.operation import check_options
 
 from .tasks import DEFAULT_RUNNER, OPERATIONS, FileTask
 
@@ -55,7 +58,9 @@ def discover(inputs: Sequence[str]) -> list[tuple[str, str]]:
         (searched recursively for files with a known model extension) and glob patterns
         (``*``, ``?``, ``[...]``; ``**`` spans folders).  Hidden files and folders, and
         files named like batch outputs (``*.orient.*``, ``*.remove-interior.*``,
-        ``*.layers.*``), are skipped in folders and patterns.
+        ``*.layers.*``), are skipped in folders and patterns, and so, with a warning, are
+        files found there that lie outside the folder or the pattern's fixed leading
+        folders (a symbolic link out of it, a pattern climbing out with ``..``).
 
     Returns
     -------
@@ -72,9 +77,13 @@ def discover(inputs: Sequence[str]) -> list[tuple[str, str]]:
     out: list[tuple[str, str]] = []
     seen: set[str] = set()
 
-    def add(path: str, rel: str) -> None:
+    def add(path: str, rel: str, folder: str | None = None) -> None:
         key = os.path.realpath(path)
-        if key not in seen:
+        if folder is not None and not inside_folder(path, folder):
+            # a link out of the folder, or a pattern climbing out with "..": neither is read,
+            # and the output name would leave --out
+            warnings.warn(f"{path}: lies outside {folder} (a link or '..'); skipped", stacklevel=3)
+        elif key not in seen:
             seen.add(key)
             out.append((path, rel))
 
@@ -88,7 +97,7 @@ def discover(inputs: Sequence[str]) -> list[tuple[str, str]]:
                     f"(known extensions: {', '.join(sorted(READ_FORMATS))})"
                 )
             for f in files:
-                add(f, os.path.relpath(f, spec))
+                add(f, os.path.relpath(f, spec), spec)
         elif os.path.lexists(spec):
             add(spec, os.path.basename(spec))
         elif glob.has_magic(spec):
@@ -97,7 +106,7 @@ def discover(inputs: Sequence[str]) -> list[tuple[str, str]]:
             for m in sorted(glob.glob(spec, recursive=True)):
                 files = _walk(m) if os.path.isdir(m) else [m] if _is_model_name(os.path.basename(m)) else []
                 for f in files:
-                    add(f, os.path.relpath(f, base))
+                    add(f, os.path.relpath(f, base), base)
                 matched = matched or bool(files)
             if not matched:
                 raise ParameterError(f"{spec}: the pattern matches no model file")
@@ -135,12 +144,17 @@ def plan(
     Raises
     ------
     ParameterError
-        Unknown operation, inputs not found (see :func:`discover`), or an output that
-        would overwrite one of the inputs.
+        Unknown operation, options that every file would fail on
+        (:func:`meshvis.repair.operation.check_options`),
+        inputs not found (see :func:`discover`), or an output that would overwrite one of
+        the inputs.
     """
     if op not in OPERATIONS:
         raise ParameterError(f"unknown operation {op!r}; choose one of {', '.join(OPERATIONS)}")
+    check_options(op, options or {})  # every file would fail on a bad option
     found = discover(inputs)
+    if not found:
+        raise ParameterError("no model file to run on: every file found lies outside its folder")
     names = [os.path.splitext(rel)[0] for _, rel in found]
     count: dict[str, int] = {}
     for key in [n.casefold() for n in names] + [rel.casefold() for _, rel in found]:

@@ -83,9 +83,10 @@ def _remove(path: str) -> None:
 
 def report_status(path: str) -> dict | None:
     """The report at ``path`` if it is complete JSON, else None."""
+    from meshvis.io.jsonfile import read_json
+
     try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
+        data = read_json(path)
     except (OSError, ValueError):
         return None
     return data if isinstance(data, dict) else None
@@ -152,6 +153,7 @@ def run_file(task: FileTask) -> dict:
     dict with the keys :data:`COLUMNS`
     """
     from meshvis.io import check_output, load
+    from meshvis.io.writing import check_not_read
 
     row = empty_row(task, ERROR)
     t0 = time.perf_counter()
@@ -170,6 +172,8 @@ def run_file(task: FileTask) -> dict:
                         ) from None
                 check_output(path, [task.input], True)
             soup = load(task.input)
+            for path in (task.output, task.report):  # never over a texture of the input
+                check_not_read(path, soup)
             row["faces_in"] = soup.n_faces
             report = _resolve(task.runner)(task.op, soup, operation_args(task), None)
             row["faces_out"] = _faces_out(report, soup.n_faces)
@@ -222,13 +226,19 @@ def completed_row(task: FileTask) -> dict | None:
     rep = report_status(task.report)
     if rep is None or rep.get("status") != OK or rep.get("operation") != task.op:
         return None
-    prev = rep.get("batch") or {}
-    if not isinstance(prev.get("options"), dict) or _effective(task, prev["options"]) != _effective(
-        task, task.options
-    ):
+    prev = rep.get("batch")
+    if not isinstance(prev, dict) or not isinstance(prev.get("options"), dict):
+        return None
+    if _effective(task, prev["options"]) != _effective(task, task.options):
         return None
     row = empty_row(task, SKIPPED)
-    for key in ("faces_in", "faces_out", "rays", "seconds", "warnings"):
-        if key in prev:
-            row[key] = prev[key]
+    # a report edited by hand must not carry text into a number column (or the reverse)
+    for key, kinds in _RESUMED.items():
+        value = prev.get(key)
+        if isinstance(value, kinds) and not isinstance(value, bool):
+            row[key] = value
     return row
+
+
+#: the columns a resumed row takes from the earlier report, with their types
+_RESUMED = {"faces_in": int, "faces_out": int, "rays": int, "seconds": (int, float), "warnings": str}

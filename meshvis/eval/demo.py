@@ -10,15 +10,17 @@ ground truth.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import time
 from collections.abc import Callable
 
 import numpy as np
 
+from meshvis import _validate
 from meshvis.eval.generators import overlapping_solids, soupify
 from meshvis.graphcut.classify import classify
-from meshvis.io import save
+from meshvis.io import save, staged_outputs
 from meshvis.io.jsonfile import write_json
 from meshvis.rays.camera import Camera
 from meshvis.rays.render import render, render_layers, save_png
@@ -82,10 +84,35 @@ def run_demo(
 
     Raises
     ------
+    ParameterError
+        ``seed`` is not an integer of at least 0, or ``size`` is not a picture size
+        within ``MAX_PIXELS``; nothing is written.
     OSError
         ``folder`` cannot be created or written.
+
+    Notes
+    -----
+    The files appear together when every step has succeeded; a failure (or Ctrl-C) leaves
+    none of them, and no folder that the call created.
     """
+    seed = _validate.seed(seed)
+    _validate.image_size((size, size))
+    made = not os.path.isdir(folder)
     os.makedirs(folder, exist_ok=True)
+    try:
+        with staged_outputs():
+            return _run(folder, seed, size, say, detail)
+    except BaseException:
+        if made:
+            with contextlib.suppress(OSError):
+                os.rmdir(folder)  # only when empty
+        raise
+
+
+def _run(
+    folder: str, seed: int, size: int, say: Callable[[str], None], detail: Callable[[str], None] | None
+) -> dict:
+    """:func:`run_demo` once its arguments are checked, inside one stage of outputs."""
     t0 = time.perf_counter()
     truth = soupify(overlapping_solids(), flip=0.3, seed=seed)
     soup = truth.soup

@@ -81,6 +81,109 @@ def _sides(T):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
+def pair_flags(i, j, order, tri, fw, axes, valid, has_normal, low, high, eps, near, tau, cos_angle, cos_fold):
+    """(intersects, coplanar, too_close, folded) of the faces in rows ``i`` and ``j``.
+
+    Faces are stored in the spatial order ``order`` (input id of each row); the pair is
+    tested with the face of the smaller input id first, whatever its rows.
+    """
+    pad = max(eps, near)
+    eps_r = eps * (1 + SLACK)
+    near_r = near * (1 + SLACK)
+    pad_r = pad * (1 + SLACK)
+    inter = False
+    close = False
+    fold = False
+    if order[i] > order[j]:  # as (smaller, larger) input id, the orientation of the tests
+        i, j = j, i
+    Ti = tri[i]
+    Tj = tri[j]
+    nshared = 0
+    ci = -1
+    cj = -1
+    for a in range(3):
+        for b in range(3):
+            if fw[i, a] == fw[j, b]:
+                nshared += 1
+                ci = a
+                cj = b
+    # stage 1: the 4 axes of each face, the normals first
+    max_gap = -np.inf
+    in_plane = -np.inf
+    mid_i = 0.5 * (low[i, 0] + high[i, 0])
+    mid_j = 0.5 * (low[j, 0] + high[j, 0])
+    g, p0, p1, p2 = _proj_gap(axes[i, 0, 0], axes[i, 0, 1], axes[i, 0, 2], Tj, low[i, 0], high[i, 0])
+    dev_j = max(abs(p0 - mid_i), max(abs(p1 - mid_i), abs(p2 - mid_i)))  # j's corners from i's plane
+    if valid[i, 0]:
+        max_gap = g
+    g, p0, p1, p2 = _proj_gap(axes[j, 0, 0], axes[j, 0, 1], axes[j, 0, 2], Ti, low[j, 0], high[j, 0])
+    dev_i = max(abs(p0 - mid_j), max(abs(p1 - mid_j), abs(p2 - mid_j)))
+    if valid[j, 0]:
+        max_gap = max(max_gap, g)
+    both = has_normal[i] and has_normal[j]
+    cosn = axes[i, 0, 0] * axes[j, 0, 0] + axes[i, 0, 1] * axes[j, 0, 1] + axes[i, 0, 2] * axes[j, 0, 2]
+    flat = both and abs(cosn) >= cos_angle * (1 - SLACK) and dev_j <= eps_r and dev_i <= eps_r
+    # A gap along a normal above pad_r leaves a face's corners that far from the other's
+    # plane: not flat, so nothing to report for a pair apart; and a pair sharing a corner
+    # that is not flat needs no in-plane axis either (its tests below use the normals)
+    if nshared == 0 and max_gap > pad_r:
+        return False, False, False, False
+    if nshared == 0 or flat:
+        for k in range(1, 4):
+            if valid[i, k]:
+                g = _proj_gap(axes[i, k, 0], axes[i, k, 1], axes[i, k, 2], Tj, low[i, k], high[i, k])[0]
+                max_gap = max(max_gap, g)
+                in_plane = max(in_plane, g)
+            if valid[j, k]:
+                g = _proj_gap(axes[j, k, 0], axes[j, k, 1], axes[j, k, 2], Ti, low[j, k], high[j, k])[0]
+                max_gap = max(max_gap, g)
+                in_plane = max(in_plane, g)
+    copl = flat and in_plane < -eps * (1 - SLACK)
+    if nshared == 0:
+        # stage 2: edge x edge axes while the pair is still within reach
+        if max_gap <= pad_r:
+            Ei, Li = _sides(Ti)
+            Ej, Lj = _sides(Tj)
+            for a in range(3):
+                for b in range(3):
+                    ex = Ei[a, 1] * Ej[b, 2] - Ei[a, 2] * Ej[b, 1]
+                    ey = Ei[a, 2] * Ej[b, 0] - Ei[a, 0] * Ej[b, 2]
+                    ez = Ei[a, 0] * Ej[b, 1] - Ei[a, 1] * Ej[b, 0]
+                    length = math.sqrt(ex * ex + ey * ey + ez * ez)
+                    if not length > tau * Li[a] * Lj[b]:
+                        continue
+                    g, p0, p1, p2 = _proj_gap(ex, ey, ez, Ti, 0.0, 0.0)
+                    lo_i = min(p0, min(p1, p2))
+                    hi_i = max(p0, max(p1, p2))
+                    g, p0, p1, p2 = _proj_gap(ex, ey, ez, Tj, lo_i, hi_i)
+                    max_gap = max(max_gap, g / length)
+        inter = (not flat) and max_gap <= eps_r
+        close = max_gap <= near_r
+    elif not flat:
+        if nshared == 1 and both:
+            ni = axes[i, 0]
+            nj = axes[j, 0]
+            lx = ni[1] * nj[2] - ni[2] * nj[1]
+            ly = ni[2] * nj[0] - ni[0] * nj[2]
+            lz = ni[0] * nj[1] - ni[1] * nj[0]
+            length = math.sqrt(lx * lx + ly * ly + lz * lz)
+            if length > tau:
+                lx /= length
+                ly /= length
+                lz /= length
+                meet = (_in_wedge(Ti, ci, ni, lx, ly, lz) and _in_wedge(Tj, cj, nj, lx, ly, lz)) or (
+                    _in_wedge(Ti, ci, ni, -lx, -ly, -lz) and _in_wedge(Tj, cj, nj, -lx, -ly, -lz)
+                )
+            else:
+                meet = True
+            inter = meet
+            close = meet
+        elif nshared == 2 and both:
+            fold = _folded(Ti, Tj, fw[i], fw[j], cos_fold)
+    return inter, copl, close, fold
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def narrow_phase(
     order,
     tri,
@@ -103,98 +206,97 @@ def narrow_phase(
 ):
     """Per-pair (intersects, coplanar, too_close, folded) flags; see ``classify_pairs``.
 
-    Faces are stored in the spatial order ``order`` (input id of each row); a pair is
-    tested with the face of the smaller input id first, whatever its rows.  The flags are
-    set in ``inter``, ``copl``, ``close`` and ``fold`` (p,), which come in all False.
+    The flags of :func:`pair_flags` of every pair are set in ``inter``, ``copl``, ``close``
+    and ``fold`` (p,), which come in all False.
     """
-    p = pairs.shape[0]
-    pad = max(eps, near)
-    eps_r = eps * (1 + SLACK)
-    near_r = near * (1 + SLACK)
-    pad_r = pad * (1 + SLACK)
-    for q in range(p):
-        i = pairs[q, 0]
-        j = pairs[q, 1]
-        if order[i] > order[j]:  # as (smaller, larger) input id, the orientation of the tests
-            i, j = j, i
-        Ti = tri[i]
-        Tj = tri[j]
-        nshared = 0
-        ci = -1
-        cj = -1
-        for a in range(3):
-            for b in range(3):
-                if fw[i, a] == fw[j, b]:
-                    nshared += 1
-                    ci = a
-                    cj = b
-        # stage 1: the 4 axes of each face
-        max_gap = -np.inf
-        in_plane = -np.inf
-        dev_j = 0.0  # largest distance of j's corners from i's mid-plane
-        dev_i = 0.0
-        mid_i = 0.5 * (low[i, 0] + high[i, 0])
-        mid_j = 0.5 * (low[j, 0] + high[j, 0])
-        for k in range(4):
-            g, p0, p1, p2 = _proj_gap(axes[i, k, 0], axes[i, k, 1], axes[i, k, 2], Tj, low[i, k], high[i, k])
-            if k == 0:
-                dev_j = max(abs(p0 - mid_i), max(abs(p1 - mid_i), abs(p2 - mid_i)))
-            if valid[i, k]:
-                max_gap = max(max_gap, g)
-                if k > 0:
-                    in_plane = max(in_plane, g)
-            g, p0, p1, p2 = _proj_gap(axes[j, k, 0], axes[j, k, 1], axes[j, k, 2], Ti, low[j, k], high[j, k])
-            if k == 0:
-                dev_i = max(abs(p0 - mid_j), max(abs(p1 - mid_j), abs(p2 - mid_j)))
-            if valid[j, k]:
-                max_gap = max(max_gap, g)
-                if k > 0:
-                    in_plane = max(in_plane, g)
-        both = has_normal[i] and has_normal[j]
-        cosn = axes[i, 0, 0] * axes[j, 0, 0] + axes[i, 0, 1] * axes[j, 0, 1] + axes[i, 0, 2] * axes[j, 0, 2]
-        flat = both and abs(cosn) >= cos_angle * (1 - SLACK) and dev_j <= eps_r and dev_i <= eps_r
-        copl[q] = flat and in_plane < -eps * (1 - SLACK)
-        if nshared == 0:
-            # stage 2: edge x edge axes while the pair is still within reach
-            if max_gap <= pad_r:
-                Ei, Li = _sides(Ti)
-                Ej, Lj = _sides(Tj)
-                for a in range(3):
-                    for b in range(3):
-                        ex = Ei[a, 1] * Ej[b, 2] - Ei[a, 2] * Ej[b, 1]
-                        ey = Ei[a, 2] * Ej[b, 0] - Ei[a, 0] * Ej[b, 2]
-                        ez = Ei[a, 0] * Ej[b, 1] - Ei[a, 1] * Ej[b, 0]
-                        length = math.sqrt(ex * ex + ey * ey + ez * ez)
-                        if not length > tau * Li[a] * Lj[b]:
-                            continue
-                        g, p0, p1, p2 = _proj_gap(ex, ey, ez, Ti, 0.0, 0.0)
-                        lo_i = min(p0, min(p1, p2))
-                        hi_i = max(p0, max(p1, p2))
-                        g, p0, p1, p2 = _proj_gap(ex, ey, ez, Tj, lo_i, hi_i)
-                        max_gap = max(max_gap, g / length)
-            inter[q] = (not flat) and max_gap <= eps_r
-            close[q] = max_gap <= near_r
-        elif not flat:
-            if nshared == 1 and both:
-                ni = axes[i, 0]
-                nj = axes[j, 0]
-                lx = ni[1] * nj[2] - ni[2] * nj[1]
-                ly = ni[2] * nj[0] - ni[0] * nj[2]
-                lz = ni[0] * nj[1] - ni[1] * nj[0]
-                length = math.sqrt(lx * lx + ly * ly + lz * lz)
-                if length > tau:
-                    lx /= length
-                    ly /= length
-                    lz /= length
-                    meet = (_in_wedge(Ti, ci, ni, lx, ly, lz) and _in_wedge(Tj, cj, nj, lx, ly, lz)) or (
-                        _in_wedge(Ti, ci, ni, -lx, -ly, -lz) and _in_wedge(Tj, cj, nj, -lx, -ly, -lz)
-                    )
-                else:
-                    meet = True
-                inter[q] = meet
-                close[q] = meet
-            elif nshared == 2 and both:
-                fold[q] = _folded(Ti, Tj, fw[i], fw[j], cos_fold)
+    for q in range(pairs.shape[0]):
+        inter[q], copl[q], close[q], fold[q] = pair_flags(
+            pairs[q, 0],
+            pairs[q, 1],
+            order,
+            tri,
+            fw,
+            axes,
+            valid,
+            has_normal,
+            low,
+            high,
+            eps,
+            near,
+            tau,
+            cos_angle,
+            cos_fold,
+        )
+
+
+#: bits of the codes of :func:`broad_narrow`
+INTERSECTS, COPLANAR, TOO_CLOSE = 1, 2, 4
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def broad_narrow(
+    first,
+    starts,
+    counts,
+    ent,
+    key,
+    cell_rows,
+    cell,
+    lo,
+    hi,
+    bits,
+    m,
+    order,
+    tri,
+    fw,
+    axes,
+    valid,
+    has_normal,
+    low,
+    high,
+    eps,
+    near,
+    tau,
+    cos_angle,
+    cos_fold,
+):
+    """The pairs of :func:`broad_pairs` tested by :func:`pair_flags` as they are met.
+
+    Only the pairs with a flag come out: (k,) int64 keys ``i * m + j`` (``i < j``, rows) and
+    (k,) uint8 codes (:data:`INTERSECTS` | :data:`COPLANAR` | :data:`TOO_CLOSE`; a fold counts
+    as coplanar), so that memory follows the flagged pairs, not the candidates.
+    """
+    cap = 64 + first.shape[0]
+    out = np.empty(cap, np.int64)
+    code = np.empty(cap, np.uint8)
+    n = 0
+    for q in range(first.shape[0]):
+        a = first[q]
+        for o in range(starts[q], starts[q] + counts[q]):
+            b = ent[o]
+            la = cell_rows[q] if cell_rows.shape[0] else cell[a]
+            if not _meets_here(a, b, la, cell[b], key[q], lo, hi, bits):
+                continue
+            i = min(a, b)
+            j = max(a, b)
+            f_int, f_copl, f_close, f_fold = pair_flags(
+                i, j, order, tri, fw, axes, valid, has_normal, low, high, eps, near, tau, cos_angle, cos_fold
+            )
+            c = (
+                (INTERSECTS if f_int else 0)
+                | (COPLANAR if (f_copl or f_fold) else 0)
+                | (TOO_CLOSE if f_close else 0)
+            )
+            if c == 0:
+                continue
+            if n == cap:
+                cap *= 2
+                out = _grown(out, n, cap)
+                code = _grown(code, n, cap)
+            out[n] = i * m + j
+            code[n] = c
+            n += 1
+    return out[:n].copy(), code[:n].copy()
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -241,14 +343,46 @@ def _folded(Ti, Tj, fi, fj, cos_fold):
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def broad_pairs(first, starts, counts, ent, low_a, low_b, key, lo, hi, bits, m):
+def _low_cell(x, h, top):
+    """Cell coordinate of ``x`` on a grid of size ``h``, clipped to ``[0, top]`` (as :func:`grid_cells`)."""
+    return np.int64(min(max(math.floor(x / h), 0.0), top))
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _meets_here(a, b, la, lb, key_q, lo, hi, bits):
+    """Boxes ``a`` and ``b`` overlap, and the lower corner of their overlap lies in cell ``key_q``.
+
+    ``la`` and ``lb`` are the boxes' lower cells on this grid, packed like the keys.  The
+    lower cell of the overlap is their larger coordinates, so each overlapping pair is met
+    in exactly one of the cells both cover.
+    """
+    mask = (np.int64(1) << bits) - 1
+    cx = max(la >> (2 * bits), lb >> (2 * bits))
+    cy = max((la >> bits) & mask, (lb >> bits) & mask)
+    cz = max(la & mask, lb & mask)
+    if ((cx << (2 * bits)) | (cy << bits) | cz) != key_q:
+        return False
+    return (
+        lo[a, 0] <= hi[b, 0]
+        and lo[b, 0] <= hi[a, 0]
+        and lo[a, 1] <= hi[b, 1]
+        and lo[b, 1] <= hi[a, 1]
+        and lo[a, 2] <= hi[b, 2]
+        and lo[b, 2] <= hi[a, 2]
+    )
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def broad_pairs(first, starts, counts, ent, key, cell_rows, cell, lo, hi, bits, m):
     """Pairs met in their lowest common grid cell whose boxes overlap (broad phase step).
 
     Row ``q`` stands for box ``first[q]`` in the cell ``key[q]``; its candidates are the
-    boxes ``ent[starts[q] : starts[q] + counts[q]]``.  A pair is kept when the cell holding
-    the lower corner of the two boxes' overlap (``max`` of their lower cells on this grid,
-    ``low_a`` / ``low_b``) is this cell -- so each pair is emitted once -- and the closed
-    boxes overlap on every axis.  Returns (k,) int64 pair keys ``i * m + j`` with ``i < j``.
+    boxes ``ent[starts[q] : starts[q] + counts[q]]``.  ``cell`` (m,) holds the lower cell of
+    every box on its own level, packed like the keys, ``cell_rows`` (empty, or one per row)
+    that of the row's box on this grid when it lives on a finer level.  A pair is kept
+    when the cell holding the lower corner of the two boxes' overlap is this cell -- so
+    each pair is emitted once -- and the closed boxes overlap on every axis.  Returns (k,)
+    int64 pair keys ``i * m + j`` with ``i < j``.
     """
     out = np.empty(counts.sum(), np.int64)
     n = 0
@@ -256,22 +390,95 @@ def broad_pairs(first, starts, counts, ent, low_a, low_b, key, lo, hi, bits, m):
         a = first[q]
         for o in range(starts[q], starts[q] + counts[q]):
             b = ent[o]
-            cx = max(low_a[a, 0], low_b[b, 0])
-            cy = max(low_a[a, 1], low_b[b, 1])
-            cz = max(low_a[a, 2], low_b[b, 2])
-            if ((cx << (2 * bits)) | (cy << bits) | cz) != key[q]:
-                continue
-            if (
-                lo[a, 0] <= hi[b, 0]
-                and lo[b, 0] <= hi[a, 0]
-                and lo[a, 1] <= hi[b, 1]
-                and lo[b, 1] <= hi[a, 1]
-                and lo[a, 2] <= hi[b, 2]
-                and lo[b, 2] <= hi[a, 2]
-            ):
+            la = cell_rows[q] if cell_rows.shape[0] else cell[a]
+            if _meets_here(a, b, la, cell[b], key[q], lo, hi, bits):
                 out[n] = min(a, b) * m + max(a, b)
                 n += 1
     return out[:n]
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def sweep_order(key, x):
+    """Order of grid entries by cell ``key``, then by ``x``, then by position (a stable lexsort)."""
+    order = np.argsort(key, kind="mergesort")
+    n = key.shape[0]
+    s = 0
+    while s < n:
+        e = s + 1
+        while e < n and key[order[e]] == key[order[s]]:
+            e += 1
+        if e - s > 1:
+            run = order[s:e].copy()
+            xs = np.empty(e - s)
+            for k in range(e - s):
+                xs[k] = x[run[k]]
+            by_x = np.argsort(xs, kind="mergesort")
+            for k in range(e - s):
+                order[s + k] = run[by_x[k]]
+        s = e
+    return order
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def finer_rows(lo, hi, fine, h, top, bits, gkey, grank, sweep, xs, margin):
+    """Rows of the pairs of finer boxes ``fine`` with the entries of a coarser grid.
+
+    Every cell of size ``h`` a fine box covers is looked up among the grid's sorted cell
+    keys ``gkey``; a cell found gives a row: the box, the first entry of the cell, the
+    entries of the cell that start (in x) before the box ends (the sweep values of
+    :class:`meshvis.geometry.intersect._Grid`), and the cell.  Rows without entries are
+    left out.  Returns ``first``, ``starts``, ``counts``, ``key`` and ``low`` (r,) int64,
+    ``low`` the box's lower cell on this grid, packed like the keys.
+    """
+    cap = 16 + fine.shape[0]
+    low = np.empty(cap, np.int64)
+    first = np.empty(cap, np.int64)
+    starts = np.empty(cap, np.int64)
+    counts = np.empty(cap, np.int64)
+    key = np.empty(cap, np.int64)
+    n = 0
+    ng = gkey.shape[0]
+    for t in range(fine.shape[0]):
+        f = fine[t]
+        a0 = _low_cell(lo[f, 0], h, top)
+        a1 = _low_cell(lo[f, 1], h, top)
+        a2 = _low_cell(lo[f, 2], h, top)
+        b0 = _low_cell(hi[f, 0], h, top)
+        b1 = _low_cell(hi[f, 1], h, top)
+        b2 = _low_cell(hi[f, 2], h, top)
+        packed = (a0 << (2 * bits)) | (a1 << bits) | a2
+        for z in range(a2, b2 + 1):
+            for y in range(a1, b1 + 1):
+                for x in range(a0, b0 + 1):
+                    k = (x << (2 * bits)) | (y << bits) | z
+                    start = np.searchsorted(gkey, k)
+                    if start >= ng or gkey[start] != k:
+                        continue
+                    end = np.searchsorted(sweep, grank[start] + hi[f, 0] * xs + margin, side="right")
+                    if end <= start:
+                        continue
+                    if n == cap:
+                        cap *= 2
+                        first = _grown(first, n, cap)
+                        starts = _grown(starts, n, cap)
+                        counts = _grown(counts, n, cap)
+                        key = _grown(key, n, cap)
+                        low = _grown(low, n, cap)
+                    first[n] = f
+                    low[n] = packed
+                    starts[n] = start
+                    counts[n] = end - start
+                    key[n] = k
+                    n += 1
+    return first[:n].copy(), starts[:n].copy(), counts[:n].copy(), key[:n].copy(), low[:n].copy()
+
+
+@numba.njit(cache=True, nogil=True)
+def _grown(a, n, cap):
+    """A copy of ``a[:n]`` with room for ``cap`` entries."""
+    out = np.empty(cap, a.dtype)
+    out[:n] = a[:n]
+    return out
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

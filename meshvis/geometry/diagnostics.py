@@ -124,7 +124,12 @@ def analyse(
     flags = None
     if intersections:
         flags = intersect.intersection_flags(
-            v, f, eps, faces_welded=fw, progress=lambda x: report("analyse", 0.35 + 0.65 * x)
+            v,
+            f,
+            eps,
+            faces_welded=fw,
+            duplicate_first=first,
+            progress=lambda x: report("analyse", 0.35 + 0.65 * x),
         )
         lap("intersections", 1.0)
     return Analysis(fw, table, degenerate, collapsed, first, flags, seconds)

@@ -8,22 +8,33 @@ intersects must never be missed.
 
 Pipeline
 --------
-1. Normalise: centre on the bounding-box centre, scale to unit diagonal.  Every tolerance
+1. Copies: faces with the same welded corners (either winding,
+   :func:`meshvis.geometry.adjacency.duplicate_faces`) are one triangle to within the weld
+   tolerance.  Only the first face of each group meets the other faces; each copy is tested
+   against that first face alone, and the whole group shares the flags.  ``k`` copies of
+   one triangle would otherwise make ``k**2 / 2`` pairs (20,000 copies: 200 M pairs).
+2. Normalise: centre on the bounding-box centre, scale to unit diagonal.  Every tolerance
    below is then a plain number, and the flags do not change under scaling or translation.
    The faces are stored in Morton order (:func:`spatial_order`) so that the two faces of a
    candidate pair are near each other in memory; every result is mapped back to the
    input's face ids, and a pair is always tested with its smaller input id first.
-2. Broad phase (:func:`candidate_pairs`): axis-aligned boxes inflated by ``eps``, sorted
+3. Broad phase (:class:`_BroadPhase`): axis-aligned boxes inflated by ``eps``, sorted
    into a *hierarchical uniform grid*.  Level ``L`` has cells of size ``h0 * 2**L`` (``h0``
    the median box size); a triangle lives on the finest level where its box covers at most
    27 cells, whatever its size (a huge triangle cannot blow up memory, a flat wall stays on
    a fine level).  Pairs on one level meet in a shared cell, where entries are also swept
    along x; a triangle meets the coarser levels by looking up its own cells there.  Each
    pair is emitted once, from the cell that holds the lower corner of the two boxes'
-   overlap.  Cell keys are int64 (21 bits per axis), matched by sorting and
-   ``searchsorted``; large outputs are produced in bounded chunks.
-3. Narrow phase (:func:`classify_pairs`, one numba loop over the pairs, run on slices of
-   them in threads by :func:`meshvis._threads.in_threads`): a
+   overlap.  Cell keys are int64 (21 bits per axis), matched by sorting and binary search.
+   The pairs to look at are counted before any is produced, and refused above
+   :data:`meshvis.limits.MAX_FACE_PAIRS_PER_FACE` per face (distinct faces stacked in one
+   place).
+   The narrow phase runs on each pair as the grid meets it, in chunks in threads, and only
+   the pairs with a flag are kept: memory follows the grid and the flagged pairs, not the
+   candidates (a 1.3 M-face city of real models meets 57 M pairs, of which 0.64 M are flagged).
+   :func:`candidate_pairs` gives the candidates themselves.
+4. Narrow phase (:func:`classify_pairs`, and :func:`meshvis.geometry._kernels.pair_flags`
+   per pair): a
    separating-axis test on the 17 axes that separate two triangles — the two normals, the
    six in-plane edge normals (precomputed per face, :func:`meshvis.geometry._kernels.face_axes`)
    and the 9 edge x edge directions.  Each
@@ -31,7 +42,9 @@ Pipeline
    bound of the true distance, so "no axis shows a gap above ``eps``" holds for every pair
    closer than ``eps`` (conservative).  Axes that are numerically unreliable (a cross
    product of nearly parallel edges) are skipped, which can only add reports, never drop one.
-4. Coplanarity: normals parallel within ``angle_eps`` (either orientation), every corner of
+   The normals come first: a pair apart along one by more than ``max(eps, near)`` has
+   nothing to report.
+5. Coplanarity: normals parallel within ``angle_eps`` (either orientation), every corner of
    each triangle within ``eps`` of the other's plane, and the two triangles overlap in that
    plane by more than ``eps`` along each of the six in-plane edge normals (a 2D
    separating-axis test with a negative margin).  Two faces lying side by side — sharing
@@ -74,8 +87,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from meshvis._threads import in_threads
-from meshvis.errors import ParameterError
+from meshvis._threads import default_threads, in_threads, pool
+from meshvis.errors import ModelError, ParameterError
 from meshvis.geometry.adjacency import WELD_TOL, weld
 
 #: default distance tolerance, as a fraction of the bounding-box diagonal
@@ -131,39 +144,100 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray, *, overwrite: bool = F
     Returns
     -------
     (p, 2) int32 (int64 from 2**31 boxes), pairs ``i < j`` whose closed boxes overlap, sorted
+
+    Examples
+    --------
+    >>> lo = np.array([[0.0, 0, 0], [0.5, 0.5, 0.5], [3, 3, 3]])
+    >>> candidate_pairs(lo, lo + 1).tolist()
+    [[0, 1]]
     """
     lower = np.asarray(lower, np.float64)
     upper = np.asarray(upper, np.float64)
     m = len(lower)
     if m < 2:
         return np.zeros((0, 2), np.int64)
-    origin = lower.min(axis=0)
-    lo = np.subtract(lower, origin, out=lower if overwrite else None)
-    hi = np.subtract(upper, origin, out=upper if overwrite else None)
-    size = float((hi.max(axis=0)).max())
-    if size <= 0:  # every box is the same point
+    broad = _BroadPhase(lower, upper, overwrite)
+    if broad.same_point:  # every box is the same point
         i, j = np.triu_indices(m, 1)
         return np.stack([i, j], axis=1).astype(np.int64)
-    # finest cell: the median box size (at least 2**-20 of the whole: 21-bit keys)
-    h0 = max(H0_FACTOR * float(np.median((hi - lo).max(axis=1))), size * 2.0**-20)
-    level = _levels(lo, hi, h0, size)
-    grids, own_low = {}, np.zeros((m, 3), np.int64)  # lower cell of each box on its own level
-    out = []
-    for L in np.unique(level):
-        grids[L] = _Grid(lo, hi, np.flatnonzero(level == L), h0 * 2.0**L, size, own_low)
-        out += grids[L].pairs_within(lo, hi, own_low)
-    for L in list(grids)[1:]:
-        out += grids[L].pairs_from_finer(lo, hi, np.flatnonzero(level < L), own_low)
-    del grids, own_low, lo, hi
+    from meshvis.geometry._kernels import broad_pairs
+
+    kernel: Callable[..., np.ndarray] = broad_pairs  # numba's dispatcher, called with the job's arguments
+    out = [kernel(*job.rows(sl), *broad.bounds, _BITS, m) for job in broad.jobs for sl in _chunks(job.counts)]
+    del broad
     keys = np.concatenate(out) if out else np.zeros(0, np.int64)  # i * m + j, i < j
     del out
     keys.sort()
+    return _split_keys(keys, m)
+
+
+def _split_keys(keys: np.ndarray, m: int) -> np.ndarray:
+    """(p, 2) pairs ``(k // m, k % m)`` of sorted int64 keys, int32 where they fit."""
     # int32 ids where they fit: the pairs are the largest array of the intersection tests
     pairs = np.empty((len(keys), 2), np.int32 if m < 2**31 else np.int64)
     pairs[:, 0] = keys // m
-    keys %= m
-    pairs[:, 1] = keys
+    pairs[:, 1] = keys % m
     return pairs
+
+
+class _Job:
+    """Rows of broad-phase work on a grid of cell size ``h``.
+
+    Box ``first[q]`` meets the boxes ``ent[starts[q] : starts[q] + counts[q]]`` in the cell
+    ``key[q]``; ``low_rows`` holds the box's lower cell on this grid when it lives on a finer
+    level, and is empty otherwise (see :func:`meshvis.geometry._kernels.broad_pairs`).
+    """
+
+    def __init__(self, first, starts, counts, ent, key, low_rows):
+        self.first, self.starts, self.counts, self.ent, self.key = first, starts, counts, ent, key
+        self.low_rows = low_rows
+
+    def rows(self, sl: slice) -> tuple:
+        """The kernel arguments of rows ``sl`` (before the boxes' lower cells and bounds)."""
+        low_rows = self.low_rows[sl] if len(self.low_rows) else self.low_rows
+        return (self.first[sl], self.starts[sl], self.counts[sl], self.ent, self.key[sl], low_rows)
+
+
+#: largest cell coordinate of the grid (the keys hold :data:`_BITS` bits per axis)
+_TOP = float((1 << _BITS) - 1)
+
+
+class _BroadPhase:
+    """The grid levels of a set of boxes and the work of finding their overlapping pairs.
+
+    Building it costs memory and time linear in the boxes (their grid cells); the pairs are
+    only counted (:attr:`candidates`, an upper bound), so that a caller can refuse the work
+    before doing it, and then produced job by job in bounded chunks.
+    """
+
+    def __init__(self, lower: np.ndarray, upper: np.ndarray, overwrite: bool):
+        origin = lower.min(axis=0)
+        lo = np.subtract(lower, origin, out=lower if overwrite else None)
+        hi = np.subtract(upper, origin, out=upper if overwrite else None)
+        # the lower cell of every box on its own level, packed like the cell keys
+        low = np.zeros(len(lo), np.int64)
+        self.bounds = (low, lo, hi)
+        size = float((hi.max(axis=0)).max())
+        self.same_point = size <= 0
+        self.jobs: list[_Job] = []
+        if self.same_point:
+            return
+        # finest cell: the median box size (at least 2**-20 of the whole: 21-bit keys)
+        h0 = max(H0_FACTOR * float(np.median((hi - lo).max(axis=1))), size * 2.0**-20)
+        level = _levels(lo, hi, h0, size)
+        grids = {}
+        for L in np.unique(level):
+            grids[L] = _Grid(lo, hi, np.flatnonzero(level == L), h0 * 2.0**L, size, low)
+            self.jobs.append(grids[L].within(hi))
+        for L in list(grids)[1:]:
+            job = grids[L].from_finer(lo, hi, np.flatnonzero(level < L))
+            if job is not None:
+                self.jobs.append(job)
+
+    @property
+    def candidates(self) -> int:
+        """Pairs the jobs will look at (each overlapping pair once, plus those met twice)."""
+        return int(sum(int(job.counts.sum()) for job in self.jobs))
 
 
 def _levels(lo: np.ndarray, hi: np.ndarray, h0: float, size: float) -> np.ndarray:
@@ -185,63 +259,52 @@ class _Grid:
     (``margin`` keeps the float rounding of that value on the safe side).
     """
 
-    def __init__(self, lo, hi, boxes: np.ndarray, h: float, size: float, own_low: np.ndarray):
+    def __init__(self, lo, hi, boxes: np.ndarray, h: float, size: float, low: np.ndarray):
+        from meshvis.geometry._kernels import sweep_order
+
         owner, key, c0 = _cells(lo[boxes], hi[boxes], h)
+        low[boxes] = (c0[:, 0] << (2 * _BITS)) | (c0[:, 1] << _BITS) | c0[:, 2]
+        del c0
         ent = boxes[owner]
-        order = np.lexsort((lo[ent, 0], key))
+        del owner
+        order = sweep_order(key, lo[ent, 0])
         self.key, self.ent = key[order], ent[order]
+        del key, ent, order
         self.h, self.xs = h, 0.5 / size
-        self.rank = np.concatenate([[0], np.cumsum(self.key[1:] != self.key[:-1])])
+        self.rank = np.zeros(len(self.key), np.int64)
+        np.cumsum(self.key[1:] != self.key[:-1], out=self.rank[1:])
         self.sweep = self.rank + lo[self.ent, 0] * self.xs
         self.margin = 8 * np.spacing(self.rank[-1] + 1.0)  # above the rounding of rank + x
-        own_low[boxes] = c0
 
-    def pairs_within(self, lo, hi, own_low) -> list[np.ndarray]:
+    def within(self, hi) -> _Job:
         """Pairs in one cell of this level: later entries starting before the box ends in x."""
-        from meshvis.geometry._kernels import broad_pairs
+        pos = np.arange(1, len(self.key) + 1)
+        counts = np.searchsorted(
+            self.sweep, self.rank + hi[self.ent, 0] * self.xs + self.margin, side="right"
+        )
+        counts -= pos
+        return _Job(self.ent, pos, counts, self.ent, self.key, np.zeros(0, np.int64))
 
-        key, ent = self.key, self.ent
-        pos = np.arange(len(key))
-        counts = np.searchsorted(self.sweep, self.rank + hi[ent, 0] * self.xs + self.margin, side="right")
-        counts -= pos + 1
-        return [
-            broad_pairs(
-                ent[sl], pos[sl] + 1, counts[sl], ent, own_low, own_low, key[sl], lo, hi, _BITS, len(lo)
-            )
-            for sl in _chunks(counts)
-        ]
-
-    def pairs_from_finer(self, lo, hi, fine: np.ndarray, own_low) -> list[np.ndarray]:
+    def from_finer(self, lo, hi, fine: np.ndarray) -> _Job | None:
         """Pairs of finer boxes ``fine`` with this level's: each looks up its cells here."""
-        from meshvis.geometry._kernels import broad_pairs
+        from meshvis.geometry._kernels import finer_rows
 
         if len(fine) == 0:
-            return []
-        owner, key_f, c0f = _cells(lo[fine], hi[fine], self.h)
-        last = len(self.key) - 1
-        start = np.searchsorted(self.key, key_f, side="left")
-        found = self.key[np.minimum(start, last)] == key_f
-        r = self.rank[np.minimum(start, last)]
-        end = np.searchsorted(self.sweep, r + hi[fine[owner], 0] * self.xs + self.margin, side="right")
-        counts = np.where(found, np.maximum(end - start, 0), 0)
-        low_f = np.zeros_like(own_low)
-        low_f[fine] = c0f
-        return [
-            broad_pairs(
-                fine[owner[sl]],
-                start[sl],
-                counts[sl],
-                self.ent,
-                low_f,
-                own_low,
-                key_f[sl],
-                lo,
-                hi,
-                _BITS,
-                len(lo),
-            )
-            for sl in _chunks(counts)
-        ]
+            return None
+        first, starts, counts, key, low_rows = finer_rows(
+            lo,
+            hi,
+            fine,
+            float(self.h),
+            _TOP,
+            _BITS,
+            self.key,
+            self.rank,
+            self.sweep,
+            float(self.xs),
+            float(self.margin),
+        )
+        return _Job(first, starts, counts, self.ent, key, low_rows)
 
 
 # --------------------------------------------------------------------------- narrow phase
@@ -289,48 +352,18 @@ def classify_pairs(
     -------
     intersects, coplanar, too_close : (p,) bool, per pair (see the module notes)
     """
-    from meshvis.geometry._kernels import face_axes, narrow_phase
+    from meshvis.geometry._kernels import narrow_phase
 
-    # cross products of factors at an angle below tau are skipped: their round-off
-    # (~ machine eps / tau, relative to unit coordinates) must stay far below eps
-    tau = min(1e-3, 100 * np.finfo(np.float64).eps / min(eps, near))
-    tri = np.ascontiguousarray(triangles, np.float64)
-    m = len(tri)
-    axes, valid, has_normal = np.zeros((m, 4, 3)), np.zeros((m, 4), bool), np.zeros(m, bool)
-    low, high = np.empty((m, 4)), np.empty((m, 4))
-    in_threads(
-        lambda a, b: face_axes(
-            tri[a:b], float(tau), axes[a:b], valid[a:b], has_normal[a:b], low[a:b], high[a:b]
-        ),
-        m,
-    )
-    fw = np.ascontiguousarray(faces_welded, np.int64)
-    order = np.arange(len(tri)) if order is None else np.asarray(order, np.int64)
+    kernel: Callable[..., None] = narrow_phase  # numba's dispatcher, called with the faces' arguments
+    test = _Narrow(triangles, faces_welded, eps, near, angle_eps, fold_angle, order)
     out = np.zeros((3, len(pairs)), bool)
     for s in range(0, len(pairs), NARROW_CHUNK):
         sl = slice(s, s + NARROW_CHUNK)
         chunk = np.ascontiguousarray(pairs[sl])
         inter, copl, close, fold = np.zeros((4, len(chunk)), bool)
         in_threads(
-            lambda a, b: narrow_phase(
-                order,
-                tri,
-                fw,
-                axes,
-                valid,
-                has_normal,
-                low,
-                high,
-                chunk[a:b],
-                float(eps),
-                float(near),
-                float(tau),
-                float(np.cos(angle_eps)),
-                float(np.cos(fold_angle)),
-                inter[a:b],
-                copl[a:b],
-                close[a:b],
-                fold[a:b],
+            lambda a, b: kernel(
+                *test.faces, chunk[a:b], *test.tolerances, inter[a:b], copl[a:b], close[a:b], fold[a:b]
             ),
             len(chunk),
         )
@@ -338,6 +371,42 @@ def classify_pairs(
         if progress is not None:
             progress(min(s + NARROW_CHUNK, len(pairs)) / len(pairs))
     return out[0], out[1], out[2]
+
+
+class _Narrow:
+    """The per-face data of the narrow phase (:func:`meshvis.geometry._kernels.pair_flags`).
+
+    ``faces`` are the kernel's per-face arguments (input ids of the rows, corners, welded
+    corners, the axes of :func:`meshvis.geometry._kernels.face_axes` and their projection
+    intervals), ``tolerances`` its numbers.
+    """
+
+    def __init__(self, triangles, faces_welded, eps, near, angle_eps, fold_angle, order=None):
+        from meshvis.geometry._kernels import face_axes
+
+        # cross products of factors at an angle below tau are skipped: their round-off
+        # (~ machine eps / tau, relative to unit coordinates) must stay far below eps
+        tau = min(1e-3, 100 * np.finfo(np.float64).eps / min(eps, near))
+        tri = np.ascontiguousarray(triangles, np.float64)
+        m = len(tri)
+        axes, valid, has_normal = np.zeros((m, 4, 3)), np.zeros((m, 4), bool), np.zeros(m, bool)
+        low, high = np.empty((m, 4)), np.empty((m, 4))
+        in_threads(
+            lambda a, b: face_axes(
+                tri[a:b], float(tau), axes[a:b], valid[a:b], has_normal[a:b], low[a:b], high[a:b]
+            ),
+            m,
+        )
+        fw = np.ascontiguousarray(faces_welded, np.int64)
+        order = np.arange(m) if order is None else np.ascontiguousarray(order, np.int64)
+        self.faces = (order, tri, fw, axes, valid, has_normal, low, high)
+        self.tolerances = (
+            float(eps),
+            float(near),
+            float(tau),
+            float(np.cos(angle_eps)),
+            float(np.cos(fold_angle)),
+        )
 
 
 def _spread_bits(x: np.ndarray) -> np.ndarray:
@@ -386,8 +455,11 @@ def spatial_order(points: np.ndarray) -> np.ndarray:
     return np.argsort(code)
 
 
-def _normalised(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, float]:
-    """(m, 3, 3) corners centred on the bounding box and scaled to unit diagonal, and the diagonal."""
+def _normalised(vertices: np.ndarray, faces: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, float]:
+    """(r, 3, 3) corners of ``faces[rows]`` normalised on all ``faces``, and the diagonal.
+
+    The corners are centred on the bounding box of every face and scaled to unit diagonal.
+    """
     from meshvis.geometry._kernels import corner_bounds, gather_normalised
 
     v = np.ascontiguousarray(vertices, np.float64)
@@ -395,7 +467,7 @@ def _normalised(vertices: np.ndarray, faces: np.ndarray) -> tuple[np.ndarray, fl
     lo, hi = corner_bounds(v, faces) if len(faces) else np.zeros((2, 3))
     diag = float(np.linalg.norm(hi - lo))
     scale = 1.0 / diag if diag > 0 else 1.0
-    return gather_normalised(v, faces, 0.5 * (lo + hi), scale), diag
+    return gather_normalised(v, np.ascontiguousarray(faces[rows]), 0.5 * (lo + hi), scale), diag
 
 
 def intersection_flags(
@@ -407,6 +479,7 @@ def intersection_flags(
     angle_eps: float = ANGLE_EPS,
     faces_welded: np.ndarray | None = None,
     weld_tol: float = WELD_TOL,
+    duplicate_first: np.ndarray | None = None,
     progress: Callable[[float], None] | None = None,
 ) -> dict:
     """Per-face flags of appendix H §2: intersects another face, coplanar with one, too close.
@@ -426,23 +499,51 @@ def intersection_flags(
         Welded faces (:func:`meshvis.geometry.adjacency.weld`), to skip welding here.
     weld_tol : float
         Weld tolerance used when ``faces_welded`` is not given.
+    duplicate_first : (m,) int array, optional
+        :func:`meshvis.geometry.adjacency.duplicate_faces` of the welded faces, when the
+        caller has it.
     progress : callable, optional
-        ``progress(fraction)``: after the broad phase and after each narrow-phase chunk.
+        ``progress(fraction)``: after the broad phase's set-up and after each chunk of pairs.
 
     Returns
     -------
     dict with
         ``intersects``, ``coplanar``, ``too_close`` : (m,) bool per face;
         ``intersect_pairs``, ``coplanar_pairs``, ``close_pairs`` : (k, 2) int64 face pairs
-        (i < j) behind the flags; ``candidates`` : number of broad-phase pairs;
-        ``eps``, ``near`` : absolute tolerances used (input units); ``diagonal``.
+        (i < j) behind the flags, among the first faces of their duplicate groups, and each
+        copy with its first face; ``duplicate_first`` : (m,) int64, the first face of each
+        face's group (the copies take its pairs and flags); ``candidates`` : number of
+        broad-phase pairs looked at; ``eps``, ``near`` : absolute tolerances used (input
+        units); ``diagonal``.
+
+    Raises
+    ------
+    ModelError
+        More face pairs would have to be compared than
+        :data:`meshvis.limits.MAX_FACE_PAIRS_PER_FACE` per face allows.
 
     Notes
     -----
     ``too_close`` marks faces with a non-adjacent face (no shared welded vertex) within
     ``near`` — the clustering rule "triangle too close to a non-adjacent triangle" of
     appendix H §2.  It includes the intersecting faces whenever ``near >= eps``.
+
+    Copies of one face (the same welded corners, either winding) take part in the tests
+    once: only the first of each group meets the other faces, each copy is tested against
+    that first face, and every face of the group takes the flags of all of them.  The
+    copies are the same triangle to within the weld tolerance, far below ``eps``; without
+    this, ``k`` copies of one triangle would make ``k**2 / 2`` pairs.
+
+    Examples
+    --------
+    >>> v = np.array([[0.0, 0, 0], [1, 0, 0], [0, 1, 0]])
+    >>> d = intersection_flags(v, np.array([[0, 1, 2]] * 3))
+    >>> d["coplanar"].tolist(), d["coplanar_pairs"].tolist()
+    ([True, True, True], [[0, 1], [0, 2]])
     """
+    from meshvis.geometry._kernels import COPLANAR, INTERSECTS, TOO_CLOSE
+    from meshvis.geometry.adjacency import duplicate_faces
+
     eps = EPS if eps is None else float(eps)
     near = eps if near is None else float(near)
     if not (1e-9 <= eps < 1) or not (1e-9 <= near < 1):
@@ -455,51 +556,108 @@ def intersection_flags(
     m = len(faces)
     if faces_welded is None:
         faces_welded = weld(vertices, faces, weld_tol)[1]
-    # work in spatial order (cache locality); results go back to the input's face ids
-    order = spatial_order(np.asarray(vertices, np.float64)[faces[:, 0]])
-    tri, diag = _normalised(vertices, faces[order])
-    pad = max(eps, near)
-    corner = [tri[:, c] for c in range(3)]
-    lower = np.minimum(np.minimum(corner[0], corner[1]), corner[2]) - pad
-    upper = np.maximum(np.maximum(corner[0], corner[1]), corner[2]) + pad
-    del corner
-    pairs = candidate_pairs(lower, upper, overwrite=True)
-    del lower, upper
-    report = progress or (lambda fraction: None)
-    report(0.4)
-    inter, copl, close = classify_pairs(
-        tri,
-        np.asarray(faces_welded)[order],
-        pairs,
-        eps,
-        near,
-        angle_eps,
-        progress=lambda x: report(0.4 + 0.6 * x),
-        order=order,
+    first = (
+        duplicate_faces(faces_welded) if duplicate_first is None else np.asarray(duplicate_first, np.int64)
     )
+    own = first == np.arange(m)
+    reps, copies = np.flatnonzero(own), np.flatnonzero(~own)
+    # the first faces of the groups in spatial order (cache locality), then the copies;
+    # every result goes back to the input's face ids
+    rows = np.concatenate([reps[spatial_order(np.asarray(vertices, np.float64)[faces[reps, 0]])], copies])
+    tri, diag = _normalised(vertices, faces, rows)
+    report = progress or (lambda fraction: None)
+    test = _Narrow(tri, np.asarray(faces_welded)[rows], eps, near, angle_eps, FOLD_ANGLE, rows)
+    pairs, codes, candidates = _flagged_pairs(tri[: len(reps)], test, max(eps, near), report)
     del tri
+    # each copy against the first face of its group
+    row_of = np.empty(m, np.int64)
+    row_of[rows] = np.arange(m)
+    star = np.stack([row_of[first[copies]], np.arange(len(reps), m)], axis=1)
+    s_inter, s_copl, s_close = classify_pairs(
+        test.faces[1], test.faces[2], star, eps, near, angle_eps, order=rows
+    )
+    del test
+    star_codes = (s_inter * INTERSECTS + s_copl * COPLANAR + s_close * TOO_CLOSE).astype(np.uint8)
+    pairs = rows[np.concatenate([pairs, star])]
+    codes = np.concatenate([codes, star_codes])
+    keep = codes > 0
+    pairs, codes = np.sort(pairs[keep], axis=1), codes[keep]
+    order = np.lexsort((pairs[:, 1], pairs[:, 0]))
+    pairs, codes = pairs[order], codes[order]
+    report(1.0)
 
-    def flags(mask):
+    def flags(bit: int) -> np.ndarray:
         out = np.zeros(m, bool)
-        out[order[pairs[mask].ravel()]] = True
-        return out
+        out[pairs[(codes & bit) > 0].ravel()] = True
+        # the copies of a face share the flags of their whole group
+        group = np.zeros(m, bool)
+        np.logical_or.at(group, first, out)
+        return group[first]
 
-    def original(mask):
-        p = np.sort(order[pairs[mask]], axis=1)
-        return p[np.lexsort((p[:, 1], p[:, 0]))]
+    def of(bit: int) -> np.ndarray:
+        return pairs[(codes & bit) > 0]
 
     return {
-        "intersects": flags(inter),
-        "coplanar": flags(copl),
-        "too_close": flags(close),
-        "intersect_pairs": original(inter),
-        "coplanar_pairs": original(copl),
-        "close_pairs": original(close),
-        "candidates": int(len(pairs)),
+        "intersects": flags(INTERSECTS),
+        "coplanar": flags(COPLANAR),
+        "too_close": flags(TOO_CLOSE),
+        "intersect_pairs": of(INTERSECTS),
+        "coplanar_pairs": of(COPLANAR),
+        "close_pairs": of(TOO_CLOSE),
+        "duplicate_first": first,
+        "candidates": candidates,
         "eps": eps * diag,
         "near": near * diag,
         "diagonal": diag,
     }
+
+
+def _flagged_pairs(
+    tri: np.ndarray, test: _Narrow, pad: float, report: Callable[[float], None]
+) -> tuple[np.ndarray, np.ndarray, int]:
+    """Broad and narrow phase in one pass over the rows ``tri`` (the first rows of ``test``).
+
+    Returns the (k, 2) row pairs with a flag, their codes (bits of
+    :data:`meshvis.geometry._kernels.INTERSECTS`, ...) and the candidates looked at.  Memory
+    follows the flagged pairs: the candidates are tested in chunks as the grid meets them.
+    """
+    from meshvis import limits
+    from meshvis.geometry._kernels import broad_narrow
+
+    n = len(tri)
+    if n < 2:
+        return np.zeros((0, 2), np.int64), np.zeros(0, np.uint8), 0
+    lower = tri.min(axis=1) - pad
+    upper = tri.max(axis=1) + pad
+    broad = _BroadPhase(lower, upper, overwrite=True)
+    candidates = broad.candidates
+    cap = max(limits.MAX_FACE_PAIRS_PER_FACE * n, limits.MIN_FACE_PAIRS)
+    if candidates > cap:
+        raise ModelError(
+            f"the intersection tests would compare {candidates} pairs of faces whose boxes overlap, "
+            f"{candidates // n} per face, more than the cap MAX_FACE_PAIRS_PER_FACE of meshvis.limits "
+            f"({limits.MAX_FACE_PAIRS_PER_FACE}): many different faces are stacked in one place"
+        )
+    report(0.1)
+    work = [(job, sl) for job in broad.jobs for sl in _chunks(job.counts)]
+    bounds = broad.bounds
+    kernel: Callable[..., tuple[np.ndarray, np.ndarray]] = broad_narrow  # numba's dispatcher
+
+    def run(item) -> tuple[np.ndarray, np.ndarray]:
+        job, sl = item
+        return kernel(*job.rows(sl), *bounds, _BITS, n, *test.faces, *test.tolerances)
+
+    out = []
+    step = 4 * default_threads()
+    for s in range(0, len(work), step):
+        part = work[s : s + step]
+        workers = pool(default_threads()) if len(part) > 1 else None
+        out += list(workers.map(run, part)) if workers is not None else [run(w) for w in part]
+        report(0.1 + 0.9 * min(s + step, len(work)) / len(work))
+    del broad, work
+    keys = np.concatenate([k for k, _ in out]) if out else np.zeros(0, np.int64)
+    codes = np.concatenate([c for _, c in out]) if out else np.zeros(0, np.uint8)
+    return _split_keys(keys, n).astype(np.int64), codes, candidates
 
 
 def too_close(vertices: np.ndarray, faces: np.ndarray, near: float | None = None, **kwargs) -> np.ndarray:

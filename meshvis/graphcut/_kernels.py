@@ -82,14 +82,27 @@ def _at_least(move, best):  # pragma: no cover - compiled
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def pushed_origins(
-    pos, point_face, side, triangles, normals, flagged_index, f, g, samples, offset, proximity, square_cos
-):  # pragma: no cover - compiled  # noqa: E501
+    pos,
+    point_face,
+    side,
+    triangles,
+    normals,
+    flagged,
+    start,
+    partner,
+    duplicate_first,
+    samples,
+    offset,
+    proximity,
+    square_cos,
+):  # pragma: no cover - compiled
     """(P, 3) origins of :func:`meshvis.graphcut.nodes._pushed_origins` on one side.
 
-    ``f, g`` are the (face, partner) candidates in the numpy version's order (the pairs,
-    then the pairs reversed, keeping those whose first face is flagged); every sample point
-    of ``f`` is tested against ``g``.  Among the partners a point lies on, the one with the
-    furthest move wins, the last one on ties (the numpy version's stable sort).
+    The partners of face ``f`` are ``partner[start[f] : start[f + 1]]``, in the numpy
+    version's order (the pairs, then the pairs reversed); a copy of a face (``duplicate_first[f]
+    != f``) also meets the partners of its group's first face (but itself).  Every sample
+    point of a flagged face is tested against its partners; among those it lies on, the
+    one with the furthest move wins, the last one on ties (the numpy version's stable sort).
     """
     n_points = len(pos)
     sgn = 1.0 if side == 0 else -1.0
@@ -102,43 +115,32 @@ def pushed_origins(
     best_move = np.zeros(n_points)
     best_orient = np.zeros(n_points)
     best_g = np.full(n_points, -1, np.int64)
-    for e in range(len(f)):
-        gg = g[e]
-        n0, n1, n2 = normals[gg, 0], normals[gg, 1], normals[gg, 2]
-        a0, a1, a2 = triangles[gg, 0, 0], triangles[gg, 0, 1], triangles[gg, 0, 2]
-        v00, v01, v02 = triangles[gg, 1, 0] - a0, triangles[gg, 1, 1] - a1, triangles[gg, 1, 2] - a2
-        v10, v11, v12 = triangles[gg, 2, 0] - a0, triangles[gg, 2, 1] - a1, triangles[gg, 2, 2] - a2
-        d00 = einsum_dot3(v00, v01, v02, v00, v01, v02)
-        d01 = einsum_dot3(v00, v01, v02, v10, v11, v12)
-        d11 = einsum_dot3(v10, v11, v12, v10, v11, v12)
-        den = d00 * d11 - d01 * d01
-        ok = den > 0
-        if not ok:
-            den = 1.0
-        scale = math.sqrt(_max_nan(d00, d11))
-        t = proximity / (scale if scale > 0 else 1.0)
-        first = flagged_index[f[e]] * samples
-        for q in range(samples):
-            pt = first + q
-            p0, p1, p2 = pos[pt, 0], pos[pt, 1], pos[pt, 2]
-            d = einsum_dot3(n0, n1, n2, p0 - a0, p1 - a1, p2 - a2)
-            if not abs(d) < proximity:
-                continue
-            w0, w1, w2 = (p0 - d * n0) - a0, (p1 - d * n1) - a1, (p2 - d * n2) - a2
-            d20 = einsum_dot3(w0, w1, w2, v00, v01, v02)
-            d21 = einsum_dot3(w0, w1, w2, v10, v11, v12)
-            v = (d11 * d20 - d01 * d21) / den
-            w = (d00 * d21 - d01 * d20) / den
-            u = 1 - v - w
-            if not (ok and u >= -t and v >= -t and w >= -t):
-                continue
-            cos = einsum_dot3(n0, n1, n2, ns[pt, 0], ns[pt, 1], ns[pt, 2])
-            orient = _sign(d) if abs(cos) < square_cos else _sign(cos)
-            if orient == 0:
-                continue
-            move = offset - orient * d
-            if best_g[pt] < 0 or _at_least(move, best_move[pt]):
-                best_move[pt], best_orient[pt], best_g[pt] = move, orient, gg
+    for q in range(len(flagged)):
+        f = flagged[q]
+        r = duplicate_first[f]
+        for own in range(2):
+            src = f if own == 0 else r
+            if own == 1 and r == f:
+                break
+            for e in range(start[src], start[src + 1]):
+                gg = partner[e]
+                if own == 1 and gg == f:
+                    continue
+                _push_past(
+                    gg,
+                    q * samples,
+                    samples,
+                    pos,
+                    ns,
+                    triangles,
+                    normals,
+                    proximity,
+                    offset,
+                    square_cos,
+                    best_move,
+                    best_orient,
+                    best_g,
+                )
     for k in range(n_points):
         gg = best_g[k]
         if gg < 0:
@@ -147,6 +149,59 @@ def pushed_origins(
         for c in range(3):
             origin[k, c] = (pos[k, c] + step * normals[gg, c]) + offset * ns[k, c]
     return origin
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _push_past(
+    gg,
+    first,
+    samples,
+    pos,
+    ns,
+    triangles,
+    normals,
+    proximity,
+    offset,
+    square_cos,
+    best_move,
+    best_orient,
+    best_g,
+):  # pragma: no cover - compiled
+    """Points ``first .. first + samples - 1`` lying on partner ``gg``: keep its move where it is the furthest."""
+    n0, n1, n2 = normals[gg, 0], normals[gg, 1], normals[gg, 2]
+    a0, a1, a2 = triangles[gg, 0, 0], triangles[gg, 0, 1], triangles[gg, 0, 2]
+    v00, v01, v02 = triangles[gg, 1, 0] - a0, triangles[gg, 1, 1] - a1, triangles[gg, 1, 2] - a2
+    v10, v11, v12 = triangles[gg, 2, 0] - a0, triangles[gg, 2, 1] - a1, triangles[gg, 2, 2] - a2
+    d00 = einsum_dot3(v00, v01, v02, v00, v01, v02)
+    d01 = einsum_dot3(v00, v01, v02, v10, v11, v12)
+    d11 = einsum_dot3(v10, v11, v12, v10, v11, v12)
+    den = d00 * d11 - d01 * d01
+    ok = den > 0
+    if not ok:
+        den = 1.0
+    scale = math.sqrt(_max_nan(d00, d11))
+    t = proximity / (scale if scale > 0 else 1.0)
+    for q in range(samples):
+        pt = first + q
+        p0, p1, p2 = pos[pt, 0], pos[pt, 1], pos[pt, 2]
+        d = einsum_dot3(n0, n1, n2, p0 - a0, p1 - a1, p2 - a2)
+        if not abs(d) < proximity:
+            continue
+        w0, w1, w2 = (p0 - d * n0) - a0, (p1 - d * n1) - a1, (p2 - d * n2) - a2
+        d20 = einsum_dot3(w0, w1, w2, v00, v01, v02)
+        d21 = einsum_dot3(w0, w1, w2, v10, v11, v12)
+        v = (d11 * d20 - d01 * d21) / den
+        w = (d00 * d21 - d01 * d20) / den
+        u = 1 - v - w
+        if not (ok and u >= -t and v >= -t and w >= -t):
+            continue
+        cos = einsum_dot3(n0, n1, n2, ns[pt, 0], ns[pt, 1], ns[pt, 2])
+        orient = _sign(d) if abs(cos) < square_cos else _sign(cos)
+        if orient == 0:
+            continue
+        move = offset - orient * d
+        if best_g[pt] < 0 or _at_least(move, best_move[pt]):
+            best_move[pt], best_orient[pt], best_g[pt] = move, orient, gg
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

@@ -348,6 +348,10 @@ def classify(
         raise ParameterError("tolerance must be in [0, 1)")
     hints = Hints.coerce(hints)
     soup = as_soup(model)
+    if rays_per_point is None:
+        rays_per_point = rays_per_node
+    # what the options may ask of this input is bounded before the analysis runs
+    _validate.ray_budget(soup, rays_per_node, rays_per_point, samples_per_face)
     rng = np.random.default_rng(seed)
     stages: list[Stage] = []
     report = progress or (lambda stage, frac: None)
@@ -359,8 +363,6 @@ def classify(
     loop = _Sampling(
         caster, nodes, soup, pre.degenerate, rng, hint_out, hint_in, use_filter, opening, solver, report
     )
-    if rays_per_point is None:
-        rays_per_point = rays_per_node
     loop.run(rays_per_node, rays_per_point, progressive, tolerance)
     stages += loop.stages(use_filter)
     report("done", 1.0)
@@ -459,6 +461,7 @@ def _nodes(
         scheme=scheme,
         offset=off_abs,
         proximity=2 * off_abs,
+        duplicate_first=pre.analysis.duplicate_first,
     )
     point_note = (
         f"{nodes.n_points} sample points" if nodes.n_points else "skipped point nodes: no flagged faces"
@@ -497,7 +500,6 @@ class _Sampling:
         """Cast rounds of rays and cut after each until the labels settle (module notes)."""
         nodes = self.nodes
         budget = ray_allocation(nodes, rays_per_node, rays_per_point)
-        _validate.ray_budget(int(budget.sum()), nodes.n, rays_per_node)
         cast = np.zeros(nodes.n, np.int64)
         if progressive:
             give = ray_allocation(
@@ -551,8 +553,14 @@ class _Sampling:
 
     def _sample(self, give: np.ndarray, cast: np.ndarray, budget: np.ndarray) -> None:
         t = time.perf_counter()
-        self.report("sampling", float(cast.sum()) / max(float(budget.sum()), 1.0))
-        sample_round(self.caster, self.nodes, give, self.rng, self.counts)
+        stage, total, done = f"sampling {len(self.rounds) + 1}", max(float(give.sum()), 1.0), [0]
+        self.report(stage, 0.0)
+
+        def step(rays: int) -> None:  # the progress of this round, batch by batch
+            done[0] += rays
+            self.report(stage, done[0] / total)
+
+        sample_round(self.caster, self.nodes, give, self.rng, self.counts, progress=step)
         self.t_sample += time.perf_counter() - t
 
     def _cut(self) -> None:

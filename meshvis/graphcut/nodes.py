@@ -130,6 +130,7 @@ def build_nodes(
     scheme: int = 2,
     offset: float,
     proximity: float,
+    duplicate_first: np.ndarray | None = None,
 ) -> NodeSet:
     """Create the half-space nodes.
 
@@ -158,6 +159,11 @@ def build_nodes(
     proximity : float
         A sample point closer than this to a partner's plane, and inside it, is moved past
         that partner (appendix H Fig. 6).
+    duplicate_first : (m,) int64 array, optional
+        The first face of each face's group of copies
+        (:func:`meshvis.geometry.adjacency.duplicate_faces`): the pairs of a group's first
+        face stand for those of its copies, as :func:`meshvis.geometry.intersect.intersection_flags`
+        gives them.  Default: no copies.
 
     Returns
     -------
@@ -167,7 +173,9 @@ def build_nodes(
     side_node = clustering.side_node
     n_cluster = clustering.n_nodes
     e_node, e_face, e_side, node_start, c_area, c_faces = _cluster_entries(side_node, n_cluster, areas)
-    pts = _point_nodes(triangles, normals, areas, flagged, partner_pairs, samples, scheme, offset, proximity)
+    pts = _point_nodes(
+        triangles, normals, areas, flagged, partner_pairs, samples, scheme, offset, proximity, duplicate_first
+    )
     n_points = len(pts["point_face"])
     p_area = np.repeat(areas[pts["flagged"]] / samples, samples)
     return NodeSet(
@@ -207,7 +215,7 @@ def _cluster_entries(side_node: np.ndarray, n_cluster: int, areas: np.ndarray):
 
 
 def _point_nodes(
-    triangles, normals, areas, flagged, partner_pairs, samples, scheme, offset, proximity
+    triangles, normals, areas, flagged, partner_pairs, samples, scheme, offset, proximity, duplicate_first
 ) -> dict:
     """Sample points of the flagged faces with their pushed ray origins (NodeSet fields)."""
     m = len(triangles)
@@ -220,7 +228,17 @@ def _point_nodes(
     origin = np.empty((len(point_face), 2, 3))
     for s in (0, 1):
         origin[:, s] = _pushed_origins(
-            pos, point_face, s, triangles, normals, flagged_index, partner_pairs, samples, offset, proximity
+            pos,
+            point_face,
+            s,
+            triangles,
+            normals,
+            flagged_index,
+            partner_pairs,
+            samples,
+            offset,
+            proximity,
+            duplicate_first,
         )
     tf = triangles[flagged_faces]
     e1, e2 = tf[:, 1] - tf[:, 0], tf[:, 2] - tf[:, 0]
@@ -244,7 +262,17 @@ PERPENDICULAR_COS = 1e-3
 
 
 def _pushed_origins(
-    pos, point_face, side, triangles, normals, flagged_index, pairs, samples, offset, proximity
+    pos,
+    point_face,
+    side,
+    triangles,
+    normals,
+    flagged_index,
+    pairs,
+    samples,
+    offset,
+    proximity,
+    duplicate_first=None,
 ):
     """Ray origins of sample points on one side, pushed off the surface (appendix H Fig. 6).
 
@@ -257,20 +285,25 @@ def _pushed_origins(
     partner the origin belongs to, and picking one at random can push it through the
     partner (e.g. out of a room), so the point keeps the side of the partner it lies on,
     and does not move when it lies on the partner's plane itself.  One pass of
-    :func:`meshvis.graphcut._kernels.pushed_origins` over the (point, partner) candidates.
+    :func:`meshvis.graphcut._kernels.pushed_origins` over the (point, partner) candidates;
+    a copy of a face (``duplicate_first``) meets the partners of its group's first face,
+    whose pairs stand for the whole group's (:func:`meshvis.geometry.intersect.intersection_flags`).
     """
-    # (face, partner) candidates: every pair both ways, for the flagged first faces
+    # (face, partner) candidates: every pair both ways, grouped by face (stable: in that order)
     both = np.concatenate([pairs, pairs[:, ::-1]]) if len(pairs) else np.zeros((0, 2), np.int64)
-    both = both[flagged_index[both[:, 0]] >= 0]
+    by_face = np.argsort(both[:, 0], kind="stable")
+    start = np.searchsorted(both[by_face, 0], np.arange(len(triangles) + 1))
+    first = np.arange(len(triangles)) if duplicate_first is None else duplicate_first
     return _kernels.pushed_origins(
         np.ascontiguousarray(pos, np.float64),
         np.ascontiguousarray(point_face, np.int64),
         int(side),
         np.ascontiguousarray(triangles, np.float64),
         np.ascontiguousarray(normals, np.float64),
-        np.ascontiguousarray(flagged_index, np.int64),
-        np.ascontiguousarray(both[:, 0], np.int64),
-        np.ascontiguousarray(both[:, 1], np.int64),
+        np.ascontiguousarray(np.flatnonzero(flagged_index >= 0), np.int64),
+        np.ascontiguousarray(start, np.int64),
+        np.ascontiguousarray(both[by_face, 1], np.int64),
+        np.ascontiguousarray(first, np.int64),
         int(samples),
         float(offset),
         float(proximity),

@@ -19,6 +19,9 @@ from meshvis.rays.caster import RayCaster
 
 #: rays traced per Embree batch (bounded memory: ~100 bytes per ray in flight)
 BATCH = 1 << 20
+#: hits held before they are added to the sparse counts: memory follows the nodes' links,
+#: not the rays of a round
+HITS_HELD = 1 << 23
 
 
 @dataclass
@@ -114,12 +117,21 @@ def sample_round(
         r, c = _kernels.kept_hits(sr, s, dst, flagged_at, p, blocked, nodes.n_cluster, counts.discarded)
         rows.append(r)
         cols.append(c)
+        if sum(len(x) for x in rows) >= HITS_HELD:  # the round's hits so far into the matrix
+            _add_hits(counts, rows, cols, nodes.n)
         if progress is not None:
             progress(len(src))
     counts.cast += rays_per_node
-    if rows:
-        r, c = np.concatenate(rows), np.concatenate(cols)
-        add = sp.coo_matrix((np.ones(len(r)), (r, c)), shape=(nodes.n, nodes.n)).tocsr()
-        counts.hits = (counts.hits + add).tocsr()
+    _add_hits(counts, rows, cols, nodes.n)
     counts.time_total += time.perf_counter() - t_start
     return counts
+
+
+def _add_hits(counts: VisibilityCounts, rows: list, cols: list, n: int) -> None:
+    """Add the (row, column) hits held in ``rows`` and ``cols`` to ``counts.hits``; empty the lists."""
+    if rows:
+        r, c = np.concatenate(rows), np.concatenate(cols)
+        add = sp.coo_matrix((np.ones(len(r)), (r, c)), shape=(n, n)).tocsr()
+        counts.hits = (counts.hits + add).tocsr()
+    rows.clear()
+    cols.clear()

@@ -17,6 +17,7 @@ from __future__ import annotations
 from meshvis.io._common import (
     atomic_write,
     check_output,
+    check_outputs,
     ensure_folder,
     one_line,
     staged_outputs,
@@ -34,6 +35,7 @@ __all__ = [
     "as_soup",
     "atomic_write",
     "check_output",
+    "check_outputs",
     "ensure_folder",
     "load",
     "one_line",

@@ -23,6 +23,24 @@ import numpy as np
 from meshvis.errors import OutputError
 from meshvis.soup import Soup
 
+#: the UTF-8 byte-order mark some editors put at the start of a text file
+BOM = b"\xef\xbb\xbf"
+
+
+def without_bom(data: bytes) -> bytes:
+    """``data`` without a leading UTF-8 byte-order mark (which would otherwise be read as
+    part of the first line's keyword, and that line lost)."""
+    return data[len(BOM) :] if data.startswith(BOM) else data
+
+
+def decode_text(data: bytes) -> str:
+    """The text of a file's bytes: UTF-8 (a byte-order mark dropped), else Latin-1."""
+    data = without_bom(data)
+    try:
+        return data.decode("utf-8")
+    except UnicodeDecodeError:
+        return data.decode("latin-1")
+
 
 def one_line(text: object, limit: int = 200) -> str:
     """The first line of ``str(text)``, shortened to ``limit`` characters."""
@@ -93,8 +111,61 @@ def staged_outputs() -> Iterator[None]:
     finally:
         _STAGE.reset(token)
     with _signals_held():
+        _publish(stage)
+
+
+def _publish(stage: _Stage) -> None:
+    """Rename every staged file into place, or, when one rename fails, none of them.
+
+    Each existing target is first kept under a temporary name (a hard link, or the file
+    itself moved there when the file system has no hard links).  When a rename fails, the
+    targets already replaced get their old files back, the new ones are removed, and so are
+    the stage's other files (textures).
+    """
+    done: list[tuple[str, str | None]] = []  # (target, temporary name of its old file or None)
+    try:
         for tmp, path in stage.pending:
-            os.replace(tmp, path)
+            kept = _keep_aside(path)
+            try:
+                os.replace(tmp, path)
+            except OSError:
+                if kept is not None:
+                    os.replace(kept, path)
+                raise
+            done.append((path, kept))
+    except OSError as exc:
+        for path, kept in reversed(done):
+            with contextlib.suppress(OSError):
+                if kept is not None:
+                    os.replace(kept, path)
+                else:
+                    os.unlink(path)
+        for p in [tmp for tmp, _ in stage.pending] + stage.created:
+            with contextlib.suppress(OSError):
+                os.unlink(p)
+        failed = next((path for tmp, path in stage.pending if tmp == exc.filename), exc.filename or "")
+        raise OutputError(f"cannot write: {one_line(exc.strerror or exc)}", failed) from None
+    for _, kept in done:
+        if kept is not None:
+            with contextlib.suppress(OSError):
+                os.unlink(kept)
+
+
+def _keep_aside(path: str) -> str | None:
+    """A new temporary name in the folder of ``path`` for the file now there (None: no file)."""
+    if not os.path.lexists(path) or os.path.isdir(path):
+        return None
+    folder = os.path.dirname(os.path.abspath(path))
+    while True:
+        kept = os.path.join(folder, f"{temp_prefix(path)}{os.urandom(6).hex()}.tmp")
+        if os.path.lexists(kept):
+            continue
+        if os.path.isfile(path) and not os.path.islink(path):
+            with contextlib.suppress(OSError):  # no hard links here: move the file instead
+                os.link(path, kept)
+                return kept
+        os.replace(path, kept)
+        return kept
 
 
 def register_created(path: str) -> None:
@@ -131,7 +202,8 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
     left untouched.  Inside :func:`staged_outputs` the rename waits for the end of that
     block.  The temporary name is ``.<file name>.<random>.tmp`` (the file name shortened
     when needed, see :func:`temp_prefix`).  The new file gets the permissions of the file it replaces, or the
-    usual ones for a new file (0666 less the umask).
+    usual ones for a new file (0666 less the umask).  Text is UTF-8; a character it cannot
+    hold (a lone surrogate, from a file name that is not valid UTF-8) is written as ``?``.
 
     Parameters
     ----------
@@ -167,7 +239,9 @@ def atomic_write(path: str | os.PathLike, mode: str = "w", encoding: str = "utf-
     except OSError as exc:
         raise OutputError(f"cannot write: {one_line(exc.strerror or exc)}", path) from None
     try:
-        text: dict[str, Any] = {"encoding": encoding, "newline": "\n"} if mode == "w" else {}
+        text: dict[str, Any] = (
+            {"encoding": encoding, "newline": "\n", "errors": "replace"} if mode == "w" else {}
+        )
         with os.fdopen(fd, mode, **text) as fh:
             yield fh
             fh.flush()
@@ -255,6 +329,28 @@ def companions(path: str) -> list[str]:
     return [stem + ".mtl"] if ext.lower() == ".obj" else []
 
 
+def check_outputs(paths: list[str], inputs: list[str], force: bool) -> None:
+    """:func:`check_output` for every output of one command, and no two of them the same file.
+
+    The files written with an output (:func:`companions`, e.g. the MTL of an OBJ) count as
+    outputs too, so ``-o out/o.obj`` with ``--report out/o.mtl`` is refused before any work.
+
+    Raises
+    ------
+    OutputError
+        Two outputs (or companions) are one file, or :func:`check_output` refuses one.
+    """
+    seen: set[str] = set()
+    for path in paths:
+        for p in [path, *companions(path)]:
+            key = os.path.normcase(os.path.realpath(p))
+            if key in seen:
+                raise OutputError("two outputs of the command are this one file; give each its own path", p)
+            seen.add(key)
+    for path in paths:
+        check_output(path, inputs, force)
+
+
 def check_output(path: str, inputs: list[str], force: bool) -> None:
     """Refuse an output path that cannot or must not be written.
 
@@ -296,13 +392,23 @@ def _check_one(path: str, inputs: list[str], force: bool, what: str = "") -> Non
 
 
 def check_folder(path: str) -> None:
-    """Refuse an output path whose folder is missing or not writable (:class:`OutputError`
-    naming the path)."""
+    """Refuse an output path whose folder is missing or not writable, or whose name is
+    longer than the file system allows (:class:`OutputError` naming the path)."""
     folder = os.path.dirname(os.path.abspath(path))
-    if not os.path.isdir(folder):
+    # the folder as written too: "missing/../o.obj" names a folder that does not exist
+    if not os.path.isdir(folder) or not os.path.isdir(os.path.dirname(os.fspath(path)) or "."):
         raise OutputError("output folder does not exist", path)
     if not os.access(folder, os.W_OK):
         raise OutputError("output folder is not writable", path)
+    try:
+        limit = os.pathconf(folder, "PC_NAME_MAX")
+    except (OSError, ValueError, AttributeError):
+        limit = 255
+    size = len(os.fsencode(os.path.basename(path)))
+    if size > limit:
+        raise OutputError(
+            f"the file name is {size} bytes long, more than the file system allows ({limit})", path
+        )
 
 
 def ensure_folder(out_dir: str) -> None:

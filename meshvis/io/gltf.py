@@ -1,6 +1,7 @@
 """glTF 2.0 / GLB reader (flattened scene, instancing applied) and writer.
 
-Reading: trimesh decodes the primitives (accessors, sparse data, Draco, textures); the
+Reading: trimesh decodes the primitives (accessors, sparse data, Draco through DracoPy,
+textures; buffers compressed with meshoptimizer are refused); the
 scene tree is walked here from the file's own JSON, in file order, so that every *node
 instance* becomes one part named after the node (or after its mesh when the node has no
 name), all primitives of the node's mesh belong to that part, and material ids are the
@@ -17,14 +18,16 @@ colours and PBR materials with their base colour texture embedded.
 from __future__ import annotations
 
 import base64
+import io
 import json
 import os
 import struct
+import warnings
 
 import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
-from meshvis.io._common import atomic_write, unique_names, weld_corners
+from meshvis.io._common import BOM, atomic_write, unique_names, weld_corners
 from meshvis.io.edits import face_edits
 from meshvis.io.gltf_edit import (
     BIN_CHUNK,
@@ -72,57 +75,190 @@ def _local_matrix(node: dict) -> np.ndarray:
 
 
 def _instances(doc: dict) -> list[tuple[int, np.ndarray]]:
-    """(node index, world matrix) of every node with a mesh, depth first in file order."""
+    """(node index, world matrix) of every node with a mesh, depth first in file order.
+
+    The node graph has no cycle (:func:`check_document` refuses one), so the walk needs no
+    record of the path: linear in the instances, however deep the graph.
+    """
     nodes = doc.get("nodes", [])
-    if "scenes" in doc and doc["scenes"]:
-        scene = doc["scenes"][doc.get("scene", 0) if 0 <= doc.get("scene", 0) < len(doc["scenes"]) else 0]
-        roots = list(scene.get("nodes", []))
-    else:
-        children = {c for n in nodes for c in n.get("children", [])}
-        roots = [i for i in range(len(nodes)) if i not in children]
     out = []
-    stack = [(r, np.eye(4), ()) for r in reversed(roots)]
+    stack = [(r, np.eye(4)) for r in reversed(_roots(doc, nodes))]
     while stack:
-        i, parent, path = stack.pop()
-        if not (0 <= i < len(nodes)) or i in path:
-            continue  # bad index or a cycle
+        i, parent = stack.pop()
+        if not _index(i, len(nodes)):
+            continue
         node = nodes[i]
         world = parent @ _local_matrix(node)
         if "mesh" in node:
             out.append((i, world))
         for c in reversed(node.get("children", [])):
-            stack.append((c, world, path + (i,)))
+            stack.append((c, world))
     return out
+
+
+def _roots(doc: dict, nodes: list) -> list:
+    """The root nodes of the scene shown.
+
+    That is ``scene`` (else the first scene), or every node nobody lists as a child when the
+    file has no scenes.
+    """
+    scenes = doc.get("scenes")
+    if isinstance(scenes, list) and scenes:
+        s = doc.get("scene", 0)
+        scene = scenes[s if _index(s, len(scenes)) else 0]
+        return list(scene.get("nodes", [])) if isinstance(scene, dict) else []
+    children = {c for n in nodes if isinstance(n, dict) for c in n.get("children", [])}
+    return [i for i in range(len(nodes)) if i not in children]
 
 
 # ---------------------------------------------------------------------------- checks
 # (before trimesh sees the file: what it may read, how far it may expand, what must index what)
-def check_document(doc: dict, path: str, label: str) -> None:
+#: glTF extensions that meshvis reads as the specification asks (Draco through DracoPy,
+#: see :func:`_check_compression`)
+IMPLEMENTED_EXTENSIONS = frozenset({"KHR_draco_mesh_compression"})
+#: glTF extensions that change only what meshvis does not read (shading, lights, texture
+#: formats): a file that requires one is read without it, with a warning
+IGNORABLE_EXTENSIONS = frozenset(
+    {
+        "KHR_materials_pbrSpecularGlossiness",
+        "KHR_materials_unlit",
+        "KHR_materials_emissive_strength",
+        "KHR_materials_clearcoat",
+        "KHR_materials_transmission",
+        "KHR_materials_volume",
+        "KHR_materials_ior",
+        "KHR_materials_specular",
+        "KHR_materials_sheen",
+        "KHR_materials_iridescence",
+        "KHR_materials_anisotropy",
+        "KHR_materials_dispersion",
+        "KHR_materials_variants",
+        "KHR_texture_transform",
+        "KHR_texture_basisu",
+        "EXT_texture_webp",
+        "EXT_texture_avif",
+        "KHR_lights_punctual",
+        "KHR_xmp_json_ld",
+    }
+)
+
+
+def check_document(doc: dict, path: str, label: str, buffers: list | None = None) -> None:
     """Refuse a glTF document that is unsafe or broken (raises :class:`ModelFormatError`).
 
-    Unsafe: it reads outside its folder or expands past the caps of :mod:`meshvis.limits`;
-    broken: its accessors point at nothing.
+    Unsafe: it reads outside its folder or from something that is not a file, or expands
+    past the caps of :mod:`meshvis.limits`; broken: its accessors point at nothing or read
+    past their data, or it requires an extension meshvis does not implement.
+
+    Parameters
+    ----------
+    doc : dict
+        The JSON document.
+    path : str
+        The file, whose folder external references resolve from.
+    label : str
+        The file's name in messages.
+    buffers : list of bytes or None, optional
+        The data of every buffer held in the file (None for an external one), as
+        :func:`~meshvis.io.gltf_edit.read_container` returns it; default: every buffer is
+        taken as long as it says.
     """
-    _check_uris(doc, path, label)
-    _check_accessors(doc, label)
+    _check_compression(doc, label)  # before the required extensions: its message is the more precise
+    _check_extensions(doc, label)
+    sizes = _check_uris(doc, path, label, buffers)
+    file_bytes = os.path.getsize(path) + sum(s for s in sizes if s is not None)
+    _check_expansion(_check_accessors(doc, label, sizes), file_bytes, label)
     _check_node_graph(doc, label)
 
 
-def _check_uris(doc: dict, path: str, label: str) -> None:
-    """External buffers and images must be files in the model's folder (or below)."""
-    import os
+def _check_extensions(doc: dict, label: str) -> None:
+    """Refuse a file that requires an extension meshvis does not implement (glTF 2.0 §3.12).
+
+    A required extension that changes only what meshvis does not read gets a warning.
+    """
+    import warnings
+
+    required = [str(e) for e in _list(doc, "extensionsRequired", label)]
+    missing = [e for e in required if e not in IMPLEMENTED_EXTENSIONS and e not in IGNORABLE_EXTENSIONS]
+    if missing:
+        raise ModelFormatError(
+            f"the file requires the glTF extension {', '.join(missing)}, which meshvis does not implement",
+            label,
+        )
+    ignored = [e for e in required if e in IGNORABLE_EXTENSIONS]
+    if ignored:
+        warnings.warn(
+            f"{label}: the file requires the glTF extension {', '.join(ignored)}; meshvis reads it without "
+            "(it changes only materials, textures or lights)",
+            stacklevel=4,
+        )
+
+
+def _check_uris(doc: dict, path: str, label: str, held: list | None) -> list[int | None]:
+    """External buffers and images must be regular files in the model's folder (or below).
+
+    Returns the size in bytes of the data of every buffer (None: unknown, e.g. a missing file).
+    """
     from urllib.parse import unquote
 
-    from meshvis.io.mtl import inside_folder
+    from meshvis.io.mtl import outside_reference
 
     folder = os.path.dirname(os.path.abspath(path))
+    sizes: list[int | None] = []
     for kind in ("buffers", "images"):
         for i, item in enumerate(_list(doc, kind, label)):
             uri = item.get("uri") if isinstance(item, dict) else None
-            if not isinstance(uri, str) or uri.startswith("data:"):
-                continue
-            if "://" in uri or not inside_folder(os.path.join(folder, unquote(uri)), folder):
-                raise ModelFormatError(f"{kind[:-1]} {i} refers to {uri}, outside the model's folder", label)
+            data = held[i] if kind == "buffers" and held is not None and i < len(held) else None
+            size = len(data) if data is not None else None
+            if isinstance(uri, str) and not uri.startswith("data:"):
+                full = os.path.join(folder, unquote(uri))
+                if outside_reference(unquote(uri), folder, folder):
+                    raise ModelFormatError(
+                        f"{kind[:-1]} {i} refers to {uri}, outside the model's folder", label
+                    )
+                if os.path.exists(full) and not os.path.isfile(full):
+                    raise ModelFormatError(
+                        f"{kind[:-1]} {i} refers to {uri}, which is not a regular file (a FIFO, socket or device)",
+                        label,
+                    )
+                size = os.path.getsize(full) if os.path.isfile(full) else None
+            if kind == "buffers":
+                sizes.append(size)
+    return sizes
+
+
+#: the extensions that store buffer views compressed with meshoptimizer (not decoded here)
+MESHOPT_EXTENSIONS = ("EXT_meshopt_compression", "KHR_meshopt_compression")
+
+
+def _check_compression(doc: dict, label: str) -> None:
+    """Compressed geometry is decoded, or refused: never read as its placeholder zeros.
+
+    Draco-compressed primitives (``KHR_draco_mesh_compression``) are decoded by trimesh
+    with DracoPy; without DracoPy their accessors would read as zeros (one point, every
+    face degenerate).  Buffer views compressed with meshoptimizer are refused.
+    """
+    for i, view in enumerate(_list(doc, "bufferViews", label)):
+        used = [
+            e for e in MESHOPT_EXTENSIONS if isinstance(view, dict) and e in (view.get("extensions") or {})
+        ]
+        if used:
+            raise ModelFormatError(
+                f"bufferView {i} is compressed with {used[0]}, which meshvis does not decode", label
+            )
+    draco = any(
+        isinstance(prim, dict) and "KHR_draco_mesh_compression" in (prim.get("extensions") or {})
+        for mesh in _list(doc, "meshes", label)
+        if isinstance(mesh, dict)
+        for prim in mesh.get("primitives", [])
+    )
+    if draco:
+        try:
+            import DracoPy  # noqa: F401
+        except ImportError:
+            raise ModelFormatError(
+                "the geometry is Draco-compressed and DracoPy, which decodes it, is not installed", label
+            ) from None
 
 
 def _list(doc: dict, key: str, label: str) -> list:
@@ -136,39 +272,92 @@ def _index(value, n: int) -> bool:
     return isinstance(value, int) and not isinstance(value, bool) and 0 <= value < n
 
 
-def _check_accessors(doc: dict, label: str) -> None:
-    """Every accessor's bufferView exists and holds it; every bufferView lies in its buffer."""
+#: bytes of one component of each accessor componentType, and components of each type
+_COMPONENT_BYTES = {5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4}
+_TYPE_WIDTH = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
+
+
+def _check_accessors(doc: dict, label: str, sizes: list[int | None]) -> int:
+    """Check that every accessor's bufferView exists and holds it, and every view its buffer.
+
+    Returns the bytes all accessors decode to.
+    """
     buffers, views = _list(doc, "buffers", label), _list(doc, "bufferViews", label)
     for i, v in enumerate(views):
         if not isinstance(v, dict) or not _index(v.get("buffer"), len(buffers)):
             raise ModelFormatError(f"bufferView {i} refers to a buffer that does not exist", label)
-        end = int(v.get("byteOffset", 0)) + int(v.get("byteLength", 0))
-        if min(int(v.get("byteOffset", 0)), int(v.get("byteLength", 0))) < 0 or (
-            "byteLength" in buffers[v["buffer"]] and end > int(buffers[v["buffer"]]["byteLength"])
+        offset, length = _whole(v.get("byteOffset", 0)), _whole(v.get("byteLength", 0))
+        buf = buffers[v["buffer"]]
+        declared = _whole(buf.get("byteLength")) if isinstance(buf, dict) and "byteLength" in buf else None
+        actual = sizes[v["buffer"]] if v["buffer"] < len(sizes) else None
+        if (
+            offset is None
+            or length is None
+            or any(n is not None and offset + length > n for n in (declared, actual))
         ):
             raise ModelFormatError(f"bufferView {i} lies outside its buffer", label)
-    sizes = {5120: 1, 5121: 1, 5122: 2, 5123: 2, 5125: 4, 5126: 4}
-    widths = {"SCALAR": 1, "VEC2": 2, "VEC3": 3, "VEC4": 4, "MAT2": 4, "MAT3": 9, "MAT4": 16}
+        stride = v.get("byteStride")
+        if stride is not None and (_whole(stride) is None or not 4 <= stride <= 252):
+            raise ModelFormatError(
+                f"bufferView {i} has a byteStride of {stride!r} (glTF allows 4 to 252)", label
+            )
+    decoded = 0
     for i, a in enumerate(_list(doc, "accessors", label)):
         if not isinstance(a, dict):
             raise ModelFormatError(f"accessor {i} is not an object", label)
         count = a.get("count", 0)
-        if not isinstance(count, int) or isinstance(count, bool) or count < 0:
+        if _whole(count) is None:
             raise ModelFormatError(f"accessor {i} has an invalid count {count!r}", label)
+        item = _COMPONENT_BYTES.get(a.get("componentType"), 4) * _TYPE_WIDTH.get(a.get("type"), 16)
+        decoded += count * item
+        sparse = a.get("sparse")
+        if sparse is not None and (not isinstance(sparse, dict) or _whole(sparse.get("count")) is None):
+            raise ModelFormatError(f"accessor {i} has an invalid sparse count", label)
+        if sparse is not None and sparse["count"] > count:
+            raise ModelFormatError(
+                f"accessor {i} replaces {sparse['count']} of its {count} elements (sparse)", label
+            )
         if "bufferView" not in a:
-            continue  # all zeros (or sparse)
+            continue  # all zeros (or sparse): counted in the expansion, not in a view
         if not _index(a["bufferView"], len(views)):
             raise ModelFormatError(
                 f"accessor {i} refers to bufferView {a['bufferView']!r}, which does not exist", label
             )
-        if a.get("componentType") in sizes and a.get("type") in widths and count:
-            view = views[a["bufferView"]]
-            item = sizes[a["componentType"]] * widths[a["type"]]
-            need = int(a.get("byteOffset", 0)) + (count - 1) * int(view.get("byteStride", item)) + item
-            if need > int(view.get("byteLength", 0)):
-                raise ModelFormatError(
-                    f"accessor {i} reads past the end of bufferView {a['bufferView']}", label
-                )
+        view = views[a["bufferView"]]
+        offset, stride = _whole(a.get("byteOffset", 0)), view.get("byteStride", item)
+        if offset is None:
+            raise ModelFormatError(f"accessor {i} has an invalid byteOffset", label)
+        if stride < item:
+            raise ModelFormatError(
+                f"accessor {i} has {item}-byte elements, wider than the byteStride {stride} of its bufferView",
+                label,
+            )
+        if count and offset + (count - 1) * stride + item > view.get("byteLength", 0):
+            raise ModelFormatError(f"accessor {i} reads past the end of bufferView {a['bufferView']}", label)
+    return decoded
+
+
+def _check_expansion(decoded: int, file_bytes: int, label: str) -> None:
+    """Refuse a file whose accessors decode to more than the expansion cap allows.
+
+    Images are not decoded when a file is read (a rebuilt output copies their bytes, or
+    decodes them under the same cap), so they are not counted here.
+    """
+    from meshvis import limits
+
+    allowed = max(limits.MIN_EXPANSION_BYTES, limits.MAX_EXPANSION * file_bytes)
+    if decoded > allowed:
+        raise ModelFormatError(
+            f"the accessors decode to {decoded} bytes, more than {limits.MAX_EXPANSION} times "
+            f"the {file_bytes} bytes of the file and its buffers (the cap MAX_EXPANSION of meshvis.limits; "
+            f"at least MIN_EXPANSION_BYTES, {limits.MIN_EXPANSION_BYTES})",
+            label,
+        )
+
+
+def _whole(value) -> int | None:
+    """``value`` when it is a non-negative integer of the JSON, else None."""
+    return value if isinstance(value, int) and not isinstance(value, bool) and value >= 0 else None
 
 
 def _check_node_graph(doc: dict, label: str) -> None:
@@ -197,13 +386,8 @@ def _check_node_graph(doc: dict, label: str) -> None:
         for c in node.get("children", []):
             inst, faces = inst + memo[c][0], faces + memo[c][1]
         memo[i] = (min(inst, 1 << 62), min(faces, 1 << 62))
-    scenes = _list(doc, "scenes", label)
-    if scenes:
-        s = doc.get("scene", 0)
-        roots = scenes[s if _index(s, len(scenes)) else 0].get("nodes", [])
-    else:
-        children = {c for n in nodes for c in n.get("children", [])}
-        roots = [i for i in range(len(nodes)) if i not in children]
+    _list(doc, "scenes", label)
+    roots = _roots(doc, nodes)
     inst = sum(memo[r][0] for r in roots if r in memo)
     faces = sum(memo[r][1] for r in roots if r in memo)
     if inst > limits.MAX_INSTANCES:
@@ -253,13 +437,25 @@ def _children(nodes: list, i: int, label: str) -> list[int]:
 def read_gltf(path: str, label: str | None = None) -> Soup:
     """Read a .glb / .gltf file into a flattened soup (see the module docstring)."""
     import trimesh
+    from PIL import Image
 
     label = label or path
     doc, buffers, glb_bin = read_container(path, label)
-    check_document(doc, path, label)
+    check_document(doc, path, label, buffers)
     with open(path, "rb") as fh:
-        ftype = "glb" if fh.read(4) == _GLB_MAGIC else "gltf"
-    scene = trimesh.load(path, file_type=ftype, force="scene", process=False, maintain_order=True)
+        head = fh.read(4)
+    ftype = "glb" if head == _GLB_MAGIC else "gltf"
+    source: object = path
+    options: dict = {"file_type": ftype, "force": "scene", "process": False, "maintain_order": True}
+    if head.startswith(BOM):  # trimesh reads JSON without one: hand it the text after the mark
+        from trimesh.resolvers import FilePathResolver
+
+        with open(path, "rb") as fh:
+            source = io.BytesIO(fh.read()[len(BOM) :])
+        options["resolver"] = FilePathResolver(path)
+    with warnings.catch_warnings():  # images are opened, not decoded: the expansion is checked above
+        warnings.simplefilter("ignore", Image.DecompressionBombWarning)
+        scene = trimesh.load(source, **options)
     meshes = doc.get("meshes", [])
     geoms = list(scene.geometry.values())
     prim_counts = [len(m.get("primitives", [])) for m in meshes]

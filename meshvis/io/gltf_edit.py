@@ -41,8 +41,9 @@ from urllib.parse import unquote
 import numpy as np
 
 from meshvis.errors import ModelFormatError
-from meshvis.io._common import atomic_write
+from meshvis.io._common import atomic_write, without_bom
 from meshvis.io.edits import FaceEdits, negate_in_type, split_turned_vertices
+from meshvis.io.jsonfile import parse_json
 
 GLB_MAGIC = b"glTF"
 JSON_CHUNK = 0x4E4F534A
@@ -107,7 +108,7 @@ def read_container(path: str, label: str) -> tuple[dict, list, int]:
     else:
         raw = data
     try:
-        doc = json.loads(raw.decode("utf-8"))
+        doc = parse_json(without_bom(raw).decode("utf-8"))
     except (UnicodeDecodeError, ValueError) as exc:
         raise ModelFormatError(f"glTF JSON does not parse: {str(exc).splitlines()[0]}", label) from None
     if not isinstance(doc, dict) or "asset" not in doc:

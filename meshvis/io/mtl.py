@@ -33,12 +33,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from meshvis.errors import OutputError
+from meshvis.errors import ModelFormatError, OutputError
 from meshvis.io._common import atomic_write, one_line, register_created, temp_prefix
 from meshvis.soup import Material
 
 # MTL statements whose last token is a file name (texture maps)
 _MAP_STATEMENTS = re.compile(r"^\s*(map_\w+|bump|disp|decal|refl|norm)\s", re.IGNORECASE)
+
+
+#: a URL scheme or a drive letter at the start of a file name (``file:``, ``http:``, ``C:``)
+_SCHEME = re.compile(r"^[A-Za-z][A-Za-z0-9+.-]*:")
 
 
 class TextureWarning(UserWarning):
@@ -49,6 +53,18 @@ def inside_folder(path: str, folder: str) -> bool:
     """True when ``path`` (symbolic links resolved) lies in ``folder`` or below it."""
     real, root = os.path.realpath(path), os.path.realpath(folder)
     return real == root or real.startswith(root.rstrip(os.sep) + os.sep)
+
+
+def outside_reference(name: str, folder: str, root: str) -> bool:
+    """Whether a file reference of a model names a place outside the model's folder ``root``.
+
+    Outside are a URL (``file:``, ``http:``), a drive (``C:``), and a path relative to
+    ``folder`` that leaves ``root`` with ``..``, from ``/`` or through a symbolic link;
+    backslashes count as separators too (files written on Windows use them).
+    """
+    if _SCHEME.match(name):
+        return True
+    return not all(inside_folder(os.path.join(folder, n), root) for n in {name, name.replace("\\", "/")})
 
 
 @dataclass
@@ -93,21 +109,40 @@ class MtlSource:
                     out.append((parts[0], parts[-1]))
         return out
 
+    def where(self) -> str:
+        """The start of a message about this block, ``"model.obj: model.mtl: "``.
+
+        The MTL file is named relative to the model's folder.
+        """
+        parts = [self.label] if self.label else []
+        if self.path:
+            root = self.root if self.root is not None else self.folder
+            parts.append(os.path.relpath(self.path, root) if inside_folder(self.path, root) else self.path)
+        return "".join(f"{p}: " for p in parts)
+
+    def outside(self, fname: str) -> bool:
+        """Whether texture ``fname`` names a place outside the model's folder (:func:`outside_reference`)."""
+        return outside_reference(fname, self.folder, self.root if self.root is not None else self.folder)
+
     def texture_path(self, fname: str, warn: bool = True) -> str | None:
         """The file of texture ``fname``, or None.
 
-        None (with a :class:`TextureWarning`) when it is outside the model's folder or missing.
+        None (with a :class:`TextureWarning`) when it is outside the model's folder
+        (:meth:`outside`) or missing.  Backslashes are folder separators unless a file has
+        the name as written.
         """
-        root = self.root if self.root is not None else self.folder
-        full = os.path.normpath(os.path.join(self.folder, fname))
-        who = f"{self.label}: " if self.label else ""
-        if not inside_folder(full, root):
+        who = self.where()
+        if self.outside(fname):
             if warn:
                 warnings.warn(
                     f"{who}texture {fname} is outside the model's folder; skipped", TextureWarning, 2
                 )
             return None
-        return full if os.path.isfile(full) else None
+        for name in (fname, fname.replace("\\", "/")):
+            full = os.path.normpath(os.path.join(self.folder, name))
+            if os.path.isfile(full):
+                return full
+        return None
 
 
 # ---------------------------------------------------------------------------- file helpers
@@ -238,21 +273,44 @@ def _safe_file_name(text: str) -> str:
 
 
 def _image_bytes(image) -> tuple[bytes | None, str | None]:
-    """PNG bytes of a PIL image (kept as JPEG/PNG bytes when they are already bytes).
+    """PNG or JPEG bytes of an image: bytes, or a PIL image.
+
+    PNG and JPEG bytes are kept as they are, and so are those a PIL image was read from
+    (a glTF texture): nothing is decoded.  Any other image is decoded and written as PNG,
+    unless it would decode to more than the expansion cap of :mod:`meshvis.limits` allows
+    for its encoded size (a small file of many pixels).
 
     Raises
     ------
-    OSError (PIL's ``UnidentifiedImageError``) when the bytes are not an image.
+    OSError (PIL's ``UnidentifiedImageError``) when the bytes are not an image;
+    ModelFormatError when the image decodes past the expansion cap.
     """
+    from meshvis import limits
+
     if image is None:
         return None, None
+    encoded = None
     if isinstance(image, (bytes, bytearray)):
         for magic, mime in _IMAGE_MIME.items():
             if bytes(image[: len(magic)]) == magic:
                 return bytes(image), mime
         from PIL import Image
 
+        encoded = len(image)
         image = Image.open(io.BytesIO(image))
+    else:
+        source = getattr(image, "fp", None)
+        raw = source.getvalue() if isinstance(source, io.BytesIO) else None
+        for magic, mime in _IMAGE_MIME.items():
+            if raw is not None and raw[: len(magic)] == magic:
+                return raw, mime
+        encoded = None if raw is None else len(raw)
+    decoded = 4 * image.width * image.height
+    if decoded > max(limits.MIN_EXPANSION_BYTES, limits.MAX_EXPANSION * (encoded or 0)):
+        raise ModelFormatError(
+            f"an image of {image.width} x {image.height} pixels from {encoded} bytes would decode past the cap "
+            "MAX_EXPANSION of meshvis.limits"
+        )
     buf = io.BytesIO()
     img = image
     if img.mode not in ("RGB", "RGBA", "L", "LA"):
@@ -271,7 +329,7 @@ def _texture_image(src: MtlSource, fname: str) -> tuple[bytes | None, str | None
     try:
         return _image_bytes(data)
     except Exception as exc:  # PIL raises several kinds for bytes that are not an image
-        who = f"{src.label}: " if src.label else ""
+        who = src.where()
         warnings.warn(
             f"{who}texture {fname} is not an image ({type(exc).__name__}); written without it",
             TextureWarning,
@@ -323,7 +381,10 @@ def describe_pbr(material: Material | None, name: str) -> PbrDescription:
             desc.base_color[: len(f)] = f[:4]
         tex = getattr(pbr, "baseColorTexture", None)
         if tex is not None:
-            desc.image, desc.mime = _image_bytes(tex)
+            try:
+                desc.image, desc.mime = _image_bytes(tex)
+            except ModelFormatError as exc:
+                warnings.warn(f"material {name}: {exc}; written without its texture", TextureWarning, 2)
         desc.metallic = getattr(pbr, "metallicFactor", None)
         desc.roughness = getattr(pbr, "roughnessFactor", None)
         desc.double_sided = bool(getattr(pbr, "doubleSided", False))
@@ -365,7 +426,7 @@ def _mtl_block(
             fname = parts[-1]
             full = src.texture_path(fname, warn=False)
             if full is None:
-                if not inside_folder(os.path.join(src.folder, fname), src.root or src.folder):
+                if src.outside(fname):
                     continue  # never point the output at a file outside the model's folder
                 lines.append(line)  # a missing texture: the reference stays as it was
                 continue

@@ -27,9 +27,16 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
-from meshvis.io._common import atomic_write, fmt_floats, unique_names, weld_corners
+from meshvis.io._common import atomic_write, decode_text, fmt_floats, unique_names, weld_corners
 from meshvis.io.edits import FaceEdits, face_edits
-from meshvis.io.mtl import MtlSource, TextureWarning, inside_folder, remove_created, write_mtl
+from meshvis.io.mtl import (
+    MtlSource,
+    TextureWarning,
+    inside_folder,
+    outside_reference,
+    remove_created,
+    write_mtl,
+)
 from meshvis.io.triangulate import triangulate
 from meshvis.soup import Material, Soup, SourceRecord
 
@@ -130,6 +137,8 @@ class ObjSource:
     default_part : str or None
         Name of the part of the faces before any ``o``/``g`` (the input's stem), None when
         there are none.
+    folder : str or None
+        The input's folder, from which its ``mtllib`` references resolve.
     """
 
     lines: list[str]
@@ -138,6 +147,7 @@ class ObjSource:
     corners: np.ndarray
     mtllibs: list[str]
     default_part: str | None = None
+    folder: str | None = None
 
 
 @dataclass(eq=False)
@@ -213,22 +223,25 @@ def read_obj(path: str, label: str | None = None) -> Soup:
     )
     before_any = not st.groups or st.groups[0][0] > 0
     data = ObjSource(
-        lines, np.asarray(st.f_where, np.int64), src.copy(), local, st.mtllibs, stem if before_any else None
+        lines,
+        np.asarray(st.f_where, np.int64),
+        src.copy(),
+        local,
+        st.mtllibs,
+        stem if before_any else None,
+        os.path.dirname(os.path.abspath(path)),
     )
     soup.source = SourceRecord("obj", soup.vertices, soup.faces.copy(), data)
     return soup
 
 
 def _read_lines(path: str, label: str) -> list[str]:
-    r"""The file's text lines (UTF-8 or Latin-1, ``\\`` continuations joined)."""
+    r"""The file's text lines (UTF-8 or Latin-1, a byte-order mark dropped, ``\\`` continuations joined)."""
     with open(path, "rb") as fh:
         data = fh.read()
     if b"\x00" in data[:65536]:
         raise ModelFormatError("binary data, not OBJ text", label)
-    try:
-        text = data.decode("utf-8")
-    except UnicodeDecodeError:
-        text = data.decode("latin-1")
+    text = decode_text(data)
     del data
     if "\\\n" in text or "\\\r\n" in text:
         text = re.sub(r"\\\r?\n", " ", text)
@@ -553,10 +566,7 @@ def _read_mtllibs(mtllibs: list[str], path: str) -> dict[str, MtlSource]:
                 raw = fh.read()
         except OSError:
             continue
-        try:
-            text = raw.decode("utf-8")
-        except UnicodeDecodeError:
-            text = raw.decode("latin-1")
+        text = decode_text(raw)
         mtl_folder = os.path.dirname(mtl_path)
         name, block = None, []
         for line in text.splitlines() + ["newmtl"]:
@@ -664,7 +674,20 @@ def _edited_lines(edits: FaceEdits, mtl_name: str | None, stem: str) -> str:
         # the faces before any o/g are named after the file: keep the input's name
         first = int(src.record_line[0])
         lines[first : first + 1] = [f"o {src.default_part}", lines[first]]
-    return "\n".join(ln for ln in lines if ln is not None) + "\n"
+    # without an MTL of its own the output keeps the input's references, but none outside its folder
+    folder = None if mtl_name else src.folder
+    return (
+        "\n".join(ln for ln in lines if ln is not None and not (folder and _mtllib_outside(ln, folder)))
+        + "\n"
+    )
+
+
+def _mtllib_outside(line: str, folder: str) -> bool:
+    """Whether ``line`` is an ``mtllib`` statement naming a file outside ``folder``."""
+    word, _, rest = line.partition("#")[0].strip().partition(" ")
+    return word == "mtllib" and any(
+        outside_reference(n, folder, folder) for n in [rest.strip(), *rest.split()]
+    )
 
 
 def _is_vn(line: str) -> bool:

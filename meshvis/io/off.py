@@ -19,7 +19,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
-from meshvis.io._common import atomic_write, fmt_floats, weld_corners
+from meshvis.io._common import atomic_write, fmt_floats, weld_corners, without_bom
 from meshvis.io.edits import FaceEdits, face_edits
 from meshvis.io.triangulate import triangulate
 from meshvis.soup import Soup, SourceRecord
@@ -109,7 +109,7 @@ def _read_lines(path: str, label: str) -> tuple[list[str], list[list[str]], list
         data = fh.read()
     if b"\x00" in data[:4096]:
         raise ModelFormatError("binary data, not OFF text (binary OFF is not supported)", label)
-    raw = data.decode("latin-1").splitlines()
+    raw = without_bom(data).decode("latin-1").splitlines()
     tokens = [ln.partition("#")[0].split() for ln in raw]
     where = [i for i, t in enumerate(tokens) if t]
     lines = [tokens[i] for i in where]

@@ -22,7 +22,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
-from meshvis.io._common import atomic_write, one_line, weld_corners
+from meshvis.io._common import atomic_write, one_line, weld_corners, without_bom
 from meshvis.io.edits import face_edits
 from meshvis.io.ply_edit import NewProperty, write_edited
 from meshvis.io.triangulate import triangulate
@@ -113,6 +113,11 @@ def _read_binary(
             p.name: (np.zeros(0, np.int64), np.zeros(0, p.dtype)) if p.count_dtype else np.zeros(0, p.dtype)
             for p in props
         }, offset
+    # every row holds at least its fixed properties and its list counts: a count of rows
+    # the file cannot hold is refused before anything is allocated for them
+    least = sum(np.dtype(p.count_dtype or p.dtype).itemsize for p in props)
+    if offset + n * least > total:
+        raise ModelFormatError(f"the file is truncated (in the '{name}' data)", label)
     fixed = _read_fixed_lists(buf, offset, n, props, endian, label, name)
     if fixed is not None:
         return fixed
@@ -130,10 +135,14 @@ def _read_fixed_lists(buf, offset: int, n: int, props: list[_Prop], endian: str,
             if pos + csize > total:
                 raise ModelFormatError(f"the file is truncated (in the '{name}' data)", label)
             k = int(np.frombuffer(buf, endian + p.count_dtype, count=1, offset=pos)[0])
+            if k < 0:
+                raise ModelFormatError(f"a list of the '{name}' data has {k} entries", label)
             first_len[i] = k
+            pos += csize + k * np.dtype(p.dtype).itemsize
+            if pos > total:  # the first row already runs past the end
+                raise ModelFormatError(f"the file is truncated (in the '{name}' data)", label)
             fields.append((f"c{i}", endian + p.count_dtype))
             fields.append((f"p{i}", endian + p.dtype, (k,)))
-            pos += csize + k * np.dtype(p.dtype).itemsize
         else:
             fields.append((f"p{i}", endian + p.dtype))
             pos += np.dtype(p.dtype).itemsize
@@ -173,6 +182,8 @@ def _walk_rows(buf, offset: int, n: int, props: list[_Prop], endian: str, label:
             for is_list, cfmt, csize, isize in layout:
                 if is_list:
                     k = unpack(cfmt, buf, pos)[0]
+                    if k < 0:
+                        raise ModelFormatError(f"a list of the '{name}' data has {k} entries", label)
                     counts[r, j] = k
                     j += 1
                     pos += csize + k * isize
@@ -225,13 +236,15 @@ def _read_ascii(values: np.ndarray, offset: int, n: int, props: list[_Prop], lab
             p.name: (np.zeros(0, np.int64), np.zeros(0, p.dtype)) if p.count_dtype else np.zeros(0, p.dtype)
             for p in props
         }, offset
+    if offset + n * len(props) > total:  # a row has at least one number per property
+        raise ModelFormatError(f"the file is truncated (in the '{name}' data)", label)
     # fast path: lists as long as in the first row
     width, pos, first_len = 0, offset, {}
     for i, p in enumerate(props):
         if p.count_dtype:
             if pos >= total:
                 raise ModelFormatError(f"the file is truncated (in the '{name}' data)", label)
-            k = int(values[pos])
+            k = _list_count(values[pos], label, name)
             first_len[i] = (width, k)
             width += 1 + k
             pos += 1 + k
@@ -264,7 +277,7 @@ def _read_ascii(values: np.ndarray, offset: int, n: int, props: list[_Prop], lab
         for r in range(n):
             for j, lst in enumerate(is_list):
                 if lst:
-                    k = int(vals[pos])
+                    k = _list_count(vals[pos], label, name)
                     starts[r, j] = pos + 1
                     counts[r, j] = k
                     pos += 1 + k
@@ -284,6 +297,13 @@ def _read_ascii(values: np.ndarray, offset: int, n: int, props: list[_Prop], lab
         else:
             out[p.name] = values[starts[:, j]].astype(p.dtype)
     return out, pos
+
+
+def _list_count(value: float, label: str, name: str) -> int:
+    """The entry count of a list of an ASCII body: a whole number of at least 0."""
+    if not (value >= 0 and value == int(value)):
+        raise ModelFormatError(f"a list of the '{name}' data has {float(value):g} entries", label)
+    return int(value)
 
 
 @dataclass(eq=False)
@@ -315,7 +335,7 @@ def read_elements(path: str, label: str, layout: list | None = None):
     When ``layout`` is a list, a :class:`PlyLayout` of the file is appended to it.
     """
     with open(path, "rb") as fh:
-        data = fh.read()
+        data = without_bom(fh.read())
     fmt, elements, comments, body = _parse_header(data, label)
     out: dict[str, dict] = {}
     raw = []
@@ -572,7 +592,7 @@ def write_ply(soup: Soup, path: str, groups=None, group_names=None, face_values=
         ]
     )
     with atomic_write(path, "wb") as fh:
-        fh.write((header + "\n").encode("utf-8"))
+        fh.write((header + "\n").encode("utf-8", "replace"))
         fh.write(vdata.tobytes())
         fh.write(fdata.tobytes())
     return False

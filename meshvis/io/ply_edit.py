@@ -103,7 +103,7 @@ def _header(lines: list[str], face: str, counts: dict, added: list, comments: li
             if len(tok) == 3 and tok[0] == "element" and tok[1] in counts:
                 line = f"element {tok[1]} {counts[tok[1]]}"
         out.append(line)
-    return ("\n".join(out) + "\n").encode("latin-1")
+    return ("\n".join(out) + "\n").encode("latin-1", "replace")
 
 
 def _is_element_line(line: str, name: str) -> bool:

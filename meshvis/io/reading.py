@@ -16,7 +16,7 @@ import struct
 from meshvis import _validate
 from meshvis.errors import MeshvisError, ModelError, ModelFormatError
 from meshvis.io import gltf, obj, off, ply, stl
-from meshvis.io._common import describe_exception, one_line
+from meshvis.io._common import describe_exception, one_line, without_bom
 from meshvis.io.scene import soup_from_scene
 from meshvis.io.up_axis import format_up
 from meshvis.soup import Soup, validate
@@ -141,6 +141,7 @@ def sniff(head: bytes, size: int) -> str | None:
     the content gives no clear sign.  A binary STL is recognised by its size:
     84 header bytes plus 50 per triangle, the count being stored at byte 80.
     """
+    head = without_bom(head)
     if head[:4] == b"glTF":
         return "glb"
     if head[:4] == b"PK\x03\x04":
@@ -189,8 +190,9 @@ def _read(fmt: str, path: str, label: str) -> Soup:
 def check_zip(path: str, label: str) -> None:
     """Refuse a zip archive with more entries or inflated bytes than :mod:`meshvis.limits` allows.
 
-    The sizes are those its directory declares, which :mod:`zipfile` enforces while
-    inflating.
+    The inflated bytes must stay within ``MAX_ZIP_BYTES`` and within ``MAX_ZIP_EXPANSION``
+    times the archive's size (real 3MF files inflate about 5 times).  The sizes are those its
+    directory declares, which :mod:`zipfile` enforces while inflating.
     """
     import zipfile
 
@@ -209,4 +211,12 @@ def check_zip(path: str, label: str) -> None:
     if total > limits.MAX_ZIP_BYTES:
         raise ModelFormatError(
             f"the archive inflates to {total} bytes, more than the cap of {limits.MAX_ZIP_BYTES}", label
+        )
+    allowed = max(limits.MIN_EXPANSION_BYTES, limits.MAX_ZIP_EXPANSION * os.path.getsize(path))
+    if total > allowed:
+        raise ModelFormatError(
+            f"the archive inflates to {total} bytes, more than {limits.MAX_ZIP_EXPANSION} times its "
+            f"{os.path.getsize(path)} bytes (the cap MAX_ZIP_EXPANSION of meshvis.limits; at least "
+            f"MIN_EXPANSION_BYTES, {limits.MIN_EXPANSION_BYTES})",
+            label,
         )

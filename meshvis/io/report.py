@@ -10,20 +10,16 @@ is the ``schema`` field of every report and changes whenever a field changes mea
 from __future__ import annotations
 
 import io
-import json
 import os
-import sys
 from typing import Any
 
 import numpy as np
 
 from meshvis.io._common import atomic_write
-from meshvis.io.jsonfile import to_builtin, write_json
+from meshvis.io.jsonfile import write_json
 
 #: the ``schema`` field of every report (docs/report.schema.json)
 SCHEMA_VERSION = 1
-#: ``--report -``: the report goes to standard output
-STDOUT = "-"
 
 
 def write_report(report: dict, path: str, per_face: str | None = None) -> None:
@@ -60,11 +56,7 @@ def write_report(report: dict, path: str, per_face: str | None = None) -> None:
             "file": os.path.basename(per_face),
             "arrays": {k: {"dtype": str(v.dtype), "length": int(len(v))} for k, v in arrays.items()},
         }
-    if path == STDOUT:
-        sys.stdout.write(json.dumps(to_builtin(report), indent=1, allow_nan=False, default=str) + "\n")
-        sys.stdout.flush()
-    else:
-        write_json(path, report)
+    write_json(path, report)
 
 
 def with_schema(report: dict[str, Any]) -> dict[str, Any]:

@@ -26,7 +26,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from meshvis.errors import ModelError, ModelFormatError
-from meshvis.io._common import atomic_write, fmt_floats, unique_names
+from meshvis.io._common import atomic_write, fmt_floats, unique_names, without_bom
 from meshvis.io.edits import face_edits
 from meshvis.soup import Soup, SourceRecord
 
@@ -53,6 +53,7 @@ def read_stl(path: str, label: str | None = None) -> Soup:
             )
             soup.source = SourceRecord("stl", soup.vertices, soup.faces.copy(), StlSource(data[:80], rec))
             return soup
+    data = without_bom(data)
     head = data[:1024].lstrip()
     if not head.startswith(b"solid") or b"\x00" in data[:4096]:
         if len(data) >= 84:

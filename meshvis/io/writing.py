@@ -18,7 +18,7 @@ import numpy as np
 from meshvis import _validate
 from meshvis.errors import OutputError, ParameterError
 from meshvis.io import gltf, obj, off, ply, stl
-from meshvis.io._common import check_folder
+from meshvis.io._common import check_folder, companions
 from meshvis.io.convert import as_soup
 from meshvis.soup import Material, Soup
 
@@ -125,7 +125,8 @@ def save(
     Raises
     ------
     OutputError
-        Unknown extension, missing or unwritable folder.
+        Unknown extension, missing or unwritable folder, or a path that is a file the
+        input model reads (its MTL, a texture, an external glTF buffer or image).
     ParameterError
         ``face_groups`` / ``face_values`` of the wrong length.
     """
@@ -171,6 +172,7 @@ def write(
     ext = os.path.splitext(path)[1].lower()
     check_format(path)
     check_folder(path)
+    check_not_read(path, soup)
     m = soup.n_faces
     groups = None
     if face_groups is not None:
@@ -191,6 +193,52 @@ def write(
         extra = [Material(f"material{i}") for i in range(len(soup.materials), n_mat)]
         soup = replace(soup, materials=list(soup.materials) + extra)
     return bool(WRITERS[WRITE_FORMATS[ext]](soup, path, groups, group_names, values))
+
+
+def input_files(soup: Soup) -> list[str]:
+    """The files a soup's model reads besides the model file, those that exist.
+
+    They are its MTL files and textures, or a glTF file's external buffers and images.
+    """
+    from urllib.parse import unquote
+
+    from meshvis.io.gltf_edit import GltfSource
+    from meshvis.io.mtl import MtlSource
+
+    out = []
+    for mat in soup.materials:
+        src = mat.source
+        if isinstance(src, MtlSource):
+            if src.path:
+                out.append(src.path)
+            out += [p for _, f in src.textures() if (p := src.texture_path(f, warn=False))]
+    rec = soup.source
+    if rec is not None and isinstance(rec.data, GltfSource):
+        for kind in ("buffers", "images"):
+            for item in rec.data.doc.get(kind) or []:
+                uri = item.get("uri") if isinstance(item, dict) else None
+                if isinstance(uri, str) and not uri.startswith("data:"):
+                    out.append(os.path.join(rec.data.folder, unquote(uri)))
+    return [p for p in dict.fromkeys(out) if os.path.isfile(p)]
+
+
+def check_not_read(path: str, soup: Soup) -> None:
+    """Refuse to write ``path`` (or the MTL written with it) over a file the soup's model reads.
+
+    That is an MTL file, a texture, an external glTF buffer or image (:func:`input_files`).
+
+    Raises
+    ------
+    OutputError
+        ``path`` or its companion is one of :func:`input_files`.
+    """
+    files = input_files(soup)
+    for p in [path, *companions(path)]:
+        if os.path.exists(p) and any(os.path.samefile(p, f) for f in files):
+            raise OutputError(
+                "is a file of the input model (its MTL, a texture or a buffer); choose another output name",
+                p,
+            )
 
 
 def rebuilds_groups(path: str) -> bool:

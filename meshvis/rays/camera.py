@@ -7,6 +7,7 @@ pixel and its centre is at (0.5, 0.5).  The vertical field of view ``fov`` is in
 from __future__ import annotations
 
 import os
+from collections.abc import Mapping
 from dataclasses import asdict, dataclass, field
 from typing import Any
 
@@ -83,13 +84,17 @@ class Camera:
     ortho_height: float | None = None
 
     def __post_init__(self) -> None:
-        self.position = np.asarray(self.position, np.float64).reshape(3)
-        self.target = np.asarray(self.target, np.float64).reshape(3)
-        self.up = np.asarray(self.up, np.float64).reshape(3)
-        if not (np.isfinite(self.position).all() and np.isfinite(self.target).all()):
-            raise ParameterError("camera position and target must be finite")
-        if not 0 < self.fov < 180:
-            raise ParameterError(f"field of view must be in (0, 180) degrees, got {self.fov}")
+        for name in ("position", "target", "up"):
+            v = _validate.points(f"camera {name}", getattr(self, name))
+            if len(v) != 1:
+                raise ParameterError(f"camera {name} must be three numbers, got {len(v)} points")
+            setattr(self, name, v[0])
+        if not np.any(self.up):
+            raise ParameterError("camera up must not be zero")
+        self.fov = _field_of_view(self.fov)
+        self.orthographic = _validate.flag("orthographic", self.orthographic)
+        if self.ortho_height is not None:
+            self.ortho_height = _validate.real("ortho_height", self.ortho_height, 0.0, open_lo=True)
 
     # ------------------------------------------------------------------ frame
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -204,6 +209,10 @@ class Camera:
         or a vector) defaults to the model's up axis (:func:`model_up`).
         """
         azimuth, elevation = _validate.real("azimuth", azimuth), _validate.real("elevation", elevation)
+        if distance is not None:
+            distance = _validate.real("distance", distance, 0.0, open_lo=True)
+        margin = _validate.real("margin", margin, 0.0, open_lo=True)
+        fov = _field_of_view(fov)
         bounds = _bounds_of(model)
         center = bounds.mean(axis=0)
         radius = 0.5 * float(np.linalg.norm(bounds[1] - bounds[0])) or 1.0
@@ -244,13 +253,29 @@ class Camera:
         Raises
         ------
         ParameterError
-            ``d`` has a key that is not a camera field.
+            ``d`` is not an object with ``position`` and ``target``, has a key that is not
+            a camera field, or a value out of its range.
         """
+        if not isinstance(d, Mapping):
+            raise ParameterError(
+                f"a camera must be an object with position and target, got {type(d).__name__}"
+            )
         known = {"position", "target", "up", "fov", "orthographic", "ortho_height"}
-        unknown = set(d) - known
+        unknown = set(map(str, d)) - known
         if unknown:
             raise ParameterError(f"unknown camera keys: {', '.join(sorted(unknown))}")
+        missing = {"position", "target"} - set(d)
+        if missing:
+            raise ParameterError(f"the camera has no {' and no '.join(sorted(missing))}")
         return cls(**d)
+
+
+def _field_of_view(value: Any) -> float:
+    """A vertical field of view: a number of degrees in (0, 180)."""
+    fov = _validate.real("field of view", value)
+    if not 0 < fov < 180:
+        raise ParameterError(f"field of view must be in (0, 180) degrees, got {fov}")
+    return fov
 
 
 def _bounds_of(model: Any) -> np.ndarray:

@@ -24,6 +24,7 @@ slower.  ``meshvis bench rays`` measures all three side by side.
 from __future__ import annotations
 
 import copy
+import time
 from dataclasses import dataclass
 from typing import Any
 
@@ -31,6 +32,7 @@ import numpy as np
 
 from meshvis import _validate
 from meshvis._threads import default_threads, in_threads
+from meshvis.errors import ModelError
 from meshvis.geometry.adjacency import VertexGroups, group_vertices
 from meshvis.io import as_soup
 from meshvis.rays import _kernels
@@ -49,6 +51,9 @@ VISIBILITY_OFFSET = 1e-6
 #: threads pay (the monastery's from-region search traces 114 batches of 4-32 k rays;
 #: docs/performance.md, "Ray backend")
 CHUNK = 1 << 11
+#: rays traced by every caster of this process and the seconds Embree took (read by the
+#: benchmarks: ``meshvis bench scale --real`` reports them per command)
+RAYS = {"rays": 0, "seconds": 0.0}
 
 
 def _used_bounds(soup, firsts: np.ndarray) -> np.ndarray:
@@ -63,6 +68,32 @@ def _used_bounds(soup, firsts: np.ndarray) -> np.ndarray:
     if (lo == 0).any() or (hi == 0).any():
         return soup.bounds
     return np.stack([lo, hi])
+
+
+def _check_copies(corners: np.ndarray, n_groups: int, path: str | None) -> None:
+    """Refuse more than :data:`meshvis.limits.MAX_FACE_COPIES` copies of one triangle.
+
+    ``corners`` (m, 3) are the faces' vertex groups (bit-identical corners); a ray through a
+    stack of copies tests every one of them, so the work of every ray grows with the stack.
+    """
+    from meshvis import limits
+
+    if len(corners) <= limits.MAX_FACE_COPIES:
+        return
+    c = np.sort(corners.astype(np.int64), axis=1)
+    if n_groups < 2**21:  # one int64 key per sorted corner triple
+        key = (c[:, 0] * n_groups + c[:, 1]) * n_groups + c[:, 2]
+        key.sort()
+        starts = np.flatnonzero(np.r_[True, key[1:] != key[:-1], True])
+        most = int(np.diff(starts).max())
+    else:
+        most = int(np.unique(c, axis=0, return_counts=True)[1].max())
+    if most > limits.MAX_FACE_COPIES:
+        raise ModelError(
+            f"{most} faces lie exactly on top of each other: a ray through them tests every one; "
+            f"more than the cap MAX_FACE_COPIES of meshvis.limits ({limits.MAX_FACE_COPIES})",
+            path,
+        )
 
 
 @dataclass
@@ -154,6 +185,7 @@ class RayCaster:
         # an extent beyond the float64 range (infinite diagonal) gives NaN: clamp it harmlessly
         v32[~np.isfinite(v32).all(axis=1)] = 0
         corners = groups.corner_groups(soup.faces, soup.n_vertices).astype(np.int32, copy=False)
+        _check_copies(corners, len(groups.first), soup.path)
         self._scene = rs.EmbreeScene()
         self._mesh = mc.TriangleMesh(self._scene, v32, corners)
 
@@ -210,7 +242,10 @@ class RayCaster:
                 np.ascontiguousarray(o32[a:b]), np.ascontiguousarray(d32[a:b]), query=query, **kw
             )
 
+        t = time.perf_counter()
         parts = in_threads(call, n, threads=self.threads, rows=CHUNK)
+        RAYS["rays"] += n
+        RAYS["seconds"] += time.perf_counter() - t
         if len(parts) == 1:
             return parts[0]
         if query == "INTERSECT":

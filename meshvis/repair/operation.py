@@ -58,6 +58,7 @@ OPERATION_OPTIONS: dict[str, dict[str, tuple[str, str]]] = {
         "keep_border": (REMOVE, "keep_border"),
         "budget": (REMOVE, "budget"),
         "up": (REMOVE, "up"),
+        "conservative": (REMOVE, "conservative"),
     },
     "layers": {"max_layers": (LAYERS, "max_layers")},
 }
@@ -213,6 +214,10 @@ def check_options(op: str, options: Mapping[str, Any] | Any) -> None:
         cells_path(o["from_region"])  # a PVS file of meshvis pvs
     elif by_region:
         parse_region(o["from_region"])
+    if op == "remove-interior" and o["conservative"]:
+        from meshvis.visibility.viewpoints import parse_viewpoints
+
+        parse_viewpoints(o["from_region"])  # viewpoints, not a region: fails before any work
     if o["output"] and op != "classify":
         check_format(o["output"], layers=op == "layers")
     if o["removed"]:
@@ -335,6 +340,8 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[
 
     r = layers(soup, classification=c, max_layers=o["max_layers"])
     n = int(r.layer.max())
+    if rebuilds_groups(o["output"]) and _same_format(soup, o["output"]):
+        _check_layer_paths(layer_paths(o["output"], n), o)
     names = [f"layer{k}" for k in range(1, n + 1)]
     groups = dict(face_groups=r.layer - 1, group_names=names, face_values={"layer": r.layer})
     edited = _save(soup, o["output"], tell, "one node or group per layer", **groups)
@@ -353,6 +360,27 @@ def _layers_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[
     unreached = f", {r.unreached} faces no view reaches" if r.unreached else ""
     line = f"{r.n_layers} layers ({per_layer} faces{unreached})"
     return report, f"{line}; wrote {', '.join(wrote)}"
+
+
+def _check_layer_paths(paths: list[str], o: dict) -> None:
+    """Refuse per-layer files that would be another output of the command, or its MTL.
+
+    The other outputs are ``--preview``, ``--report`` and so on; checked before anything is
+    written.
+    """
+    import os
+
+    from meshvis.errors import OutputError
+    from meshvis.io._common import companions
+
+    others = [p for k in (*OUTPUT_KEYS, "per_face") if k != "output" and (p := o.get(k)) and p != "-"]
+    taken = {os.path.realpath(q) for p in others for q in [p, *companions(p)]}
+    for path in paths:
+        for q in [path, *companions(path)]:
+            if os.path.realpath(q) in taken:
+                raise OutputError(
+                    "a file of one layer would be another output of the command; choose another path", q
+                )
 
 
 def _same_format(soup, path: str) -> bool:
@@ -386,6 +414,7 @@ def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
         budget=None if o["budget"] is None else int(o["budget"]),
         up=_up(o["up"]),
         seed=int(o["seed"]),
+        conservative=bool(o["conservative"]),
     )
 
 
@@ -462,7 +491,7 @@ def run_operation(
     more = detail or (lambda text: None)
     up = up_vector(_up(o.get("up")), soup)  # of the preview
     c = None
-    by_sight = (op == "remove-interior" and o["visibility"] == "view") or (
+    by_sight = (op == "remove-interior" and (o["visibility"] == "view" or o["conservative"])) or (
         op == "orient" and o["from_region"]
     )
     if not by_sight:  # sight alone needs no cut

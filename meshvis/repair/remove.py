@@ -60,8 +60,11 @@ REASONS = (
     "removed: no outside side by the cut",
     "removed: not seen from the region",
     "removed: hidden by the cut and no view of it was found",
+    "kept: may be seen from the region (conservative set)",
+    "removed: surely hidden from the region (outside the conservative set)",
 )
 _KEPT_CUT, _KEPT_SEEN, _KEPT_RESCUED, _KEPT_GROUP, _KEPT_BORDER, _GONE_CUT, _GONE_VIEW, _GONE_BOTH = range(8)
+_KEPT_MAY, _GONE_SURELY = 8, 9
 
 
 @dataclass
@@ -129,6 +132,7 @@ def remove_interior(
     budget: int | None = None,
     up=None,
     view: Visibility | None = None,
+    conservative: bool = False,
     **classify_kw: Any,
 ) -> RemovalResult:
     """Remove the faces that cannot be seen from outside (or from ``region``).
@@ -157,6 +161,11 @@ def remove_interior(
         (``Soup.up``: y for glTF and OBJ files, z otherwise).
     view : Visibility, optional
         Reuse a from-region search of the same model (``"view"`` only).
+    conservative : bool
+        Remove only the faces outside the conservative set from the viewpoints of
+        ``region`` (``points:...`` or ``path:CAMERAS.json``;
+        :func:`meshvis.visible_from` with ``conservative=True``): nothing visible from them
+        is removed.  No cut; ``visibility`` is not used.
     **classify_kw : passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
         in ``"both"`` an unset ``rays_per_point`` is ``rays_per_node // samples_per_face``
         (module notes)
@@ -168,7 +177,7 @@ def remove_interior(
     Raises
     ------
     ParameterError
-        Unknown mode or level, negative ``keep_border``.
+        Unknown mode or level, ``keep_border`` not an integer of at least 0, a budget below 1.
 
     Examples
     --------
@@ -190,12 +199,18 @@ def remove_interior(
         )
     if level not in LEVELS:
         raise ParameterError(f"unknown level {level!r}; choose one of {', '.join(LEVELS)}")
-    if int(keep_border) < 0:
-        raise ParameterError(f"keep_border must be at least 0, got {keep_border}")
+    _validate.removal_args(keep_border, budget)
     seed = int(classify_kw.get("seed", 0))
     c: Classification | None = None
     vis: Visibility | None = None
-    if visibility == "view":
+    if conservative:
+        soup = as_soup(model)
+        vis = visible_from(soup, region, budget=budget, seed=seed, up=up, conservative=True)
+        assert vis.conservative is not None
+        keep = vis.conservative.visible.copy()
+        code = np.where(keep, _KEPT_MAY, _GONE_SURELY)
+        visibility = "conservative"
+    elif visibility == "view":
         soup = as_soup(model)
         vis = view or _sight(soup, region, budget=budget, seed=seed, up=up)
         keep = vis.seen.copy()

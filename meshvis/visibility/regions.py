@@ -25,13 +25,14 @@ certifies its first hit as visible from the region.
 
 from __future__ import annotations
 
-import json
 import os
 from dataclasses import dataclass, field
 
 import numpy as np
 
 from meshvis.errors import ParameterError
+from meshvis.io import one_line
+from meshvis.io.jsonfile import read_json
 from meshvis.io.up_axis import up_vector
 from meshvis.rays.samples import uniform_sphere
 from meshvis.visibility import _kernels
@@ -302,7 +303,7 @@ def parse_region(text: str | Region, *, up=None) -> Region:
     Raises
     ------
     ParameterError
-        Unknown kind, wrong number of coordinates, unreadable path file.
+        Unknown kind, wrong number of coordinates, a bad ``up``, an unreadable path file.
 
     Examples
     --------
@@ -345,10 +346,9 @@ def _path_positions(path: str) -> np.ndarray:
     if not path or not os.path.isfile(path):
         raise ParameterError(f"{path or '(no file)'}: camera path file not found")
     try:
-        with open(path, encoding="utf-8") as fh:
-            data = json.load(fh)
+        data = read_json(path)
     except (OSError, ValueError) as exc:
-        raise ParameterError(f"{path}: not a JSON camera path ({exc})") from None
+        raise ParameterError(f"{path}: not a JSON camera path ({one_line(exc)})") from None
     if isinstance(data, dict):
         data = data.get("positions", data.get("cameras", []))
     try:
@@ -358,4 +358,6 @@ def _path_positions(path: str) -> np.ndarray:
         raise ParameterError(f"{path}: expected a list of [x, y, z] positions") from None
     if len(arr) == 0:
         raise ParameterError(f"{path}: the camera path has no positions")
+    if not np.isfinite(arr).all():
+        raise ParameterError(f"{path}: a camera position is not finite")
     return arr

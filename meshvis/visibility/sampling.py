@@ -240,8 +240,14 @@ def _cast_targets(caster, region, seen: Sightings, owner: np.ndarray, targets: n
     origin, direction = region.border_origins(seen.origin[owner], seen.direction[owner], targets)
     if origin.shape != targets.shape:
         origin = np.broadcast_to(origin, targets.shape).copy()
-    found, hits = trace(caster, origin, direction)
-    return hits.face, (found, owner[hits.hit]), len(targets)
+    aimed = np.isfinite(direction).all(axis=1)  # a viewer standing on its target aims nowhere
+    if aimed.all():
+        found, hits = trace(caster, origin, direction)
+        return hits.face, (found, owner[hits.hit]), len(targets)
+    found, hits = trace(caster, origin[aimed], direction[aimed])
+    face = np.full(len(targets), -1, hits.face.dtype)
+    face[aimed] = hits.face
+    return face, (found, owner[aimed][hits.hit]), len(targets)
 
 
 def reverse_sampling(

@@ -22,16 +22,20 @@ from __future__ import annotations
 
 import time
 from dataclasses import dataclass, field
+from typing import TYPE_CHECKING
 
 import numpy as np
 
-from meshvis import limits
+from meshvis import _validate, limits
 from meshvis.errors import ParameterError
 from meshvis.geometry.adjacency import weld
 from meshvis.io import as_soup
 from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.visibility.regions import Region, parse_region
 from meshvis.visibility.sampling import Sightings, border_sampling, random_seeds, reverse_sampling
+
+if TYPE_CHECKING:
+    from meshvis.visibility.conservative import ConservativeSet
 
 #: seed rays per unseen face in successive rounds
 SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
@@ -112,6 +116,9 @@ class Visibility:
     seconds : float
     stopped : str
         Why sampling stopped: ``"all seen"``, ``"few new faces"``, ``"budget"``, ``"rounds done"``.
+    conservative : ConservativeSet or None
+        With ``conservative=True``: the faces that may be seen from the viewpoints
+        (:mod:`meshvis.visibility.conservative`).
     """
 
     seen_side: np.ndarray
@@ -128,6 +135,7 @@ class Visibility:
     seconds: float
     stopped: str = ""
     extra: dict = field(default_factory=dict)
+    conservative: ConservativeSet | None = None
 
     @property
     def seen(self) -> np.ndarray:
@@ -155,6 +163,8 @@ class Visibility:
             "seconds": self.seconds,
             "history": self.history,
         }
+        if self.conservative is not None:
+            d["conservative"] = self.conservative.bracket(self.seen_side)
         if per_face:
             d["per_face"] = {
                 "seen_front": self.seen_side[:, 0],
@@ -241,6 +251,7 @@ def visible_from(
     min_new: float = MIN_NEW_PER_MILLION,
     min_new_area: float = MIN_NEW_AREA_PER_MILLION,
     caster: RayCaster | None = None,
+    conservative: bool = False,
 ) -> Visibility:
     """Which sides of the model's faces a viewer in ``region`` can see.
 
@@ -277,6 +288,11 @@ def visible_from(
         (0 for either: that rule never stops the search).
     caster : RayCaster, optional
         A caster of the same model to reuse (its offset is not changed).
+    conservative : bool
+        Also bound the search from above: the faces that may be seen from the viewpoints of
+        a ``points:`` or ``path:`` region, in ``result.conservative``
+        (:func:`meshvis.visibility.conservative.bracket`; the search then looks from the
+        viewpoints themselves).
 
     Returns
     -------
@@ -285,7 +301,8 @@ def visible_from(
     Raises
     ------
     ParameterError
-        Unknown method or region, negative budget.
+        Unknown method or region, a budget below 1, a seed that is not an integer of at
+        least 0, ``per_side`` not a bool.
 
     Examples
     --------
@@ -296,6 +313,14 @@ def visible_from(
     """
     if method not in METHODS:
         raise ParameterError(f"unknown method {method!r}; choose one of {', '.join(METHODS)}")
+    _validate.visibility_args(budget, seed, per_side, min_new, min_new_area)
+    if conservative:
+        from meshvis.visibility.conservative import bracket
+
+        return bracket(
+            model, region, search=visible_from, budget=budget, seed=seed, method=method, up=up,
+            per_side=per_side, faces=faces, min_new=min_new, min_new_area=min_new_area, caster=caster,
+        )  # fmt: skip
     soup = as_soup(model)
     region = parse_region(region, up=up).bind(soup)
     asked = np.ones(soup.n_faces, bool)
@@ -305,8 +330,6 @@ def visible_from(
         if asked.shape != (soup.n_faces,):
             raise ParameterError(f"faces must be {soup.n_faces} booleans or face indices")
     budget = default_budget(int(asked.sum())) if budget is None else int(budget)
-    if budget < 0:
-        raise ParameterError(f"budget must be at least 0, got {budget}")
     caster = caster or RayCaster(soup, offset=VISIBILITY_OFFSET)
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new, min_new_area)

@@ -193,7 +193,96 @@ CASES = [
         ParameterError,
         "face_values must be a Mapping",
     ),
+    # seeds of every seeded entry point (numpy's SeedSequence refused them with a ValueError)
+    (lambda c, rc, tmp: meshvis.visible_from(M, seed=-5), ParameterError, "seed must be at least 0, got -5"),
+    (lambda c, rc, tmp: meshvis.visible_from(M, seed=2**200), ParameterError, "seed must be at most"),
+    (lambda c, rc, tmp: meshvis.visible_from(M, seed=1.5), ParameterError, "seed must be an integer"),
+    (lambda c, rc, tmp: meshvis.orient_from(M, seed=-1), ParameterError, "seed must be at least 0"),
+    (lambda c, rc, tmp: meshvis.orient(M, seed=-1), ParameterError, "seed must be at least 0"),
+    (lambda c, rc, tmp: meshvis.layers(M, seed=-1), ParameterError, "seed must be at least 0"),
+    (
+        lambda c, rc, tmp: meshvis.remove_interior(M, visibility="view", seed=-1),
+        ParameterError,
+        "seed must be at least 0",
+    ),
+    (lambda c, rc, tmp: _demo(tmp, seed=-1), ParameterError, "seed must be at least 0"),
+    (lambda c, rc, tmp: _demo(tmp, size=0), ParameterError, "width must be at least 1"),
+    # values that used to pass silently
+    (
+        lambda c, rc, tmp: meshvis.visible_from(M, per_side="yes"),
+        ParameterError,
+        "per_side must be True or False",
+    ),
+    (lambda c, rc, tmp: meshvis.visible_from(M, budget=0), ParameterError, "budget must be at least 1"),
+    (lambda c, rc, tmp: meshvis.visible_from(M, budget="100"), ParameterError, "budget must be an integer"),
+    (lambda c, rc, tmp: meshvis.visible_from(M, min_new=-1), ParameterError, "min_new must be at least 0"),
+    (
+        lambda c, rc, tmp: meshvis.remove_interior(M, budget="100"),
+        ParameterError,
+        "budget must be an integer",
+    ),
+    (lambda c, rc, tmp: meshvis.remove_interior(M, budget=0), ParameterError, "budget must be at least 1"),
+    (
+        lambda c, rc, tmp: meshvis.remove_interior(M, keep_border="2"),
+        ParameterError,
+        "keep_border must be an integer",
+    ),
+    (
+        lambda c, rc, tmp: meshvis.remove_interior(M, keep_border=-1),
+        ParameterError,
+        "keep_border must be at least 0",
+    ),
+    # raw Python / numpy errors from inside
+    (
+        lambda c, rc, tmp: meshvis.parse_region("upper-hemisphere", up="q"),
+        ParameterError,
+        "up must be auto, x, y, z",
+    ),
+    (
+        lambda c, rc, tmp: meshvis.parse_region("upper-hemisphere", up=[1, 2]),
+        ParameterError,
+        "up must be auto, x, y, z or three numbers",
+    ),
+    (
+        lambda c, rc, tmp: meshvis.parse_region("upper-hemisphere", up=[0, 0, 0]),
+        ParameterError,
+        "finite non-zero",
+    ),
+    (
+        lambda c, rc, tmp: meshvis.Soup(V, F, part_id=[0, 1]),
+        ModelError,
+        "part_id must be numbers of shape (12,)",
+    ),
+    (lambda c, rc, tmp: meshvis.Soup(V, F, part_id=[5] * 12, part_names=["a"]), ModelError, "names no part"),
+    (lambda c, rc, tmp: meshvis.Soup(V, F, part_id=[-1] * 12), ModelError, "part_id must be at least 0"),
+    (
+        lambda c, rc, tmp: meshvis.Soup(V, F, uv=np.zeros((5, 2))),
+        ModelError,
+        "uv must be numbers of shape (12, 3, 2)",
+    ),
+    (lambda c, rc, tmp: meshvis.Soup(V, F, colors=[1, 2]), ModelError, "colors must be numbers of shape"),
+    (lambda c, rc, tmp: meshvis.Soup(V, F, source_face="x"), ModelError, "source_face must be numbers"),
+    (lambda c, rc, tmp: meshvis.Camera.from_json([1, 2]), ParameterError, "a camera must be an object"),
+    (lambda c, rc, tmp: meshvis.Camera.from_json({1: 2}), ParameterError, "unknown camera keys: 1"),
+    (
+        lambda c, rc, tmp: meshvis.Camera((0, 0, 5), (0, 0, 0), ortho_height=-1),
+        ParameterError,
+        "ortho_height",
+    ),
+    (lambda c, rc, tmp: meshvis.Camera.fit(M, distance=-1), ParameterError, "distance must be above 0"),
+    (lambda c, rc, tmp: meshvis.Camera.fit(M, up="q"), ParameterError, "up must be auto, x, y, z"),
+    (
+        lambda c, rc, tmp: meshvis.classify(M, hints={"inside_points": [[10**400, 0, 0]]}),
+        ParameterError,
+        "finite",
+    ),
 ]
+
+
+def _demo(tmp, **kw):
+    from meshvis.eval.demo import run_demo
+
+    return run_demo(str(tmp / "demo"), say=lambda text: None, **kw)
 
 
 @pytest.mark.parametrize("call, kind, words", CASES, ids=[w for _, _, w in CASES])

@@ -276,10 +276,14 @@ def test_batch_checks_its_options_once_before_starting(tmp_path, capsys):
 
 
 def test_total_ray_budget_is_capped(monkeypatch):
-    """Many nodes times an allowed rays_per_node: refused by MAX_RAYS before any ray is cast."""
+    """Rays per byte of input: refused before any analysis or ray, whatever the options."""
     import trimesh
 
-    monkeypatch.setattr(limits, "MAX_RAYS", 10_000)
-    with pytest.raises(ParameterError, match=r"the ray budget is \d+ rays .* more than the cap MAX_RAYS"):
-        meshvis.classify(trimesh.creation.icosphere(2), rays_per_node=4096, progressive=False)
-    assert meshvis.classify(trimesh.creation.icosphere(2), rays_per_node=8).n_rays <= 10_000
+    ball = trimesh.creation.icosphere(2)  # 320 faces
+    monkeypatch.setattr(limits, "MIN_RAY_CAP", 10_000)
+    with pytest.raises(
+        ParameterError, match=r"320 faces may ask for \d+ rays .* more than the \d+ an input of"
+    ):
+        meshvis.classify(ball, rays_per_node=4096, progressive=False)
+    monkeypatch.setattr(limits, "RAYS_PER_INPUT_BYTE", 1)
+    assert meshvis.classify(ball, rays_per_node=8, samples_per_face=1).n_rays <= 10_000

@@ -155,7 +155,7 @@ def test_sigterm_to_a_running_command(tmp_path):
         "--report",
         str(out / "r.json"),
         "--rays-per-node",
-        "2048",
+        "1024",  # within the ray cap of the 267 KB file (RAYS_PER_INPUT_BYTE)
         "--verbose",  # prints the model's size once it is loaded
     ]
     proc = subprocess.Popen(

@@ -78,7 +78,7 @@ def test_bad_removal_arguments(scenes):
     for kw in ({"visibility": "sight"}, {"level": "object"}, {"keep_border": -1}):
         with pytest.raises(ParameterError):
             remove_interior(cube, **kw)
-    assert len(REASONS) == 8
+    assert len(REASONS) == 10
 
 
 def test_cli_flags_of_remove_interior_and_visible(scenes, tmp_path, capsys):

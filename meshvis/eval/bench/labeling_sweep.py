@@ -5,7 +5,8 @@ the promises everywhere it can reach in a minute or two: for every (model, view,
 size, layout, method) it lays the labels out once and records whether the layout is
 clean (no box overlap, no leader crossing, no box over the model, no bad anchor, no
 leader through a box), how many visible parts were left out, and the leader lengths.
-The summary is per (layout, method, size): clean layouts, labels placed and left out,
+Boxes may reach beyond the image here (``solve(..., inside=False)``): the sweep checks the
+box stage's own promise that every visible part gets a place.  The summary is per (layout, method, size): clean layouts, labels placed and left out,
 mean leader, the 90th percentile and the largest of each layout's longest leader (all
 divided by ``d_S``), and the mean layout time.
 
@@ -142,7 +143,7 @@ def run(
                     ib = id_buffer(soup, cam, (n, n), caster=caster)
                     for layout in layouts:
                         for method in methods:
-                            r = solve(ib, texts, layout=layout, method=method)
+                            r = solve(ib, texts, layout=layout, method=method, inside=False)
                             m = r.metrics
                             cases[f"{name}|{az:g}|{el:g}|{n}|{layout}|{method}"] = {
                                 "labels": int(m["labels"]),

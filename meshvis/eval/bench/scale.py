@@ -1,5 +1,7 @@
 """``meshvis bench scale``: time, peak memory and per-stage times of classify from 20 k to 5 M faces.
 
+With ``--real``, the commands on cities of real models instead (:mod:`meshvis.eval.bench.scale_real`).
+
 The generated models are an icosphere subdivided ``5 .. 9`` times (20,480 .. 5,242,880 faces,
 4x per step), made into a soup by :func:`meshvis.eval.generators.soupify` (30 % of the faces
 turned over, every face its own corners, shuffled).  Real models are the largest of
@@ -20,6 +22,7 @@ import tempfile
 import time
 
 from meshvis.eval.bench.real_models import add_models_argument
+from meshvis.eval.bench.scale_real import peak_mb
 
 #: icosphere subdivisions of the generated sizes (20 k ... 5 M faces)
 SUBDIVISIONS = (5, 6, 7, 8, 9)
@@ -43,6 +46,9 @@ def add_arguments(p) -> None:
     add_models_argument(p)
     p.add_argument("--seed", type=int, default=0)
     p.add_argument("--json", metavar="FILE")
+    from meshvis.eval.bench import scale_real
+
+    scale_real.add_arguments(p)
 
 
 def generated(subdivisions: int, seed: int = 0):
@@ -71,26 +77,6 @@ def raw_embree_seconds(soup) -> float:
     mc.TriangleMesh(scene, v, soup.faces.astype(np.int32))
     scene.run(np.zeros((1, 3), np.float32), np.ones((1, 3), np.float32))
     return time.perf_counter() - t
-
-
-def peak_mb() -> float:
-    """Peak resident memory of this process, in MB.
-
-    ``VmHWM`` of ``/proc/self/status`` where there is one: Linux carries the parent's
-    resident size at the fork into the child's ``ru_maxrss`` across the ``exec``, so a child
-    started by a parent that had just built a 5 M-face soup reported the parent's peak.
-    ``VmHWM`` belongs to the child's own address space.  Elsewhere ``ru_maxrss``.
-    """
-    import resource
-
-    try:
-        with open("/proc/self/status") as fh:
-            for line in fh:
-                if line.startswith("VmHWM:"):
-                    return int(line.split()[1]) / 1024
-    except OSError:
-        pass
-    return resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
 
 
 def one(spec: str, seed: int) -> dict:
@@ -213,9 +199,13 @@ def format(results: list[dict], header: bool = True) -> str:
 
 
 def main(args) -> int:
-    """CLI entry of ``meshvis bench scale``."""
+    """CLI entry of ``meshvis bench scale`` (``--real``: :func:`meshvis.eval.bench.scale_real.main`)."""
     from meshvis.eval.bench.real_models import models_folder
 
+    if args.real:
+        from meshvis.eval.bench import scale_real
+
+        return scale_real.main(args)
     specs = [f"ico:{n}" for n in args.sizes]
     if not args.no_real:
         base = os.path.dirname(os.path.abspath(models_folder(args.models_dir)))

@@ -1,0 +1,565 @@
+"""Conservative from-point visibility: a set of faces that surely holds every face a point sees (FastV).
+
+Sampling (:func:`meshvis.visible_from`) proves faces visible; what it does not see is only
+probably hidden.  This module answers the opposite question after FastV (``003_*.txt``,
+DESIGN.md §12): which faces *may* be visible from a point, so that everything outside the
+set is certainly hidden.  With the sampled set it brackets the truth, sampled ⊆ exact ⊆
+conservative.
+
+Per viewpoint (FastV §3.1): the directions it looks in are cut into small four-sided
+frusta, a grid of ``2**base_level`` cells a side on each root (the six faces of a cube
+map, or a camera's view, :mod:`.viewpoints`).  For each frustum the compiled kernel
+(:mod:`._frusta_kernels`) looks for a *blocker*, a connected set of triangles that every
+ray of the frustum provably hits, grown from the first hits of the frustum's centre and
+corner rays (traced by Embree, one batch per level); its deepest point in the frustum is
+the far plane (FastV §3.3), and every triangle meeting the frustum in front of it is kept
+unless it lies behind the blocker.  A frustum without a blocker is split in four, level
+by level (FastV §3.4), down to ``max_level``; there, it keeps every triangle it meets for
+which no blocker is found among the rays that reach that triangle.
+
+A face is kept with the side that faces the point (both when the point lies within the
+margin of its plane).  Every test takes margins of ``tolerance`` times the scene's size
+seen from the point (:func:`margins`), so that rounding -- ours, or the float32 scene that
+Embree traces -- can only keep more.  Two consequences a user sees: a face that only
+touches a visible one along the edge of an outline (the side of a box seen from above
+touches its top) stays in the set, because a ray through that edge meets both; and a
+crack between two faces that do not share their corners exactly lets the set see
+through it, however thin.
+
+>>> import trimesh
+>>> box = trimesh.creation.box()  # from its centre a point sees the six sides' inner faces
+>>> c = conservative_from(box, "points:0,0,0")
+>>> bool(c.visible_side[:, 1].all()), bool(c.visible_side[:, 0].any())
+(True, False)
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from meshvis import _validate
+from meshvis.geometry.adjacency import edges, weld
+from meshvis.geometry.bvh import Bvh, build_bvh
+from meshvis.io import as_soup
+from meshvis.rays.caster import RayCaster
+from meshvis.rays.samples import uniform_sphere
+from meshvis.soup import Soup
+from meshvis.visibility import _frusta_kernels as fk
+from meshvis.visibility.regions import Points, Region
+from meshvis.visibility.viewpoints import Viewpoint, parse_viewpoints
+
+#: each root starts as a grid of 2**DEFAULT_BASE_LEVEL x 2**DEFAULT_BASE_LEVEL frusta
+DEFAULT_BASE_LEVEL = 4
+#: frusta without a blocker are split down to this level (2**level cells on a root's side)
+DEFAULT_MAX_LEVEL = 11
+#: margin of every test, relative to the scene's size seen from the point: 16 float32
+#: units of the Embree scene (about 6e-8), far above float64 rounding
+DEFAULT_TOLERANCE = 1e-6
+#: most triangles in one blocker (a longer walk gives up, and the frustum is split)
+MAX_WALK = 64
+#: frusta per kernel batch within a level (bounded memory for the seed rays)
+BATCH = 1 << 16
+#: highest subdivision level the frustum boxes represent exactly (dyadic float64)
+LEVEL_CAP = 24
+#: a face whose middle corner lies within this fraction of the diagonal of the line through
+#: the other two joins a T-junction (:func:`fillers`); far below the margins of the tests
+FILLER_WIDTH = 1e-7
+#: rays per batch of :func:`sample_views`
+SAMPLE_BATCH = 1 << 20
+#: rays in all of a camera path's views when cameras look into views and no budget is given
+VIEW_RAYS = 1 << 22
+
+
+@dataclass
+class ConservativeSet:
+    """Result of :func:`conservative_from`.
+
+    Attributes
+    ----------
+    visible_side : (m, 2) bool
+        Per input face and side (0 front, 1 back): may be seen from some viewpoint.
+        Every side not in it is hidden from all of them.
+    points : (k, 3) float64
+        The viewpoints.
+    point_faces : list of (n_i,) int64
+        Faces in each viewpoint's set.
+    point_sides : list of (n_i,) int8
+        Their side: 0 front, 1 back, 2 both (the point is within the margin of the plane).
+    area : (m,) float64
+        Face areas.
+    frusta : dict
+        Frusta traced, in total and by outcome (``blocked``, ``split``, ``open`` at the
+        limit, ``empty``), and per viewpoint (``per_point``).
+    parameters : dict
+        ``base_level``, ``max_level``, ``tolerance``.
+    seconds : float
+    """
+
+    visible_side: np.ndarray
+    points: np.ndarray
+    point_faces: list
+    point_sides: list
+    area: np.ndarray
+    frusta: dict
+    parameters: dict
+    seconds: float
+    extra: dict = field(default_factory=dict)
+
+    @property
+    def visible(self) -> np.ndarray:
+        """(m,) bool: some side of the face may be seen."""
+        return np.asarray(self.visible_side.any(axis=1))
+
+    @property
+    def visible_area(self) -> float:
+        """Area of the faces that may be seen."""
+        return float(self.area[self.visible].sum())
+
+    def point_side(self, i: int) -> np.ndarray:
+        """(m, 2) bool: the set of viewpoint ``i`` per face and side."""
+        out = np.zeros((len(self.area), 2), bool)
+        faces, sides = self.point_faces[i], self.point_sides[i]
+        out[faces, 0] = sides != 1
+        out[faces, 1] = sides != 0
+        return out
+
+    def bracket(self, sampled_side: np.ndarray) -> dict:
+        """The sampled and the conservative set side by side: counts, areas and the bracket.
+
+        Parameters
+        ----------
+        sampled_side : (m, 2) bool
+            Sides proved visible by sampling from the same viewpoints.
+
+        Returns
+        -------
+        dict
+            ``sampled_faces``, ``conservative_faces``, their areas, ``bracket_faces`` and
+            ``bracket_area`` (in the conservative set, not seen: what any removal from these
+            viewpoints may get wrong at most), ``area_ratio`` (conservative over sampled
+            area), ``outside`` (faces seen but outside the set: 0 unless the viewpoints
+            differ), frusta and seconds.
+        """
+        seen = np.asarray(sampled_side).any(axis=1)
+        may = self.visible
+        area = self.area
+        seen_area, may_area = float(area[seen].sum()), float(area[may].sum())
+        return {
+            "sampled_faces": int(seen.sum()),
+            "conservative_faces": int(may.sum()),
+            "sampled_area": seen_area,
+            "conservative_area": may_area,
+            "bracket_faces": int((may & ~seen).sum()),
+            "bracket_area": float(area[may & ~seen].sum()),
+            "bracket_area_fraction": float(area[may & ~seen].sum()) / max(float(area.sum()), 1e-300),
+            "area_ratio": may_area / seen_area if seen_area > 0 else None,
+            "outside": int((seen & ~may).sum()),
+            "frusta": self.frusta["traced"],
+            "seconds": self.seconds,
+        }
+
+    def report(self, per_face: bool = True) -> dict:
+        """JSON-ready summary (and per-face arrays when ``per_face``)."""
+        total = max(float(self.area.sum()), 1e-300)
+        d = {
+            "points": self.points.tolist(),
+            "faces": int(len(self.area)),
+            "conservative_faces": int(self.visible.sum()),
+            "conservative_area_fraction": self.visible_area / total,
+            "per_point_faces": [int(len(f)) for f in self.point_faces],
+            "frusta": self.frusta,
+            "parameters": self.parameters,
+            "seconds": self.seconds,
+        }
+        if per_face:
+            d["per_face"] = {
+                "may_see_front": self.visible_side[:, 0],
+                "may_see_back": self.visible_side[:, 1],
+            }
+        return d
+
+
+@dataclass(frozen=True)
+class FrustumScene:
+    """What the frusta of every viewpoint trace against, built once per model.
+
+    Attributes
+    ----------
+    soup : Soup
+    triangles : (m, 3, 3) float64
+    welded : (m, 3) int64
+        Corners welded where their coordinates are equal (no tolerance: a blocker's
+        triangles must share their edges exactly).
+    face_edge, edge_start, edge_face : int64 arrays
+        The edge of each face side and the faces of each edge.
+    filler : (m,) int8
+        :func:`fillers`.
+    bvh : Bvh
+    caster : RayCaster
+        Traces the seed rays.
+    """
+
+    soup: Soup
+    triangles: np.ndarray
+    welded: np.ndarray
+    face_edge: np.ndarray
+    edge_start: np.ndarray
+    edge_face: np.ndarray
+    filler: np.ndarray
+    bvh: Bvh
+    caster: RayCaster
+
+    @classmethod
+    def build(cls, model, caster: RayCaster | None = None, weld_tolerance: float = 0.0) -> FrustumScene:
+        """Weld, edge table, hierarchy and caster of ``model``."""
+        soup = as_soup(model)
+        triangles = np.ascontiguousarray(soup.triangles, np.float64)
+        _, welded = weld(soup.vertices, soup.faces, tol=weld_tolerance)
+        table = edges(welded)
+        edge_start = np.searchsorted(table.half_edge, np.arange(len(table.count) + 1)).astype(np.int64)
+        return cls(
+            soup=soup,
+            triangles=triangles,
+            welded=np.ascontiguousarray(welded, np.int64),
+            face_edge=np.ascontiguousarray(table.face_edge, np.int64),
+            edge_start=edge_start,
+            edge_face=np.ascontiguousarray(table.half_face, np.int64),
+            filler=fillers(triangles, welded, FILLER_WIDTH * soup.diagonal),
+            bvh=build_bvh(triangles),
+            caster=caster or RayCaster(soup),
+        )
+
+
+def fillers(triangles: np.ndarray, welded: np.ndarray, width: float) -> np.ndarray:
+    """(m,) int8: for each sliver whose corners lie on one line, the side that is its long edge; -1 for the others.
+
+    Such slivers join T-junctions (a corner of one face on the edge of another) with three
+    shared corners: the faces on either side of them close the surface, and a blocker may
+    pass through them (:mod:`._frusta_kernels`).  A sliver is a face with three distinct
+    welded corners whose middle corner lies within ``width`` of the line through the
+    other two.
+
+    Examples
+    --------
+    >>> t = np.array([[[0, 0, 0], [2, 0, 0], [1, 1e-9, 0]], [[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
+    >>> fillers(t, np.array([[0, 1, 2], [0, 2, 3]]), 1e-6).tolist()
+    [0, -1]
+    """
+    distinct = (
+        (welded[:, 0] != welded[:, 1]) & (welded[:, 1] != welded[:, 2]) & (welded[:, 2] != welded[:, 0])
+    )
+    out = np.full(len(triangles), -1, np.int8)
+    idx = np.flatnonzero(distinct)
+    t = triangles[idx]
+    # the middle corner along the longest extent; the long edge is the side opposite to it
+    axis = np.argmax(t.max(axis=1) - t.min(axis=1), axis=1)
+    order = np.argsort(t[np.arange(len(idx)), :, axis], axis=1, kind="stable")
+    k = np.arange(len(idx))
+    lo, mid, hi = t[k, order[:, 0]], t[k, order[:, 1]], t[k, order[:, 2]]
+    span = hi - lo
+    length = np.linalg.norm(span, axis=1)
+    off = np.linalg.norm(np.cross(mid - lo, span), axis=1) / np.where(length > 0, length, 1.0)
+    sliver = (length > 0) & (off <= width)
+    out[idx[sliver]] = ((order[sliver, 1] + 1) % 3).astype(np.int8)
+    return out
+
+
+def margins(scene: FrustumScene, position: np.ndarray, tolerance: float) -> tuple[float, float, float]:
+    """The margins of the tests from ``position``: ``(delta, eta, mu)``.
+
+    ``delta`` is a length, ``tolerance`` times the scene's size seen from the point (its
+    bounding-box diagonal plus the point's distance to the box centre); ``eta`` an angle,
+    ``tolerance`` radians; ``mu``, by which frusta, boxes and far depths are widened, is
+    ``2 delta`` plus ``eta`` times the farthest corner of the box.
+    """
+    lo, hi = scene.soup.bounds if scene.soup.n_faces else (np.zeros(3), np.zeros(3))
+    corners = np.array([[x, y, z] for x in (lo[0], hi[0]) for y in (lo[1], hi[1]) for z in (lo[2], hi[2])])
+    reach = float(np.linalg.norm(corners - position, axis=1).max())
+    size = float(np.linalg.norm(hi - lo)) + float(np.linalg.norm(0.5 * (lo + hi) - position))
+    delta = tolerance * max(size, np.finfo(float).tiny)
+    eta = tolerance
+    return delta, eta, 2.0 * delta + eta * reach
+
+
+def conservative_from(
+    model,
+    region: str | Region | list[Viewpoint],
+    *,
+    base_level: int = DEFAULT_BASE_LEVEL,
+    max_level: int = DEFAULT_MAX_LEVEL,
+    tolerance: float = DEFAULT_TOLERANCE,
+    scene: FrustumScene | None = None,
+    caster: RayCaster | None = None,
+) -> ConservativeSet:
+    """The faces that may be seen from the viewpoints of ``region``, per face and side.
+
+    Parameters
+    ----------
+    model : Soup or anything :func:`meshvis.io.as_soup` accepts
+    region : str, Region or list of Viewpoint
+        ``"points:x,y,z;..."`` (each point looks everywhere) or ``"path:CAMERAS.json"``
+        (each camera looks into its view, or everywhere without a target; see
+        :mod:`meshvis.visibility.viewpoints`), a Points region, or the viewpoints.
+    base_level : int
+        Each root starts as ``2**base_level`` x ``2**base_level`` frusta.
+    max_level : int
+        Frusta without a blocker are split down to ``2**max_level`` cells a side; a
+        higher limit gives a tighter set and traces more frusta.
+    tolerance : float
+        Margin of the tests relative to the scene's size (:func:`margins`).
+    scene : FrustumScene, optional
+        A prepared scene of the same model to reuse.
+    caster : RayCaster, optional
+        A caster of the same model for the seed rays.
+
+    Returns
+    -------
+    ConservativeSet
+
+    Raises
+    ------
+    ParameterError
+        A region without viewpoints, a level out of range, a bad tolerance.
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> box = trimesh.creation.box()
+    >>> c = conservative_from(box, "points:0,0,5")  # above the box: its top, and the sides touching it
+    >>> c.visible_side.sum(axis=0).tolist(), bool(c.visible_side[box.face_normals[:, 2] < -0.5].any())
+    ([2, 8], False)
+    """
+    base_level = _validate.integer("base_level", base_level, 0, LEVEL_CAP)
+    max_level = _validate.integer("max_level", max_level, base_level, LEVEL_CAP)
+    tolerance = _validate.real("tolerance", tolerance, 1e-15, 0.1)
+    start = time.perf_counter()
+    views = region if isinstance(region, list) else parse_viewpoints(region)
+    scene = scene or FrustumScene.build(model, caster)
+    soup = scene.soup
+    m = soup.n_faces
+    visible_side = np.zeros((m, 2), bool)
+    point_faces, point_sides, per_point = [], [], []
+    totals = dict.fromkeys(("traced", "blocked", "split", "open", "empty"), 0)
+    for view in views:
+        t0 = time.perf_counter()
+        keep, counts = _trace_viewpoint(scene, view, base_level, max_level, tolerance)
+        faces = np.flatnonzero(keep)
+        sides = facing_sides(
+            scene.triangles[faces], view.position, margins(scene, view.position, tolerance)[0]
+        )
+        visible_side[faces, 0] |= sides != 1
+        visible_side[faces, 1] |= sides != 0
+        point_faces.append(faces)
+        point_sides.append(sides)
+        for k in totals:
+            totals[k] += counts[k]
+        per_point.append({**counts, "seconds": time.perf_counter() - t0})
+    return ConservativeSet(
+        visible_side=visible_side,
+        points=np.array([v.position for v in views], np.float64).reshape(-1, 3),
+        point_faces=point_faces,
+        point_sides=point_sides,
+        area=soup.areas.copy(),
+        frusta={**totals, "per_point": per_point},
+        parameters={"base_level": base_level, "max_level": max_level, "tolerance": tolerance},
+        seconds=time.perf_counter() - start,
+    )
+
+
+def facing_sides(triangles: np.ndarray, position: np.ndarray, delta: float) -> np.ndarray:
+    """(n,) int8: the side of each triangle that faces ``position`` (0 front, 1 back, 2 both).
+
+    Both when the point is within ``2 delta`` of the triangle's plane (or the triangle has
+    no area): a ray from there meets it at a grazing angle, on either side.
+
+    Examples
+    --------
+    >>> tri = np.array([[[0, 0, 0], [1, 0, 0], [0, 1, 0]]], float)
+    >>> [int(facing_sides(tri, np.array(p, float), 1e-9)[0]) for p in ([0, 0, 1], [0, 0, -1], [5, 5, 0])]
+    [0, 1, 2]
+    """
+    a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
+    n = np.cross(b - a, c - a)
+    toward = np.einsum("ij,ij->i", n, position - a)
+    near = np.abs(toward) <= 2.0 * delta * np.linalg.norm(n, axis=1)
+    return np.where(near, 2, np.where(toward > 0, 0, 1)).astype(np.int8)
+
+
+def base_frusta(n_roots: int, level: int) -> tuple[np.ndarray, np.ndarray]:
+    """The ``2**level`` x ``2**level`` grid of frusta on each root: ``(root, box)``.
+
+    Examples
+    --------
+    >>> root, box = base_frusta(1, 1)
+    >>> root.tolist(), box[0].tolist()
+    ([0, 0, 0, 0], [-1.0, 0.0, -1.0, 0.0])
+    """
+    n = 1 << level
+    edges_ = np.linspace(-1.0, 1.0, n + 1)
+    i, j = np.divmod(np.arange(n * n), n)
+    box = np.stack([edges_[i], edges_[i + 1], edges_[j], edges_[j + 1]], axis=1)
+    root = np.repeat(np.arange(n_roots), n * n)
+    return root, np.tile(box, (n_roots, 1))
+
+
+def split_frusta(root: np.ndarray, box: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Each frustum's four quarters: ``(root, box)`` with four rows per input row."""
+    u0, u1, w0, w1 = box.T
+    um, wm = 0.5 * (u0 + u1), 0.5 * (w0 + w1)
+    quarters = np.stack(
+        [
+            np.stack([u0, um, w0, wm], axis=1),
+            np.stack([um, u1, w0, wm], axis=1),
+            np.stack([u0, um, wm, w1], axis=1),
+            np.stack([um, u1, wm, w1], axis=1),
+        ],
+        axis=1,
+    ).reshape(-1, 4)
+    return np.repeat(root, 4), quarters
+
+
+def _seed_rays(roots: np.ndarray, root: np.ndarray, box: np.ndarray) -> np.ndarray:
+    """(n, 5, 3) unit directions of each frustum's centre and corner rays."""
+    u0, u1, w0, w1 = box.T
+    us = np.stack([0.5 * (u0 + u1), u0, u1, u1, u0], axis=1)
+    ws = np.stack([0.5 * (w0 + w1), w0, w0, w1, w1], axis=1)
+    r = roots[root]
+    d = r[:, None, 0] + us[..., None] * r[:, None, 1] + ws[..., None] * r[:, None, 2]
+    return d / np.linalg.norm(d, axis=2, keepdims=True)
+
+
+def _trace_viewpoint(
+    scene: FrustumScene, view: Viewpoint, base_level: int, max_level: int, tolerance: float
+) -> tuple[np.ndarray, dict]:
+    """Trace one viewpoint's frusta level by level; the kept faces (m,) uint8 and the counts."""
+    from meshvis._threads import in_threads
+
+    m = scene.soup.n_faces
+    keep = np.zeros(m, np.uint8)
+    counts = dict.fromkeys(("traced", "blocked", "split", "open", "empty"), 0)
+    if m == 0:
+        return keep, counts
+    v = np.asarray(view.position, np.float64)
+    delta, eta, mu = margins(scene, v, tolerance)
+    roots = np.ascontiguousarray(view.roots, np.float64)
+    bvh = scene.bvh
+    root, box = base_frusta(len(roots), base_level)
+    level = base_level
+    while len(root):
+        at_limit = np.full(len(root), level >= max_level)
+        status = np.empty(len(root), np.int8)
+        far = np.empty(len(root))
+        for a in range(0, len(root), BATCH):
+            b = min(a + BATCH, len(root))
+            directions = _seed_rays(roots, root[a:b], box[a:b]).reshape(-1, 3)
+            hits = scene.caster.intersect(np.broadcast_to(v, directions.shape), directions)
+            seeds = np.ascontiguousarray(hits.face.reshape(-1, 5), np.int64)
+
+            def work(i, j, a=a, seeds=seeds):
+                s = slice(a + i, a + j)
+                fk.trace_frusta(
+                    v, roots, root[s], box[s], at_limit[s], seeds[i:j],
+                    scene.triangles, scene.welded, scene.face_edge, scene.edge_start, scene.edge_face, scene.filler,
+                    bvh.lo, bvh.hi, bvh.first, bvh.count, bvh.order,
+                    delta, eta, mu, MAX_WALK, keep, status[s], far[s],
+                )  # fmt: skip
+
+            in_threads(work, b - a, rows_per_item=64)
+        counts["traced"] += len(root)
+        counts["blocked"] += int((status == fk.BLOCKED).sum())
+        counts["open"] += int((status == fk.OPEN).sum())
+        counts["empty"] += int((status == fk.EMPTY).sum())
+        split = status == fk.SPLIT
+        counts["split"] += int(split.sum())
+        root, box = split_frusta(root[split], box[split])
+        level += 1
+    return keep, counts
+
+
+def sample_views(
+    scene: FrustumScene, views: list[Viewpoint], rays: int, rng: np.random.Generator
+) -> np.ndarray:
+    """(m, 2) bool: the sides that ``rays`` random rays from each viewpoint hit first.
+
+    Directions are uniform on the sphere for a viewpoint that looks everywhere and uniform
+    over the view's image plane for a camera (as its pixels).  A hit is a proof of
+    visibility; this is the sampled lower bound of a camera path's bracket, and the dense
+    random reference of the benchmarks.
+
+    Parameters
+    ----------
+    scene : FrustumScene
+    views : list of Viewpoint
+    rays : int
+        Rays per viewpoint (cast in batches of :data:`SAMPLE_BATCH`).
+    rng : numpy.random.Generator
+
+    Returns
+    -------
+    (m, 2) bool
+    """
+    seen = np.zeros((scene.soup.n_faces, 2), bool)
+    for view in views:
+        left = int(rays)
+        while left > 0:
+            n = min(left, SAMPLE_BATCH)
+            left -= n
+            if view.everywhere:
+                d = uniform_sphere(n, rng)
+            else:
+                axis, right, up = view.roots[0]
+                u, w = rng.uniform(-1.0, 1.0, (2, n))
+                d = axis + u[:, None] * right + w[:, None] * up
+                d /= np.linalg.norm(d, axis=1, keepdims=True)
+            hits = scene.caster.intersect(np.broadcast_to(view.position, d.shape), d)
+            ok = hits.face >= 0
+            seen[hits.face[ok], hits.side[ok]] = True
+    return seen
+
+
+def bracket(model, region, *, search, max_level: int = DEFAULT_MAX_LEVEL, **search_kw):
+    """The sampled set and the conservative set from the viewpoints of ``region``.
+
+    What :func:`meshvis.visible_from` returns with ``conservative=True``: its search (the
+    function ``search``, with ``search_kw``) looks from the viewpoints' positions (a
+    camera path's cameras, not the lines between them), and the result carries the
+    conservative set as ``conservative``.  Cameras that look into a view, not everywhere,
+    cannot be searched by guided sampling; their sampled set is ``budget`` (default
+    :data:`VIEW_RAYS`) random rays in each view (:func:`sample_views`).
+
+    Parameters
+    ----------
+    model : Soup or anything :func:`meshvis.io.as_soup` accepts
+    region : str or Region
+        ``points:...`` or ``path:CAMERAS.json`` (:func:`conservative_from`).
+    search : callable
+        :func:`meshvis.visible_from`.
+    max_level : int
+        Subdivision limit of the frusta (:func:`conservative_from`).
+    **search_kw
+        ``budget``, ``seed``, ``method``, ``caster``, ... of the search.
+
+    Returns
+    -------
+    Visibility
+        The search's result, ``conservative`` set to the :class:`ConservativeSet`.
+    """
+    soup = as_soup(model)
+    views = parse_viewpoints(region)
+    scene = FrustumScene.build(soup, search_kw.pop("caster", None))
+    positions = Points(points=np.array([v.position for v in views]))
+    if all(v.everywhere for v in views):
+        vis = search(soup, positions, caster=scene.caster, **search_kw)
+    else:
+        budget = search_kw.pop("budget", None)
+        rays = VIEW_RAYS if budget is None else int(budget)
+        vis = search(soup, positions, caster=scene.caster, **{**search_kw, "budget": 0})
+        rng = np.random.default_rng(search_kw.get("seed", 0))
+        vis.seen_side[:] = sample_views(scene, views, max(rays // len(views), 1), rng)
+        vis.method = "random rays in the views"
+        vis.rays = {"random": rays, "total": rays}
+    vis.conservative = conservative_from(soup, views, max_level=max_level, scene=scene)
+    return vis

@@ -1,0 +1,210 @@
+"""Conservative from-point visibility on scenes whose answer is known by construction.
+
+The conservative set must hold every face a point sees (nothing visible is ever left out)
+and, on these scenes, nothing more than the construction says.
+"""
+
+from __future__ import annotations
+
+import json
+
+import numpy as np
+import pytest
+
+import meshvis
+from meshvis.cli.main import main
+from meshvis.errors import ModelError, ParameterError
+from meshvis.visibility.conservative import FrustumScene, conservative_from, sample_views
+from meshvis.visibility.viewpoints import parse_viewpoints
+
+# the faces of these scenes are large: a few levels of frusta are enough, and fast
+LEVEL = 7
+
+
+def quad_x(x0, x1, y0, y1, z):
+    """Two triangles sharing their diagonal: the rectangle [x0, x1] x [y0, y1] at height z, front +z."""
+    a, b, c, d = (x0, y0, z), (x1, y0, z), (x1, y1, z), (x0, y1, z)
+    return [[a, b, c], [a, c, d]]
+
+
+def soup_from(triangles) -> meshvis.Soup:
+    """A soup whose faces share the corners they have in common (exact duplicates merged)."""
+    tri = np.asarray(triangles, np.float64).reshape(-1, 3)
+    vertices, faces = np.unique(tri, axis=0, return_inverse=True)
+    return meshvis.Soup(vertices, faces.reshape(-1, 3))
+
+
+def sides(result, scene_faces) -> np.ndarray:
+    return result.visible_side[scene_faces]
+
+
+@pytest.mark.slow
+def test_a_point_in_a_closed_box_may_see_only_the_inner_sides(scenes):
+    cube, _ = scenes.unit_cube()  # fronts out
+    for point in ("0,0,0", "0.31,-0.2,0.07"):
+        c = conservative_from(cube, f"points:{point}", max_level=LEVEL)
+        assert c.visible_side[:, 1].all(), point  # every inner side
+        assert not c.visible_side[:, 0].any(), point  # no outer side
+        assert c.frusta["open"] == 0  # the walls block every frustum
+
+
+def test_a_slit_shows_what_is_behind_it_and_the_wall_hides_the_rest():
+    # a wall at z = 1 with a slit |x| < 0.1, and a back wall of strips 0.4 wide at z = 3
+    wall = quad_x(-5, -0.1, -5, 5, 1) + quad_x(0.1, 5, -5, 5, 1)
+    edges = np.arange(-5.0, 5.0 + 1e-9, 0.4)
+    strips = [t for x0, x1 in zip(edges[:-1], edges[1:]) for t in quad_x(x0, x1, -5, 5, 3)]
+    soup = soup_from(wall + strips)
+    c = conservative_from(soup, "points:0,0,0", max_level=LEVEL)
+    # rays through the slit reach the back wall at |x| < 0.3
+    centre_x = soup.triangles[len(wall) :, :, 0].mean(axis=1)
+    strip_lo = np.repeat(edges[:-1], 2)
+    strip_hi = np.repeat(edges[1:], 2)
+    behind_slit = (strip_hi > -0.3) & (strip_lo < 0.3)
+    assert behind_slit.sum() == 6 and centre_x[behind_slit].max() < 0.6
+    np.testing.assert_array_equal(c.visible[len(wall) :], behind_slit)
+    assert c.visible[: len(wall)].all()
+    # the point is below every face: it sees their backs (fronts face +z)
+    assert not c.visible_side[:, 0].any()
+
+
+def test_two_coplanar_triangles_sharing_an_edge_block_together_and_a_gap_between_them_does_not():
+    blocker = quad_x(-1, 1, -1, 1, 1)  # the diagonal crosses the view's centre
+    hidden = [[(-1.0, -1.0, 2.0), (1.6, -1.0, 2.0), (-1.0, 1.6, 2.0)]]  # all of it behind the square
+    soup = soup_from(blocker + hidden)
+    c = conservative_from(soup, "points:0,0,0", max_level=LEVEL)
+    assert c.visible.tolist() == [True, True, False]
+    # the same square with a crack along its diagonal: the triangle is seen through it
+    (a, b, cc), (a2, c2, d) = np.asarray(blocker)
+    shift = np.array([-1e-3, 1e-3, 0.0])  # moves the second triangle off the diagonal
+    cracked = soup_from([[a, b, cc], [a2 + shift, c2 + shift, d + shift]] + hidden)
+    c = conservative_from(cracked, "points:0,0,0", max_level=LEVEL)
+    assert c.visible.tolist() == [True, True, True]
+
+
+@pytest.mark.slow
+def test_a_grazing_view_over_a_floor_keeps_what_stands_on_it_and_not_what_lies_under_it():
+    floor = quad_x(-100, 100, -100, 100, 0)
+    above = [[(50, -1, 0.005), (51, 1, 0.005), (50, 1, 0.02)]]  # seen 0.01 below the horizon
+    under = [[(50, -1, -0.01), (51, 1, -0.01), (50, 1, -0.005)]]  # a hair under the floor
+    soup = soup_from(floor + above + under)
+    c = conservative_from(soup, "points:0,0,0.01", max_level=10)
+    assert c.visible.tolist() == [True, True, True, False]
+    assert c.visible_side[:2].tolist() == [[True, False], [True, False]]
+    # a point exactly in the floor's plane may see both of its sides
+    c = conservative_from(soup, "points:0,0,0", max_level=8)
+    assert c.visible_side[:2].all()
+
+
+@pytest.mark.slow
+def test_the_set_holds_every_face_that_random_rays_see(scenes):
+    # random triangles: no connectivity, many small blockers, grazing overlaps
+    rng = np.random.default_rng(7)
+    centres = rng.uniform(-1, 1, (300, 1, 3))
+    soup = soup_from(centres + 0.25 * rng.standard_normal((300, 3, 3)))
+    scene = FrustumScene.build(soup)
+    for point in ("0,0,0", "0.4,-0.3,0.2", "3,1,-2"):
+        c = conservative_from(soup, f"points:{point}", max_level=9, scene=scene)
+        seen = sample_views(scene, parse_viewpoints(f"points:{point}"), 200_000, rng)
+        assert not (seen & ~c.visible_side).any(), point
+        assert c.visible_side.sum() < 2 * len(c.area)  # something is hidden, each face once
+
+
+@pytest.mark.parametrize("scale", [1e-6, 1.0, 1e6])
+def test_the_answer_does_not_change_with_scale_or_a_far_translation(scenes, scale):
+    cube, _ = scenes.unit_cube()
+    wall = soup_from(quad_x(-5, -0.1, -5, 5, 1) + quad_x(0.1, 5, -5, 5, 1) + quad_x(-5, 5, -5, 5, 3))
+    base = [conservative_from(s, "points:0.1,0.05,0.2", max_level=LEVEL).visible_side for s in (cube, wall)]
+    for shift in (0.0, 1e7 * scale):
+        for soup, expect in zip((cube, wall), base):
+            moved = meshvis.Soup(soup.vertices * scale + shift, soup.faces)
+            point = np.array([0.1, 0.05, 0.2]) * scale + shift
+            c = conservative_from(moved, "points:" + ",".join(map(repr, point.tolist())), max_level=LEVEL)
+            np.testing.assert_array_equal(c.visible_side, expect)
+
+
+def test_a_point_a_hair_from_a_wall_keeps_the_walls_inner_sides_and_only_that_walls_outer_side(scenes):
+    cube, names = scenes.unit_cube()
+    c = conservative_from(cube, "points:0.1,0.2,0.4999999999", max_level=LEVEL)
+    assert c.visible_side[:, 1].all()
+    assert not c.visible_side[names != "+z", 0].any()  # the +z wall: within the margin, both sides
+
+
+def test_a_camera_sees_only_what_is_in_its_view(tmp_path, scenes):
+    cube, names = scenes.unit_cube()
+    path = tmp_path / "cameras.json"
+    path.write_text(json.dumps([{"position": [0, 0, 0], "target": [0, 0, 1], "fov": 60}, [0, 0, 0.3]]))
+    views = parse_viewpoints(f"path:{path}")
+    assert [v.everywhere for v in views] == [False, True]
+    c = conservative_from(cube, f"path:{path}", max_level=LEVEL)
+    np.testing.assert_array_equal(c.point_side(0)[:, 1], names == "+z")
+    assert c.point_side(1)[:, 1].all() and c.visible_side[:, 1].all()
+
+
+def test_same_input_same_output_whatever_the_threads(monkeypatch, scenes):
+    soup, _, _ = scenes.slot_box()
+    a = conservative_from(soup, "points:0.5,0.5,2;0.2,0.3,0.4", max_level=9)
+    monkeypatch.setenv("MESHVIS_THREADS", "1")
+    b = conservative_from(soup, "points:0.5,0.5,2;0.2,0.3,0.4", max_level=9)
+    np.testing.assert_array_equal(a.visible_side, b.visible_side)
+    for fa, fb in zip(a.point_faces, b.point_faces):
+        np.testing.assert_array_equal(fa, fb)
+    assert a.frusta["traced"] == b.frusta["traced"]
+
+
+def test_regions_without_viewpoints_and_bad_levels_are_refused(scenes):
+    cube, _ = scenes.unit_cube()
+    for region in ("outside", "box:0,0,0,1,1,1", "upper-hemisphere"):
+        with pytest.raises(ParameterError, match="points"):
+            conservative_from(cube, region)
+    with pytest.raises(ParameterError, match="max_level"):
+        conservative_from(cube, "points:0,0,0", base_level=5, max_level=3)
+
+
+def test_an_empty_model_is_refused_and_a_single_triangle_is_seen_from_its_side():
+    with pytest.raises(ModelError):
+        conservative_from((np.zeros((0, 3)), np.zeros((0, 3), np.int64)), "points:0,0,0")
+    one = soup_from([[(0, 0, 1), (1, 0, 1), (0, 1, 1)]])
+    assert conservative_from(one, "points:0.2,0.2,0", max_level=LEVEL).visible_side.tolist() == [
+        [False, True]
+    ]
+    assert conservative_from(one, "points:0.2,0.2,2", max_level=LEVEL).visible_side.tolist() == [
+        [True, False]
+    ]
+
+
+def test_visible_from_brackets_the_guided_search(scenes):
+    soup, _, _ = scenes.slot_box()
+    vis = meshvis.visible_from(soup, "points:0.5,0.5,1.5", conservative=True, budget=100_000)
+    assert vis.conservative is not None
+    assert not (vis.seen_side & ~vis.conservative.visible_side).any()
+    r = vis.report(per_face=False)["conservative"]
+    assert r["outside"] == 0 and r["conservative_faces"] >= r["sampled_faces"] > 0
+    assert r["bracket_faces"] == r["conservative_faces"] - r["sampled_faces"]
+
+
+def test_the_command_line_reports_the_bracket_and_removes_only_what_is_surely_hidden(tmp_path, scenes):
+    cube, _ = scenes.unit_cube()
+    inner = soup_from(np.asarray(cube.triangles) * 0.5)  # a smaller cube inside, hidden from outside
+    both = meshvis.Soup.concatenate([cube, inner])
+    src, out, rep = tmp_path / "two.ply", tmp_path / "out.ply", tmp_path / "r.json"
+    meshvis.save(both, str(src))
+    args = ["visible", str(src), "--from", "points:3,2,1", "--conservative", "--max-level", "8"]
+    assert main([*args, "--report", str(rep), "-q"]) == 0
+    r = json.loads(rep.read_text())["conservative"]
+    assert r["outside"] == 0 and r["conservative_faces"] <= 12 and r["frusta"] > 0
+    args = ["remove-interior", str(src), "-o", str(out), "--from", "points:3,2,1", "--conservative"]
+    assert main([*args, "--report", str(rep), "-q", "--force"]) == 0
+    r = json.loads(rep.read_text())
+    assert r["visibility"] == "conservative" and r["removed_faces"] >= 12  # the inner cube at least
+    assert main(["visible", str(src), "--from", "outside", "--conservative", "-q"]) == 2
+
+
+def test_cameras_with_views_bracket_rays_in_their_views(tmp_path, scenes):
+    cube, names = scenes.unit_cube()
+    path = tmp_path / "cameras.json"
+    path.write_text(json.dumps({"cameras": [{"position": [0, 0, 0], "target": [1, 0, 0], "fov": 40}]}))
+    vis = meshvis.visible_from(cube, f"path:{path}", conservative=True, budget=20_000)
+    assert vis.method == "random rays in the views" and vis.rays["total"] == 20_000
+    np.testing.assert_array_equal(vis.seen, names == "+x")  # both +x triangles, nothing else
+    assert vis.report(per_face=False)["conservative"]["outside"] == 0
+    np.testing.assert_array_equal(vis.conservative.visible, names == "+x")
