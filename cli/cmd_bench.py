@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|real|scale|labeling|labeling-sweep|startup|conservative|pvs``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|orient-twice|real|scale|labeling|labeling-sweep|startup|conservative|pvs``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -50,6 +50,7 @@ def add_parser(sub) -> None:
         "compare",
         "scale",
         "orientation",
+        "orient-twice",
         "indoor",
         "real",
         "startup",

@@ -30,7 +30,9 @@ def add_parser(sub) -> None:
     sub : argparse._SubParsersAction
         The subcommands of the ``meshvis`` parser; the new parser's ``func`` is :func:`run`.
     """
-    from meshvis.visibility.visible import METHODS
+    from meshvis._defaults import module_constant
+
+    methods = module_constant("meshvis.visibility.visible:METHODS")
 
     def d(keyword):
         return library_default(VISIBLE_FROM, keyword)
@@ -45,7 +47,7 @@ def add_parser(sub) -> None:
         help="where the viewers are: outside, upper-hemisphere[:ux,uy,uz], box:x0,y0,z0,x1,y1,z1, "
         "points:x,y,z;..., path:CAMERAS.json",
     )
-    p.add_argument("--method", choices=METHODS, default=d("method"), help="guided sampling, or random rays")
+    p.add_argument("--method", choices=methods, default=d("method"), help="guided sampling, or random rays")
     p.add_argument(
         "--budget",
         type=positive_int,

@@ -130,9 +130,9 @@ def library_default(function: str, keyword: str) -> Any:
 
     The command line's defaults are read from the library here, so each is written once.
     """
-    from meshvis.repair.operation import library_default as read
+    from meshvis._defaults import signature_default
 
-    return read(function, keyword)
+    return signature_default(function, keyword)
 
 
 def up_option(p: argparse.ArgumentParser, what: str) -> None:

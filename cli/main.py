@@ -10,9 +10,11 @@ both after removing temporary files (:mod:`.signals`).
 from __future__ import annotations
 
 import argparse
+import gc
 import importlib
 import sys
 import warnings
+from typing import NoReturn
 
 # subcommand name -> module in this package
 COMMANDS = {
@@ -140,10 +142,32 @@ def main(argv: list[str] | None = None) -> int:
         return 2
 
 
+def program() -> NoReturn:
+    """The ``meshvis`` program (``python -m meshvis`` and the installed command): :func:`main`, then exit.
+
+    The interpreter's exit runs a last collection over every object still alive; after a
+    compiled kernel has been called, numba's run-time holds hundreds of thousands of them,
+    and that collection costs about 0.3 CPU seconds, a third of ``meshvis info`` on a small
+    model.  They are moved out of its reach (:func:`gc.freeze`) once the command is done:
+    the process is ending and its memory goes back to the system anyway.  Files, atexit
+    handlers and standard output are closed and flushed as on any exit.
+
+    Raises
+    ------
+    SystemExit
+        Always, with the status of :func:`main`.
+    """
+    try:
+        status = main()
+    finally:
+        gc.freeze()
+    raise SystemExit(status)
+
+
 def _show_warning(message, category, filename, lineno, file=None, line=None) -> None:
     """Warnings about the input (skipped records, ...) as one line, without source location."""
     print(f"meshvis: warning: {message}", file=sys.stderr)
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    program()

@@ -1,6 +1,6 @@
 """``python -m meshvis`` is the ``meshvis`` command."""
 
-from meshvis.cli.main import main
+from meshvis.cli.main import program
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    program()

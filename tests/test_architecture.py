@@ -20,6 +20,7 @@ LAYERS = {
     "meshvis.limits": 0,
     "meshvis._validate": 0,
     "meshvis._threads": 0,
+    "meshvis._defaults": 0,
     "meshvis.io": 1,
     "meshvis.rays": 2,
     "meshvis.geometry": 2,

@@ -83,9 +83,10 @@ def _kernel_calls(rng: np.random.Generator) -> dict:
         "escape_queries": lambda: repair.escape_queries(
             tri[:k],
             normals[:k],
-            ru[: k * per].reshape(k, per),
-            rv[: k * per].reshape(k, per),
-            x[: k * per],
+            face[:k],
+            face[k : 2 * k],
+            per,
+            repair.seed_key(5),
             face[:k] % 3 - 1,
             1e-4,
             2.0,

@@ -697,6 +697,116 @@ def component_labels(n, a, b):
     return label
 
 
+#: constants of the cell hash of :func:`near_labels` (odd multipliers of the splitmix64 family)
+_CELL_MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB))
+#: smallest cell of :func:`near_labels`, as a fraction of the points' largest extent: cell
+#: coordinates stay below 2**40, far inside int64, whatever the radius
+NEAR_CELL_FLOOR = 2.0**-40
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _cell_hash(x, y, z):
+    a = np.uint64(x + 1) * _CELL_MIX[0]
+    b = np.uint64(y + 1) * _CELL_MIX[1]
+    c = np.uint64(z + 1) * _CELL_MIX[2]
+    k = a ^ (b >> np.uint64(21)) ^ b ^ (c >> np.uint64(42)) ^ c
+    return k ^ (k >> np.uint64(31))
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def near_labels(pts, r):
+    """Components of the points ``pts`` (n, 3) linked when their distance is at most ``r``.
+
+    The pairs ``i < j`` with ``dx*dx + dy*dy + dz*dz <= r*r`` (the test of a k-d tree's
+    ``query_pairs``) are found on a grid of cells at least ``3 r`` wide: a point within
+    ``r`` of another lies in its cell or in the neighbour on its nearer side along each
+    axis, so each point looks into 8 cells, found through a hash table of the occupied
+    cells.  Returns (n,) int64 labels numbered in the order of each component's smallest
+    point, as :func:`component_labels`.
+    """
+    n = pts.shape[0]
+    parent = np.arange(n)
+    if n > 1 and not math.isfinite(r):  # every distance is at most an infinite radius
+        parent[:] = 0
+    elif n > 1:
+        lo = np.empty(3)
+        span = 0.0
+        for d in range(3):
+            a = np.inf
+            b = -np.inf
+            for i in range(n):
+                a = min(a, pts[i, d])
+                b = max(b, pts[i, d])
+            lo[d] = a
+            span = max(span, b - a)
+        h = max(3.0 * r, span * NEAR_CELL_FLOOR)
+        cell = np.empty((n, 3), np.int64)
+        side = np.empty((n, 3), np.int64)  # -1 or +1: the nearer neighbour cell along each axis
+        key = np.empty(n, np.uint64)
+        for i in range(n):
+            for d in range(3):
+                t = (pts[i, d] - lo[d]) / h
+                c = math.floor(t)
+                cell[i, d] = c
+                side[i, d] = -1 if t - c < 0.5 else 1
+            key[i] = _cell_hash(cell[i, 0], cell[i, 1], cell[i, 2])
+        order = np.argsort(key)
+        sorted_key = key[order]
+        size = 1
+        while size < 2 * n:
+            size *= 2
+        mask = np.uint64(size - 1)
+        table = np.full(size, -1, np.int64)  # slot -> first position of its hash in sorted_key
+        for p in range(n):
+            if p > 0 and sorted_key[p] == sorted_key[p - 1]:
+                continue
+            slot = sorted_key[p] & mask
+            while table[slot] >= 0:
+                slot = (slot + np.uint64(1)) & mask
+            table[slot] = p
+        r2 = r * r
+        for i in range(n):
+            for a in range(2):
+                for b in range(2):
+                    for c in range(2):
+                        cx = cell[i, 0] + a * side[i, 0]
+                        cy = cell[i, 1] + b * side[i, 1]
+                        cz = cell[i, 2] + c * side[i, 2]
+                        k = _cell_hash(cx, cy, cz)
+                        slot = k & mask
+                        p = -1
+                        while table[slot] >= 0:
+                            if sorted_key[table[slot]] == k:
+                                p = table[slot]
+                                break
+                            slot = (slot + np.uint64(1)) & mask
+                        while 0 <= p < n and sorted_key[p] == k:
+                            j = order[p]
+                            p += 1
+                            if j <= i or cell[j, 0] != cx or cell[j, 1] != cy or cell[j, 2] != cz:
+                                continue
+                            dx = pts[i, 0] - pts[j, 0]
+                            dy = pts[i, 1] - pts[j, 1]
+                            dz = pts[i, 2] - pts[j, 2]
+                            if dx * dx + dy * dy + dz * dz <= r2:
+                                x = _root(parent, i)
+                                y = _root(parent, j)
+                                if x < y:
+                                    parent[y] = x
+                                elif y < x:
+                                    parent[x] = y
+    label = np.empty(n, np.int64)
+    count = 0
+    for i in range(n):
+        root = _root(parent, i)
+        if root == i:
+            label[i] = count
+            count += 1
+        else:
+            label[i] = label[root]
+    return label
+
+
 @numba.njit(cache=True, nogil=True)
 def corner_bounds(v, faces):
     """(2, 3) min and max corner over the vertices the faces use (no mask, no gather)."""

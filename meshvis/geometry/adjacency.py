@@ -13,8 +13,6 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse as sp
-from scipy.sparse.csgraph import connected_components
 
 #: default weld tolerance, as a fraction of the bounding-box diagonal
 WELD_TOL = 1e-7
@@ -165,7 +163,7 @@ def weld(
     """Merge vertices that lie closer than ``tol`` times the bounding-box diagonal.
 
     Exact duplicates are merged first (the groups of :func:`group_vertices`); the remaining
-    distinct points are paired with a k-d tree (``cKDTree.query_pairs``) and merged by
+    distinct points closer than the weld distance are paired on a grid and merged by
     connected components, so a chain of points each within ``tol`` of the next becomes one
     vertex (harmless at the tiny default tolerance).
 
@@ -206,14 +204,9 @@ def weld(
     label = np.arange(len(uniq))
     radius = tol * _diagonal(vertices, faces)
     if radius > 0 and len(uniq) > 1:
-        from scipy.spatial import cKDTree
+        from meshvis.geometry._kernels import near_labels
 
-        pairs = cKDTree(uniq).query_pairs(radius, output_type="ndarray")
-        if len(pairs):
-            g = sp.coo_matrix(
-                (np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(len(uniq), len(uniq))
-            )
-            _, label = connected_components(g, directed=False)
+        label = near_labels(uniq, radius)
     index[groups.used] = label[of_group][groups.group]
     return index, index[faces]
 
@@ -391,10 +384,11 @@ def components(n_faces: int, pairs: np.ndarray) -> tuple[int, np.ndarray]:
     label : (n_faces,) int64 array
         Component of each face (numbered by smallest face index).
     """
+    from meshvis.geometry._kernels import component_labels
+
     pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
-    g = sp.coo_matrix((np.ones(len(pairs), np.int8), (pairs[:, 0], pairs[:, 1])), shape=(n_faces, n_faces))
-    n, label = connected_components(g.tocsr(), directed=False)
-    return int(n), label.astype(np.int64)
+    label = component_labels(n_faces, np.ascontiguousarray(pairs[:, 0]), np.ascontiguousarray(pairs[:, 1]))
+    return int(label.max()) + 1 if n_faces else 0, label
 
 
 def degenerate_faces(

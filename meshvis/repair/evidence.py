@@ -22,6 +22,12 @@ Rays are cast in rounds, each for the faces the rounds before leave open:
    leave it to chance whether it reaches :data:`MIN_ESCAPES`, or which side wins); at
    most :data:`LAST_SHARE` times the rays of the first round, largest faces first.
 
+A face that shows neither side yet (it keeps the input's winding unless its rays decide
+it, ``shown`` -1) gets rounds 2 and 3 where its counts leave open on which side of the
+:data:`DOMINANCE` line it is (:func:`near_the_line`): which rays a face gets then does
+not depend on how it came in wound.  Each face's rays come from a stream of its own
+(:class:`RayStream`).
+
 :func:`more_rays` casts further rounds for faces a caller picks: :func:`meshvis.repair.orient`
 gives flagged faces whose rays barely escaped, and those whose sign test leans to the side
 they do not show without passing, more rays before it decides.  :func:`until_decisive`
@@ -91,12 +97,61 @@ ESCAPE_REACH = 2.0
 BATCH_RAYS = 1 << 20
 
 
+class RayStream:
+    """The random rays of a model's faces, one stream per face.
+
+    The k-th ray cast from face f depends on the seed, f and k only
+    (:func:`meshvis.repair._kernels.ray_uniform`): which faces the rounds below give more
+    rays, and in which order, never changes another face's rays.  The rounds choose their
+    faces by the side each face shows, which can depend on how the input is wound; with
+    one stream for all faces, a face turned over anywhere would shift the rays of every
+    face after it.
+
+    Parameters
+    ----------
+    seed : int
+        Seed of the streams.
+    n_faces : int
+        Faces of the model.
+
+    Examples
+    --------
+    >>> s = RayStream(0, 4)
+    >>> s.take(np.array([1, 3]), 32).tolist(), s.take(np.array([3]), 64).tolist()
+    ([0, 0], [32])
+    """
+
+    def __init__(self, seed: int, n_faces: int) -> None:
+        self.key = _kernels.seed_key(seed)
+        self.drawn = np.zeros(n_faces, np.int64)
+
+    def take(self, faces: np.ndarray, rays: int) -> np.ndarray:
+        """The index of the first of ``rays`` rays of each face, and count them as drawn.
+
+        Parameters
+        ----------
+        faces : (k,) int
+            Faces, each at most once.
+        rays : int
+            Rays per face.
+
+        Returns
+        -------
+        (k,) int64
+            Rays drawn from each face before these.
+        """
+        faces = np.asarray(faces, np.int64)
+        start = self.drawn[faces]
+        self.drawn[faces] += rays
+        return start
+
+
 def escapes(
     soup: Soup,
     caster: RayCaster,
     faces: np.ndarray,
     rays: int,
-    rng: np.random.Generator,
+    stream: RayStream,
     through: np.ndarray | None = None,
 ) -> np.ndarray:
     """Escaping rays per side from ``rays`` uniformly random rays per face.
@@ -105,9 +160,9 @@ def escapes(
     ----------
     soup : Soup, the model ``caster`` was built on
     caster : RayCaster of ``soup``
-    faces : (k,) int64, faces to cast from
+    faces : (k,) int64, faces to cast from, each at most once
     rays : int, rays per face
-    rng : numpy Generator
+    stream : RayStream of ``soup``, the rays' random numbers
     through : (k,) int, optional: cast through this side of each face only (0 front,
         1 back), uniformly on its hemisphere; default both, uniformly on the sphere
 
@@ -117,6 +172,7 @@ def escapes(
     """
     faces = np.asarray(faces, np.int64)
     out = np.zeros((len(faces), 2), np.int64)
+    start = stream.take(faces, rays)
     per_batch = max(1, BATCH_RAYS // max(rays, 1))
     reach = ESCAPE_REACH * caster.diagonal
     through_all = np.full(len(faces), -1, np.int64) if through is None else np.asarray(through, np.int64)
@@ -125,15 +181,13 @@ def escapes(
     for lo in range(0, len(faces), per_batch):
         local = np.arange(lo, min(len(faces), lo + per_batch))
         k = len(local)
-        # the draws of uniform_in_triangles(per=rays) and uniform_sphere, in their order
-        ru, rv = rng.random((k, rays)), rng.random((k, rays))
-        gauss = rng.standard_normal((k * rays, 3))  # the numbers of normal(0, 1), faster
         o32, d32, dist, ok, back = _kernels.escape_queries(
             soup.triangles[faces[local]],
             np.ascontiguousarray(caster.normals[faces[local]]),
-            ru,
-            rv,
-            gauss,
+            faces[local],
+            start[local],
+            rays,
+            stream.key,
             through_all[local],
             push,
             reach,
@@ -207,7 +261,7 @@ def seen_counts(
     caster: RayCaster,
     faces: np.ndarray,
     shown: np.ndarray,
-    rng: np.random.Generator,
+    stream: RayStream,
 ) -> tuple[np.ndarray, np.ndarray]:
     """Escaping rays per side of each face, over the rounds of the module docstring.
 
@@ -220,9 +274,10 @@ def seen_counts(
     faces : (k,) int64
         Faces to test.
     shown : (k,) int
-        The side (0 front, 1 back) each face would show without this test.
-    rng : numpy Generator
-        Source of the sample points and directions.
+        The side (0 front, 1 back) each face would show without this test, or -1 for a
+        face that shows neither (it keeps the input's winding unless the test decides it).
+    stream : RayStream
+        The random numbers of the rays (of ``soup``'s faces).
 
     Returns
     -------
@@ -236,24 +291,28 @@ def seen_counts(
     k = np.arange(len(faces))
     escaped = np.zeros((len(faces), 2), np.int64)
     for through in (0, 1):
-        escaped += escapes(soup, caster, faces, FIRST_RAYS, rng, through=np.full(len(faces), through))
+        escaped += escapes(soup, caster, faces, FIRST_RAYS, stream, through=np.full(len(faces), through))
     cast = np.full(len(faces), 2 * FIRST_RAYS, np.int64)
     # faces from which nothing escaped get a second look through each side: one seen in
     # 3 % of its directions escapes none of 32 in a third of the cases (0.97^32)
     none = np.flatnonzero(escaped.sum(axis=1) == 0)
     for through in (0, 1):
         escaped[none] += escapes(
-            soup, caster, faces[none], FIRST_RAYS, rng, through=np.full(len(none), through)
+            soup, caster, faces[none], FIRST_RAYS, stream, through=np.full(len(none), through)
         )
     cast[none] += 2 * FIRST_RAYS
+    # a face that shows neither side (``shown`` -1) gets more rays where its counts leave
+    # open on which side of the 4x line it is: only there can they decide it
+    neither = shown < 0
     other, own = _other_own(escaped, shown, k)
-    again = np.flatnonzero((other > 0) & (other >= own))
+    again = np.flatnonzero(np.where(neither, near_the_line(escaped), (other > 0) & (other >= own)))
     if len(again):
-        escaped[again] += escapes(soup, caster, faces[again], MORE_RAYS, rng)
+        escaped[again] += escapes(soup, caster, faces[again], MORE_RAYS, stream)
         cast[again] += MORE_RAYS
     other, own = _other_own(escaped, shown, k)
-    last = np.flatnonzero((other > 0) & (DOMINANCE * other > own) & ~decisive(escaped))
-    more_rays(soup, caster, faces, escaped, cast, last, LAST_RAYS, LAST_SHARE, rng)
+    leaning = np.where(neither, near_the_line(escaped), (other > 0) & (DOMINANCE * other > own))
+    last = np.flatnonzero(leaning & ~decisive(escaped))
+    more_rays(soup, caster, faces, escaped, cast, last, LAST_RAYS, LAST_SHARE, stream)
     return escaped, cast
 
 
@@ -266,7 +325,7 @@ def more_rays(
     which: np.ndarray,
     rays: int,
     share: float,
-    rng: np.random.Generator,
+    stream: RayStream,
 ) -> np.ndarray:
     """Cast ``rays`` more rays from each face ``faces[which]``, adding to ``escaped`` and ``cast`` in place.
 
@@ -280,7 +339,7 @@ def more_rays(
     escaped : (k, 2) int64, escaping rays per face and side so far (updated)
     cast : (k,) int64, rays cast per face so far (updated)
     which : (j,) int, positions in ``faces`` that get more rays
-    rays : int, rays per face; share : float, the cap; rng : numpy Generator
+    rays : int, rays per face; share : float, the cap; stream : RayStream of ``soup``
 
     Returns
     -------
@@ -288,7 +347,7 @@ def more_rays(
     the cap), sorted
     """
     cap = int(share * 2 * FIRST_RAYS * len(faces)) // rays
-    return _cast_largest(soup, caster, faces, escaped, cast, np.asarray(which, np.int64), rays, cap, rng)
+    return _cast_largest(soup, caster, faces, escaped, cast, np.asarray(which, np.int64), rays, cap, stream)
 
 
 def until_decisive(
@@ -299,7 +358,7 @@ def until_decisive(
     cast: np.ndarray,
     which: np.ndarray,
     shown: np.ndarray,
-    rng: np.random.Generator,
+    stream: RayStream,
     share: float = RARE_SHARE,
 ) -> None:
     """Rounds of more rays for faces whose few escapes leave their side open (in place).
@@ -319,7 +378,7 @@ def until_decisive(
 
     Parameters
     ----------
-    soup, caster, faces, escaped, cast, which, rng : as :func:`more_rays` (``which``: the
+    soup, caster, faces, escaped, cast, which, stream : as :func:`more_rays` (``which``: the
         positions in ``faces`` that get the rounds)
     shown : (k,) int, the side (0 front, 1 back) each face shows
     share : float, the cap in place of :data:`RARE_SHARE` (the floor stays)
@@ -333,7 +392,7 @@ def until_decisive(
     >>> faces = np.arange(soup.n_faces)
     >>> escaped, cast = np.zeros((12, 2), np.int64), np.zeros(12, np.int64)
     >>> shown = np.ones(12, np.int64)  # every face shows its back, the side inside the box
-    >>> until_decisive(soup, caster, faces, escaped, cast, [0, 1, 2], shown, np.random.default_rng(0))
+    >>> until_decisive(soup, caster, faces, escaped, cast, [0, 1, 2], shown, RayStream(0, 12))
     >>> cast[:4].tolist(), bool((escaped[:3, 0] >= MIN_ESCAPES).all()), int(escaped[:, 1].sum())
     ([192, 192, 192, 0], True, 0)
     """
@@ -345,7 +404,7 @@ def until_decisive(
         untold = (total < MIN_ESCAPES) | ~significant(escaped[rows], SETTLE_LEVEL)
         return (total > 0) & untold & (other >= own)
 
-    _rounds(soup, caster, faces, escaped, cast, which, keep, RARE_FIRST_RAYS, rng, share)
+    _rounds(soup, caster, faces, escaped, cast, which, keep, RARE_FIRST_RAYS, stream, share)
 
 
 def until_settled(
@@ -356,7 +415,7 @@ def until_settled(
     cast: np.ndarray,
     which: np.ndarray,
     shown: np.ndarray,
-    rng: np.random.Generator,
+    stream: RayStream,
 ) -> None:
     """Rounds of more rays for faces that lean to their other side near the :data:`DOMINANCE` line (in place).
 
@@ -370,7 +429,7 @@ def until_settled(
 
     Parameters
     ----------
-    soup, caster, faces, escaped, cast, which, shown, rng : as :func:`until_decisive`
+    soup, caster, faces, escaped, cast, which, shown, stream : as :func:`until_decisive`
     """
     shown = np.asarray(shown, np.int64)
 
@@ -380,7 +439,7 @@ def until_settled(
         return (other > own) & near_the_line(escaped[rows], level=level)
 
     which = np.asarray(which, np.int64)
-    _rounds(soup, caster, faces, escaped, cast, which[keep(which)], keep, SETTLE_FIRST_RAYS, rng)
+    _rounds(soup, caster, faces, escaped, cast, which[keep(which)], keep, SETTLE_FIRST_RAYS, stream)
 
 
 def near_the_line(
@@ -429,25 +488,34 @@ def near_the_line(
 
 
 def _other_own(escaped: np.ndarray, shown: np.ndarray, rows: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Escapes of ``rows`` through the side each does not show, and through the side it shows."""
-    return escaped[rows, 1 - shown[rows]], escaped[rows, shown[rows]]
+    """Escapes of ``rows`` through the side each does not show, and through the side it shows.
+
+    A face that shows neither side yet (``shown`` -1) counts its side seen more often as
+    the side it does not show: every round open to a face leaning away from its side is
+    open to it.
+    """
+    e = escaped[rows]
+    s = shown[rows]
+    side = np.where(s >= 0, s, (e[:, 1] >= e[:, 0]).astype(np.int64) ^ 1)
+    k = np.arange(len(rows))
+    return e[k, 1 - side], e[k, side]
 
 
 def _rounds(
-    soup, caster, faces, escaped, cast, which, keep, first: int, rng, share: float = RARE_SHARE
+    soup, caster, faces, escaped, cast, which, keep, first: int, stream, share: float = RARE_SHARE
 ) -> None:
     """Doubling rounds of rays from ``faces[which]`` while ``keep(rows)`` holds (the budget of :func:`until_decisive`)."""
     which = np.asarray(which, np.int64)
     budget = max(int(share * 2 * FIRST_RAYS * len(faces)), RARE_MIN_BUDGET)
     rays = first
     while len(which) and rays <= min(RARE_MOST_RAYS, budget):
-        which = _cast_largest(soup, caster, faces, escaped, cast, which, rays, budget // rays, rng)
+        which = _cast_largest(soup, caster, faces, escaped, cast, which, rays, budget // rays, stream)
         budget -= rays * len(which)
         which = which[keep(which)]
         rays *= 2
 
 
-def _cast_largest(soup, caster, faces, escaped, cast, which, rays: int, cap: int, rng) -> np.ndarray:
+def _cast_largest(soup, caster, faces, escaped, cast, which, rays: int, cap: int, stream) -> np.ndarray:
     """``rays`` more rays from the ``cap`` largest faces of ``faces[which]`` (all when fewer).
 
     Adds to ``escaped`` and ``cast`` in place; returns the positions cast from, sorted.
@@ -456,7 +524,7 @@ def _cast_largest(soup, caster, faces, escaped, cast, which, rays: int, cap: int
         by_area = np.argsort(-soup.areas[faces[which]], kind="stable")
         which = np.sort(which[by_area[:cap]])
     if len(which):
-        escaped[which] += escapes(soup, caster, faces[which], rays, rng)
+        escaped[which] += escapes(soup, caster, faces[which], rays, stream)
         cast[which] += rays
     return which
 
@@ -466,7 +534,7 @@ def seen_side(
     caster: RayCaster,
     faces: np.ndarray,
     shown: np.ndarray,
-    rng: np.random.Generator,
+    stream: RayStream,
     dominance: float | np.ndarray = DOMINANCE,
 ) -> tuple[np.ndarray, np.ndarray, int]:
     """The side a viewer sees of each face, where the evidence is decisive.
@@ -476,7 +544,7 @@ def seen_side(
     soup, caster : the model and its RayCaster
     faces : (k,) int64, faces to test
     shown : (k,) int, the side (0 front, 1 back) each face would show without this test
-    rng : numpy Generator
+    stream : RayStream of ``soup``
     dominance : float or (k,) float, the dominance that makes a face's evidence decisive
         (:func:`decisive`)
 
@@ -487,7 +555,7 @@ def seen_side(
     rays : int, rays cast
     """
     shown = np.asarray(shown, np.int64)
-    escaped, cast = seen_counts(soup, caster, faces, shown, rng)
+    escaped, cast = seen_counts(soup, caster, faces, shown, stream)
     return more_seen(escaped, shown), decisive(escaped, dominance), int(cast.sum())
 
 
@@ -497,7 +565,8 @@ def more_seen(escaped: np.ndarray, shown: np.ndarray) -> np.ndarray:
     Parameters
     ----------
     escaped : (k, 2) int, escapes per face from its front and its back
-    shown : (k,) int, the side (0 front, 1 back) each face shows without the evidence
+    shown : (k,) int, the side (0 front, 1 back) each face shows without the evidence, or
+        -1 for a face that shows neither yet (a tie gives it -1)
 
     Returns
     -------
@@ -505,8 +574,8 @@ def more_seen(escaped: np.ndarray, shown: np.ndarray) -> np.ndarray:
 
     Examples
     --------
-    >>> more_seen(np.array([[3, 9], [5, 5], [7, 1]]), np.array([0, 1, 1])).tolist()
-    [1, 1, 0]
+    >>> more_seen(np.array([[3, 9], [5, 5], [7, 1], [4, 4]]), np.array([0, 1, 1, -1])).tolist()
+    [1, 1, 0, -1]
     """
     tie = escaped[:, 1] == escaped[:, 0]
     return np.where(tie, shown, escaped[:, 1] > escaped[:, 0]).astype(np.int8)

@@ -10,8 +10,6 @@ batch file is processed exactly as the single-file command would process it.
 from __future__ import annotations
 
 import functools
-import importlib
-import inspect
 import warnings
 from collections.abc import Callable, Mapping
 from typing import Any
@@ -83,9 +81,9 @@ def library_default(function: str, keyword: str) -> Any:
     >>> library_default(CLASSIFY, "rays_per_node")
     32
     """
-    module, _, name = function.partition(":")
-    fn = getattr(importlib.import_module(module), name)
-    return inspect.signature(fn).parameters[keyword].default
+    from meshvis._defaults import signature_default
+
+    return signature_default(function, keyword)
 
 
 @functools.cache
@@ -483,6 +481,7 @@ def run_operation(
     from meshvis.graphcut.classify import classify
     from meshvis.io.report import with_schema
     from meshvis.io.up_axis import up_vector
+    from meshvis.repair.orient import classify_for_orient
 
     t0 = time.perf_counter()
     o = {**default_options(op), **dict.fromkeys(OUTPUT_KEYS), **_options(options)}
@@ -500,7 +499,8 @@ def run_operation(
             kw["rays_per_point"] = cut_rays_per_point(
                 o["visibility"], kw["rays_per_node"], kw["samples_per_face"], kw["rays_per_point"]
             )
-        c = classify(soup, progress=progress, **kw)
+        # orient classifies the faces wound canonically (the cut orient makes itself)
+        c = (classify_for_orient if op == "orient" else classify)(soup, progress=progress, **kw)
         more(c.summary())
     report, line = _OUTPUTS[op](soup, c, o, tell, up)
     for text in _details(op, report):

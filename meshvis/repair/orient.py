@@ -3,14 +3,14 @@
 :func:`orient` decides, for every face, which side becomes its front, in named steps:
 
 1. **own sides** — every face whose sides got exactly one outside label (or whose sample
-   points agree) faces the outside; two-sided and conflicting faces are decided by the
-   options below;
+   points are outside on one side only, or more on one side) faces the outside; faces
+   seen from both sides are decided by the options below;
 2. **hidden sides** — faces with no outside side are oriented by the layer they belong to
    (layer semantics, DESIGN.md §4: each shell faces outward with respect to its layer; with
    ``semantics="cavity"`` shells of even layers face inward), voted by area over their
    orientable patch; faces two-sided at their layer on a patch without a vote are decided
-   by ray parity against their own body where that body is closed, and keep their winding
-   where it is open;
+   by ray parity against their own body where that body is closed and parity tells the
+   two sides apart, and keep their winding otherwise;
 3. **whole patches** — an orientable patch (faces joined by manifold edges after welding,
    flagged faces and degenerate slivers included; a sliver, which has no side of its
    own, shows the side its patch shows)
@@ -18,8 +18,7 @@
    a clear area vote takes the patch's side.  What is seen from outside votes (one-sided
    faces; flagged faces whose sample points disagree, weighted by the margin); faces that
    are one-sided only at a deeper layer vote only on patches no layer-1 face votes for,
-   and the hidden faces of a consistently wound patch that neither decides vote last,
-   each for the side step 2 gave it.
+   and the hidden faces whose side parity decided vote last.
    This keeps a consistently wound model's winding (a face of a self-intersecting fold
    follows its surface) and settles contact faces between touching solids;
 4. **visible sides** — the side a viewer sees wins over the patch vote and over layer
@@ -27,28 +26,34 @@
    rays already show their side clearly, is tested with rays of its own
    (:mod:`meshvis.repair.evidence`).  A patch of several faces first takes, as a whole,
    the side its tested faces see where their rays pooled decide it (the patch vote
-   counts only the faces the cut settled on one side); then each face is turned where
-   its own evidence is decisive and shows its other side (a face whose rays lean to its
-   other side near the 4x line gets more rays until they tell on which side of it the
-   face is); a face whose own sides the cut did not settle (two-sided, or flagged
-   with sample points that disagree) is seen from both sides and, where the input does
-   not wind its patch consistently or the patch is the face alone, takes the side seen
-   more often; a flagged face (it
-   crosses another surface, across which its patch does not speak for it) also turns
-   where a sign test says its other side is seen more often.  Faces of closed patches
-   follow their patch: a closed patch bounds a volume,
-   and a face of it whose back pokes out through the surface is a self-intersection, not
-   a face turned the wrong way.
+   counts only the faces the cut settled on one side); then each face takes the side
+   its own evidence shows where that evidence is decisive (a face whose rays lean against
+   its side near the 4x line gets more rays until they tell on which side of it the face
+   is); a flagged face (it crosses another surface, across which its patch does not speak
+   for it) also takes the side a sign test says is seen more often.  Faces of closed
+   patches follow their patch: a closed patch bounds a volume, and a face of it whose
+   back pokes out through the surface is a self-intersection, not a face turned the wrong
+   way.
+
+The evidence does not depend on how a face comes in wound: the cut and every ray are
+drawn on the canonically wound model (:func:`classify_for_orient`,
+:mod:`meshvis.geometry.winding`), each face's rays from a stream of its own
+(:class:`meshvis.repair.evidence.RayStream`); the input's winding is kept only where the
+evidence leaves a face open (with its patch), and it does not vote.  So orienting
+``orient``'s output again changes nothing.
 
 Both copies of a sheet stored twice with opposite winding (double-sided by duplication,
 :mod:`meshvis.geometry.duplicates`) are written as they are.
 
 Options for the undecided cases:
 
-* two-sided faces (both sides outside: sheets, leaves): ``keep`` (default) leaves them as
-  they are unless their patch or their own visibility decides them, ``duplicate`` emits
-  both orientations, ``strongest`` lets the side with the larger escaping ray share (outside
-  weight per area, Eq. 7) win;
+* faces seen from both sides (both sides outside, wholly or at some of their sample
+  points: sheets, leaves, the ground of a scene): ``keep`` (default) leaves them as they
+  are unless their own rays see one side decisively more often (4x); they neither vote
+  on their patch nor follow its vote, and where nothing decides them they keep the
+  winding most of their patch's undecided faces have (:func:`_kept_with_patch`);
+  ``duplicate`` emits both orientations of the two-sided ones, ``strongest`` lets the
+  side with the larger escaping ray share (outside weight per area, Eq. 7) win;
 * flagged faces whose sample points disagree: by area ``majority`` (default) or
   ``duplicate``.
 """
@@ -72,13 +77,6 @@ from meshvis.soup import Soup
 # status codes per input face
 ONE_SIDED, TWO_SIDED, HIDDEN, CONFLICT, DEGENERATE = 0, 1, 2, 3, 4
 STATUS_NAMES = ("one-sided", "two-sided", "hidden", "conflict", "degenerate")
-#: a face of an open patch whose own sides the cut did not settle (two-sided, or flagged
-#: with sample points that disagree) is seen from both sides, and where the input does not
-#: wind its patch consistently the patch does not speak for it across the surface it
-#: crosses: the side its own rays see more often wins (any
-#: dominance above 1 leaves a face seen 1.4x as often from one side to its patch; on the
-#: monastery such faces made up most of the error)
-BOTH_SEEN_DOMINANCE = 1.0
 #: a flagged face (it crosses another surface) is not spoken for by its patch's winding
 #: across that surface either, even in a patch the input winds consistently: its own rays
 #: turn it where the side they see more often wins a sign test at this level
@@ -116,9 +114,8 @@ LEANING_LEVEL = 0.05
 LEANING_RAYS = 4096
 #: ... for at most this many times the rays of the first round, largest faces first
 LEANING_SHARE = 0.5
-#: outside consistently wound patches, a cluster whose hidden side escapes at least this
-#: share of the opening threshold does not speak for its faces: the cut labels it
-#: differently from seed to seed (on the pandora level, with seeds 1 and 3, a 486-face
+#: a cluster whose hidden side escapes at least this share of the opening threshold does
+#: not speak for its faces: the cut labels it differently from seed to seed (on the pandora level, with seeds 1 and 3, a 486-face
 #: cluster whose front escapes 2 % of its rays, threshold 3 %, was cut as inside, and its
 #: faces seen only from the front were not tested: 0.40 % of the decisive area the recount
 #: confirms, against 0.15 % with seeds 0 and 2)
@@ -155,6 +152,10 @@ class OrientResult:
         twice with opposite winding (:mod:`meshvis.geometry.duplicates`)
     view : Visibility or None, the from-region visibility of :func:`orient_from` (then
         ``classification`` is None)
+    input_side : (m,) int8 or None, the side of each face of ``classification.soup`` that
+        is the input's front: :func:`orient` classifies the faces in their canonical
+        winding (:func:`classify_for_orient`), so a face listed the other way round there
+        has its input front on side 1
     """
 
     soup: Soup
@@ -169,6 +170,7 @@ class OrientResult:
     visibility: dict | None = None
     double_sided: int = 0
     view: Any = None  # the :class:`meshvis.visibility.Visibility` of :func:`orient_from`
+    input_side: np.ndarray | None = None
 
     def report(self, per_face: bool = True) -> dict:
         """The JSON-ready report: counts, the classification's summary, per-face arrays."""
@@ -204,12 +206,17 @@ class OrientResult:
         vis = self.visibility or {"tested": 0, "turned": 0, "rays": 0}
         d["visibility"] = dict(vis) if vis["tested"] else "skipped: every face is on a closed patch"
         if per_face:
+            rows = np.arange(len(self.status))
+            side = (
+                np.zeros(len(rows), np.int64) if self.input_side is None else self.input_side.astype(np.int64)
+            )
+            outside = self.classification.outside
             d["per_face"] = {
                 "flipped": self.flipped,
                 "duplicated": self.duplicated,
                 "status": np.asarray(STATUS_NAMES)[self.status],  # names, not codes
-                "outside_front": self.classification.outside[:, 0],
-                "outside_back": self.classification.outside[:, 1],
+                "outside_front": outside[rows, side],  # the sides of the input's winding
+                "outside_back": outside[rows, 1 - side],
             }
         return d
 
@@ -258,26 +265,30 @@ def surface_vote(
 def parity_side(
     c: Classification, faces: np.ndarray, seed: int = 0, rays: int = 9, max_crossings: int = 64
 ) -> np.ndarray:
-    """Outer side of ``faces`` by ray parity against their own body.
+    """Outer side of ``faces`` by ray parity against their own body, where parity tells it.
 
-    From each face's centroid, ``rays`` cosine-distributed rays leave its front side, and
-    every crossing of a face of the same body (the face's component over all welded edges,
-    non-manifold ones included) is counted, coincident copies once each: an even count
-    means the front looks out of the body (Jordan's parity rule).  The majority over the
-    rays decides (ties: front).  Meant for the few hidden faces that visibility leaves
-    open: two-sided at their layer, on a patch that no one-sided face votes for (a sliver
-    cut off by non-manifold edges where solids touch).
+    From each face's centroid, ``rays`` cosine-distributed rays leave each of its two
+    sides (the back's rays mirror the front's), and every crossing of a face of the same
+    body (the face's component over all welded edges, non-manifold ones included) is
+    counted, coincident copies once each: an even count means the ray started out of the
+    body (Jordan's parity rule).  The side with more such rays is the outer side; where
+    both sides have as many (a sheet inside a closed body, whose rays cross it an odd
+    number of times from either side), parity does not tell, and the face gets -1.
+    Meant for the few hidden faces that visibility leaves open: two-sided at their layer,
+    on a patch that no one-sided face votes for (a sliver cut off by non-manifold edges
+    where solids touch).
 
     Parameters
     ----------
     c : Classification of the model
     faces : (k,) int, faces to decide
-    seed : seed of the ray directions; rays : rays per face
+    seed : seed of the ray directions; rays : rays per face and side
     max_crossings : crossings followed per ray at most
 
     Returns
     -------
-    (k,) int8, 0 when the front should face out, 1 when the back should
+    (k,) int8, 0 when the front should face out, 1 when the back should, -1 when parity
+    does not tell
     """
     from meshvis.geometry.adjacency import components, duplicate_faces, edges, face_adjacency
     from meshvis.rays.samples import cosine_hemisphere
@@ -299,8 +310,11 @@ def parity_side(
         return np.where(keys[i] == k, per_key[i], 0)
 
     f = np.repeat(faces, rays)
-    d = cosine_hemisphere(soup.normals[f], np.random.default_rng(seed))
-    o = caster.push_off(soup.triangles[f].mean(axis=1), f, np.zeros(len(f), np.int8))
+    front = cosine_hemisphere(soup.normals[f], np.random.default_rng(seed))
+    f = np.concatenate([f, f])
+    d = np.concatenate([front, -front])
+    side = np.repeat(np.array([0, 1], np.int8), len(front))
+    o = caster.push_off(soup.triangles[f].mean(axis=1), f, side)
     step = caster.offset * caster.diagonal
     odd = np.zeros(len(f), bool)
     live = np.arange(len(f))
@@ -313,7 +327,8 @@ def parity_side(
         live = live[hit]
         if len(live) == 0:
             break
-    return (odd.reshape(-1, rays).sum(axis=1) * 2 > rays).astype(np.int8)
+    out_of_body = (~odd).reshape(2, len(faces), rays).sum(axis=2)  # per side, per face
+    return np.where(out_of_body[0] == out_of_body[1], -1, out_of_body[1] > out_of_body[0]).astype(np.int8)
 
 
 @dataclass(frozen=True)
@@ -354,18 +369,19 @@ def patches(c: Classification) -> Patches:
     return Patches(cl, closed, np.where(patch >= 0, size[np.maximum(patch, 0)], 0))
 
 
-def _patch_shows_back(p: Patches, flip: np.ndarray, areas: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(k,) bool: most of the area of each face's patch shows that face's back.
+def _patch_side(p: Patches, shows: np.ndarray, areas: np.ndarray, faces: np.ndarray) -> np.ndarray:
+    """(k,) int8: the side (0 front, 1 back) of each face that most of its patch's area shows.
 
-    ``flip`` says which faces are written turned over; a face shows its back's side node
-    where it is turned, its front's where not.  ``faces`` themselves do not vote (a
-    degenerate face has no area); where nothing else does, False.
+    ``shows`` is the side each face is written with as its front; a face shows that
+    side's node.  ``faces`` themselves do not vote (a degenerate face has no area); where
+    the vote is tied (nothing else votes), -1.
     """
     node = p.clustering.side_node
     voters = np.setdiff1d(np.flatnonzero(node[:, 0] >= 0), faces)
-    shown = node[voters, flip[voters].astype(np.int64)]
+    shown = node[voters, np.asarray(shows, np.int64)[voters]]
     area = np.bincount(shown, areas[voters], p.clustering.n_nodes)
-    return area[node[faces, 1]] > area[node[faces, 0]]
+    a0, a1 = area[node[faces, 0]], area[node[faces, 1]]
+    return np.where(a0 == a1, -1, a1 > a0).astype(np.int8)
 
 
 def _joining(c: Classification) -> np.ndarray:
@@ -397,8 +413,16 @@ def _closed_body(c: Classification) -> np.ndarray:
     return ~open_body[body]
 
 
-def _own_sides(c: Classification, two_sided: str) -> tuple[np.ndarray, np.ndarray]:
-    """Status of every face and the side its own labels put in front (hidden faces: 0)."""
+def _own_sides(
+    c: Classification, two_sided: str, given: np.ndarray, both: np.ndarray
+) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Status of every face, the side its own labels put in front, and the faces they leave open.
+
+    ``given`` is the side of each face that is the input's front; faces the labels do not
+    decide (faces seen from both sides, ``both``, under ``keep``; flagged faces whose
+    sample points are outside as much on either side; hidden faces until
+    :func:`_hidden_sides`) keep it and are returned as undecided.
+    """
     o = c.outside
     m = c.soup.n_faces
     out0, out1 = o[:, 0] > 0, o[:, 1] > 0
@@ -409,54 +433,66 @@ def _own_sides(c: Classification, two_sided: str) -> tuple[np.ndarray, np.ndarra
     status[~out0 & ~out1] = HIDDEN
     status[~agree & (out0 | out1)] = CONFLICT
     status[c.degenerate] = DEGENERATE
-    outer = np.zeros(m, np.int8)  # side that should become the front
-    outer[(status == ONE_SIDED) & full1] = 1
-    conflict = status == CONFLICT
+    outer = np.asarray(given, np.int8).copy()  # side that should become the front
+    one = status == ONE_SIDED
+    outer[one] = full1[one]
+    conflict = (status == CONFLICT) & (o[:, 1] != o[:, 0]) & ~both
     outer[conflict] = (o[conflict, 1] > o[conflict, 0]).astype(np.int8)
+    undecided = ~one & ~conflict
     if two_sided == "strongest":
         ts = status == TWO_SIDED
         outer[ts] = strongest_side(c)[ts]
-    return status, outer
+        undecided &= ~ts
+    return status, outer, undecided
 
 
 def _hidden_sides(
-    c: Classification, p: Patches, status: np.ndarray, outer: np.ndarray, semantics: str
-) -> tuple[LayerResult | None, np.ndarray, int]:
+    c: Classification,
+    p: Patches,
+    status: np.ndarray,
+    outer: np.ndarray,
+    semantics: str,
+    undecided: np.ndarray,
+) -> tuple[LayerResult | None, np.ndarray, np.ndarray]:
     """Sides of the hidden faces by layer semantics, patch vote and ray parity (in place).
 
     Returns the layers (None when nothing is hidden), the faces that are one-sided at their
-    own layer, and the number of faces decided by ray parity.
+    own layer, and the faces whose side ray parity decided.  A hidden face none of them
+    decides keeps the side ``outer`` gives it (the input's front) and stays ``undecided``;
+    the others leave it.
     """
     m = c.soup.n_faces
     hidden = status == HIDDEN
     own_layer = np.zeros(m, bool)
+    by_parity = np.zeros(m, bool)
     if not hidden.any():
-        return None, own_layer, 0
+        return None, own_layer, by_parity
     lay = layers(c.soup, classification=c)
     side = lay.outer_side[hidden]
-    side = np.where(side == 2, -1, side)
-    own = side >= 0  # one-sided at its own layer
+    own = (side == 0) | (side == 1)  # one-sided at its own layer
     own_layer[np.flatnonzero(hidden)[own]] = True
-    outer[hidden] = np.maximum(side, 0)
+    outer[own_layer] = lay.outer_side[own_layer]
     vote, decisive = surface_vote(c, outer, (status == ONE_SIDED) | own_layer, p.clustering)
     # a shell faces outward as a whole: where the face's patch has a clear vote it wins
     # over the face's own side (contact faces between touching solids see both ways)
-    outer[hidden] = np.where(decisive[hidden], vote[hidden], np.maximum(side, 0))
+    outer[hidden & decisive] = vote[hidden & decisive]
     # faces two-sided at their layer on a patch without a vote (a sliver of surface cut
     # off by non-manifold edges where solids touch): ray parity against their own body,
     # where that body is closed (parity means nothing on an open one: those faces keep
-    # their winding)
-    open_ = hidden & ~own_layer & ~decisive
-    closed_body = _closed_body(c)
-    outer[open_ & ~closed_body] = 0
-    open_ &= closed_body
-    n_parity = int(open_.sum())
-    if n_parity:
-        outer[open_] = parity_side(c, np.flatnonzero(open_), seed=int(c.params.get("seed", 0)))
+    # their winding, as do those whose two sides parity cannot tell apart)
+    open_ = hidden & ~own_layer & ~decisive & _closed_body(c)
+    faces = np.flatnonzero(open_)
+    if len(faces):
+        side = parity_side(c, faces, seed=int(c.params.get("seed", 0)))
+        told = side >= 0
+        outer[faces[told]] = side[told]
+        by_parity[faces[told]] = True
+    undecided &= ~(own_layer | (hidden & decisive) | by_parity)
     if semantics == "cavity":
-        even = hidden & (lay.layer % 2 == 0)
+        # shells of even layers face inward; a face whose side nothing decided keeps it
+        even = hidden & (lay.layer % 2 == 0) & ~undecided
         outer[even] = 1 - outer[even]
-    return lay, own_layer, n_parity
+    return lay, own_layer, by_parity
 
 
 def _whole_patches(
@@ -465,34 +501,34 @@ def _whole_patches(
     status: np.ndarray,
     outer: np.ndarray,
     own_layer: np.ndarray,
+    by_parity: np.ndarray,
     movable: np.ndarray,
+    both: np.ndarray,
 ) -> tuple[np.ndarray, int]:
     """Turn every patch as a whole (in place).
 
     Each face of a patch with a clear vote takes the patch's side.  Voters: one-sided
     faces with their area, flagged faces whose sample points disagree with their area
     times the margin; only where none of them votes, the faces one-sided at their own
-    layer (hidden faces) with their area; only where none of those votes either, on a
-    consistently wound patch, every hidden face with its area, for the side ray parity
-    gave it.
+    layer (hidden faces) with their area; only where none of those votes either, the
+    hidden faces whose side ray parity decided, with their area.
+    Faces seen from both sides (``both``) neither vote nor follow the vote.
     Returns the faces of patches with a clear vote, and how many of them changed side.
     """
     o = c.outside
     node = p.clustering.side_node
     ok = node[:, 0] >= 0
-    conflict = status == CONFLICT
+    conflict = (status == CONFLICT) & ~both
     seen = c.soup.areas * (status == ONE_SIDED)
     seen[conflict] = c.soup.areas[conflict] * np.abs(o[conflict, 1] - o[conflict, 0])
     side = outer.copy()
     voted = np.zeros(len(outer), bool)
     # what is seen from outside votes first; faces one-sided only at a deeper layer
-    # decide the patches that no face of layer 1 votes for; the hidden faces of a
-    # consistently wound patch that neither decides (each took its side from ray parity)
-    # keep it whole: on the Ferrari 20 such patches of 12 faces came back split, parity
-    # turning 7-11 of each.  (Voting so on patches wound either way, a soup's, was
-    # measured slightly worse: pandora's and the van Gogh room's soups, seeds 0-7.)
-    hidden = c.soup.areas * ((status == HIDDEN) & _consistently_wound(p))
-    for weight in (seen, c.soup.areas * own_layer, hidden):
+    # decide the patches that no face of layer 1 votes for; the hidden faces whose side
+    # parity decided keep the patches that neither decides whole (on the Ferrari, parity
+    # alone turned 7-11 faces of each of 20 hidden 12-face patches).  Faces that keep the
+    # input's winding for lack of evidence do not vote: their vote would be the input's
+    for weight in (seen, c.soup.areas * own_layer, c.soup.areas * by_parity):
         votes = np.zeros(p.clustering.n_nodes)
         d = np.flatnonzero(ok & (weight > 0))
         np.add.at(votes, node[d, outer[d]], weight[d])
@@ -502,21 +538,20 @@ def _whole_patches(
         now &= ~voted
         side[now] = (v1 > v0)[now[ok]].astype(np.int8)
         voted |= now
-    voted &= movable
+    voted &= movable & ~both
     change = voted & (side != outer)
     outer[voted] = side[voted]
     return voted, int(change.sum())
 
 
-def _clearly_one_sided(c: Classification, outer: np.ndarray, wound: np.ndarray) -> np.ndarray:
+def _clearly_one_sided(c: Classification, outer: np.ndarray) -> np.ndarray:
     """(m,) bool: clustered faces whose cluster's own rays already speak for them.
 
     The cluster escapes more than 4 times (the evidence dominance of
     :mod:`meshvis.repair.evidence`) as often through the side they show as through the
-    other (from the classification's own rays).  Outside consistently wound patches
-    (``wound`` False) the other side must also escape less than :data:`OPENING_NEAR` of
-    the opening threshold: near that threshold the cut labels the cluster differently from
-    seed to seed, and its faces are tested on their own.
+    other (from the classification's own rays), and the other side escapes less than
+    :data:`OPENING_NEAR` of the opening threshold: near that threshold the cut labels the
+    cluster differently from seed to seed, and its faces are tested on their own.
     """
     from meshvis.repair.evidence import DOMINANCE
 
@@ -531,57 +566,47 @@ def _clearly_one_sided(c: Classification, outer: np.ndarray, wound: np.ndarray) 
     clear[rows] = shown > DOMINANCE * other
     opening = c.params.get("opening")
     if opening:
-        clear[rows] &= wound[rows] | (other < OPENING_NEAR * opening)
+        clear[rows] &= other < OPENING_NEAR * opening
     return clear
 
 
-def _consistently_wound(p: Patches) -> np.ndarray:
-    """(m,) bool: the face's patch has several faces, all fronts on one side as the input winds them.
-
-    A patch of one face has no winding of its own to keep: nothing joins it to a surface
-    whose side could speak for it (a lone triangle of a level or a soup), so its own
-    evidence decides it as it decides a face of an inconsistently wound patch.  On the
-    pandora level, 580 such faces seen from both sides but about five times as often from
-    one had kept the input's inward winding (0.79 % of the decisive area).
-    """
-    patch = p.clustering.cluster
-    front = p.clustering.side_node[:, 0]
-    ok = patch >= 0
-    n = max(p.clustering.n_clusters, 1)
-    lo = np.full(n, np.iinfo(np.int64).max)
-    hi = np.full(n, -1)
-    np.minimum.at(lo, patch[ok], front[ok])
-    np.maximum.at(hi, patch[ok], front[ok])
-    at = np.maximum(patch, 0)
-    return ok & (lo[at] == hi[at]) & (p.size > 1)
-
-
 def _visible_sides(
-    c: Classification, p: Patches, status: np.ndarray, outer: np.ndarray, movable: np.ndarray, seed: int
+    c: Classification,
+    p: Patches,
+    status: np.ndarray,
+    outer: np.ndarray,
+    movable: np.ndarray,
+    undecided: np.ndarray,
+    both: np.ndarray,
+    seed: int,
 ) -> tuple[np.ndarray, dict]:
     """Let the side a viewer sees win (in place).
 
     Every movable face of an open patch is tested on its own
-    (:func:`meshvis.repair.evidence.seen_side`), except one-sided faces whose cluster's
-    own rays already show their side clearly, and turned where its evidence is decisive
-    and shows the other side.  A face whose own sides the cut did not settle (two-sided,
-    or a flagged face whose sample points disagree) is seen from both sides: where the
-    input does not wind its patch consistently, or the patch is the face alone, it takes
-    the side seen more often
-    (:data:`BOTH_SEEN_DOMINANCE`).  A flagged face also turns where the side it does not
-    show is seen significantly more often (:data:`CROSSING_LEVEL`); flagged faces and faces
-    seen from both sides whose rays barely escaped, and flagged faces whose test leans to the
-    other side without passing, get more rays first (:data:`UNSEEN_SHARE`, then rounds for
-    the faces that round does not reach; lone faces
-    :func:`meshvis.repair.evidence.until_decisive`,
-    :data:`LEANING_LEVEL`); and every face that a 4x dominance decides, whose rays lean to
-    its other side near that line, gets rounds until they tell on which side of it the face
-    is (:func:`meshvis.repair.evidence.until_settled`).  Faces of closed patches are
-    left to their patch: a closed patch bounds a volume, and a face of it whose back pokes
-    out through the surface is a self-intersection, not a face turned the wrong way.
+    (:func:`meshvis.repair.evidence.seen_counts`), except one-sided faces whose cluster's
+    own rays already show their side clearly, and takes the side seen more often where its
+    evidence is decisive (:func:`meshvis.repair.evidence.decisive`: a face seen less than
+    4x as often from one side keeps its side).  A flagged face (it crosses another surface,
+    across which its patch does not speak for it) also takes the side seen significantly
+    more often (:data:`CROSSING_LEVEL`), unless it is seen from both sides (``both``: its
+    own decisive evidence alone turns it).  Flagged faces and faces seen
+    from both sides whose rays barely escaped, and flagged faces whose test leans to one
+    side without passing, get more rays first (:data:`UNSEEN_SHARE`, then rounds for the
+    faces that round does not reach; lone faces
+    :func:`meshvis.repair.evidence.until_decisive`, :data:`LEANING_LEVEL`); and every face
+    whose rays lean against the side it shows near the 4x line gets rounds until they tell
+    on which side of it the face is (:func:`meshvis.repair.evidence.until_settled`).
+    Faces of closed patches are left to their patch: a closed patch bounds a volume, and a
+    face of it whose back pokes out through the surface is a self-intersection, not a face
+    turned the wrong way.
 
     Before the faces are tested one by one, a patch of several faces takes the side its
-    tested faces see, pooled, where that is decisive (:func:`_pooled_patches`).
+    tested faces see, pooled, where that is decisive (:func:`_pooled_patches`); its faces
+    seen from both sides add their rays but keep their side.
+
+    ``undecided`` marks the faces that show the input's front for lack of evidence: the
+    rounds treat them as showing neither side, so that which faces get more rays, and so
+    every verdict, is the same however the input is wound.
 
     Returns the faces whose side this decided, and the report: faces ``tested``, faces
     ``turned``, ``rays`` cast and ``pooled_patches``, the patches the pooled evidence
@@ -589,62 +614,61 @@ def _visible_sides(
     """
     from meshvis.repair import evidence
 
-    wound = _consistently_wound(p)
-    clear = _clearly_one_sided(c, outer, wound) & (status == ONE_SIDED)
+    clear = _clearly_one_sided(c, outer) & (status == ONE_SIDED)
     test = np.flatnonzero(movable & ~p.closed & ~clear)
     decided = np.zeros(len(outer), bool)
     if len(test) == 0:
         return decided, {"tested": 0, "turned": 0, "rays": 0, "pooled_patches": 0}
     before = outer.copy()
-    # inside a patch that the input winds consistently, a face leaves its patch only on
-    # decisive evidence (a scan seen from both sides is not speckled with turned faces)
-    both = np.isin(status[test], (TWO_SIDED, CONFLICT)) & ~wound[test]
-    dominance = np.where(both, BOTH_SEEN_DOMINANCE, evidence.DOMINANCE)
-    # a generator of its own (seeded from the classification's seed), so that the test
-    # does not shift the random numbers of anything else
-    rng = np.random.default_rng([seed, 0x5EE9])
-    shown = outer[test]
+    # a stream of rays per face, seeded from the classification's seed: by which faces it
+    # gives more rays, the test shifts no other face's rays
+    stream = evidence.RayStream(seed, c.soup.n_faces)
+
+    def shown() -> np.ndarray:  # the side each tested face shows; -1: none yet
+        return np.where(undecided[test], -1, outer[test]).astype(np.int64)
+
     # the rays start as close to their faces as the reference's: pushed by the caster's
     # default, pandora faces 7640 and 7772 looked seen from both sides about equally through
     # surfaces within about 1e-5 diagonals of their fronts (the recount sees their fronts
     # 7-8x less than their backs)
     caster = c.caster.with_offset(VISIBILITY_OFFSET)
-    escaped, cast = evidence.seen_counts(c.soup, caster, test, shown, rng)
+    escaped, cast = evidence.seen_counts(c.soup, caster, test, shown(), stream)
     flagged = c.flagged[test]
+    crossing = flagged & ~both[test]  # a face seen from both sides: no sign test
     # faces whose rays barely escaped get more first: a lone face (its patch is the face
     # alone), which nothing else speaks for, doubling rounds until its rays decide it;
-    # the other faces that only their own rays decide (flagged, or seen from both sides
-    # outside a patch that speaks for them) one capped round, the largest first, and
-    # those it does not reach doubling rounds under the same cap
+    # the other faces that only their own rays decide (flagged, or seen from both sides)
+    # one capped round, the largest first, and those it does not reach doubling rounds
+    # under the same cap
+    unsettled = np.isin(status[test], (TWO_SIDED, CONFLICT))  # the cut did not settle them
     few = escaped.sum(axis=1) < evidence.MIN_ESCAPES
     lone = p.size[test] == 1
-    unseen = np.flatnonzero((flagged | both) & few & ~lone)
+    unseen = np.flatnonzero((flagged | unsettled) & few & ~lone)
     reached = evidence.more_rays(
-        c.soup, caster, test, escaped, cast, unseen, evidence.LAST_RAYS, UNSEEN_SHARE, rng
+        c.soup, caster, test, escaped, cast, unseen, evidence.LAST_RAYS, UNSEEN_SHARE, stream
     )
-    evidence.until_decisive(c.soup, caster, test, escaped, cast, np.flatnonzero(lone & few), shown, rng)
+    evidence.until_decisive(c.soup, caster, test, escaped, cast, np.flatnonzero(lone & few), shown(), stream)
     missed = np.setdiff1d(unseen, reached)
-    evidence.until_decisive(c.soup, caster, test, escaped, cast, missed, shown, rng, UNSEEN_SHARE)
+    evidence.until_decisive(c.soup, caster, test, escaped, cast, missed, shown(), stream, UNSEEN_SHARE)
     leaning = (
-        flagged
-        & (evidence.more_seen(escaped, shown) != shown)
+        crossing
+        & (evidence.more_seen(escaped, shown()) != shown())
         & evidence.significant(escaped, LEANING_LEVEL)
         & ~evidence.significant(escaped, CROSSING_LEVEL)
     )
     evidence.more_rays(
-        c.soup, caster, test, escaped, cast, np.flatnonzero(leaning), LEANING_RAYS, LEANING_SHARE, rng
+        c.soup, caster, test, escaped, cast, np.flatnonzero(leaning), LEANING_RAYS, LEANING_SHARE, stream
     )
     # a patch of several faces turns as a whole where its faces' rays, pooled, decide it;
     # then each face leaves its patch only on evidence of its own
-    pooled = _pooled_patches(c, p, test, escaped, cast, outer, movable, clear)
-    shown = outer[test]
-    # a face whose rays lean toward its other side near the 4x line gets rounds until they settle
-    near = np.flatnonzero(dominance == evidence.DOMINANCE)
-    evidence.until_settled(c.soup, caster, test, escaped, cast, near, shown, rng)
-    sure = evidence.decisive(escaped, dominance)
-    sure |= flagged & evidence.significant(escaped, CROSSING_LEVEL)
-    turn = test[sure & (evidence.more_seen(escaped, shown) != shown)]
-    outer[turn] = 1 - outer[turn]
+    pooled = _pooled_patches(c, p, test, escaped, cast, outer, movable, clear, both)
+    undecided = undecided & ~pooled
+    # a face whose rays lean against its side near the 4x line gets rounds until they settle
+    evidence.until_settled(c.soup, caster, test, escaped, cast, np.arange(len(test)), shown(), stream)
+    sure = evidence.decisive(escaped)
+    sure |= crossing & evidence.significant(escaped, CROSSING_LEVEL)
+    outer[test[sure]] = evidence.more_seen(escaped, shown())[sure]
+    decided[test[sure]] = True
     turned = outer != before
     report = {
         "tested": len(test),
@@ -652,7 +676,27 @@ def _visible_sides(
         "rays": int(cast.sum()),
         "pooled_patches": len(np.unique(p.clustering.cluster[pooled])),
     }
-    return turned | pooled, report
+    return decided | pooled, report
+
+
+def _kept_with_patch(
+    p: Patches, outer: np.ndarray, given: np.ndarray, undecided: np.ndarray, areas: np.ndarray
+) -> None:
+    """Give every face left open the side its patch's open faces show as the input winds them (in place).
+
+    A face that no evidence decides keeps the input's winding, but as part of its patch:
+    it takes the side of the patch (the orientation double cover's node) on which most of
+    the area of the patch's open faces shows its front in the input.  A consistently
+    wound patch keeps its winding; a patch wound either way (a soup, 30 % of its faces
+    turned over) comes back with the winding most of its faces had.  Done again on the
+    output, every open face of a patch already shows that side: nothing changes.
+    """
+    node = p.clustering.side_node
+    rows = np.flatnonzero(undecided & (node[:, 0] >= 0) & (p.size > 1))
+    kept = given[rows].astype(np.int64)
+    votes = np.bincount(node[rows, kept], areas[rows], p.clustering.n_nodes)
+    other = votes[node[rows, 1 - kept]] > votes[node[rows, kept]]
+    outer[rows] = np.where(other, 1 - kept, kept)
 
 
 def _pooled_patches(
@@ -664,6 +708,7 @@ def _pooled_patches(
     outer: np.ndarray,
     movable: np.ndarray,
     clear: np.ndarray,
+    both: np.ndarray,
 ) -> np.ndarray:
     """Give every open patch of several faces the side its tested faces see, pooled (in place).
 
@@ -702,11 +747,58 @@ def _pooled_patches(
     )
     left = np.zeros(n, bool)
     left[patch[clear & pool]] = True
-    sure &= ~left[patch[at]] & movable[at]
+    sure &= ~left[patch[at]] & movable[at] & ~both[at]
     decided = np.zeros(len(outer), bool)
     decided[at[sure]] = True
     outer[at[sure]] = (back > front)[sure]
     return decided
+
+
+def classify_for_orient(model: Any, **classify_kw: Any) -> Classification:
+    """The classification :func:`orient` makes of a model: of its faces wound canonically.
+
+    Every face is classified in its canonical winding
+    (:func:`meshvis.geometry.winding.canonically_wound`), so that the random rays of the
+    cut are the same however the model's faces come in wound: a model and the model
+    :func:`orient` made of it get the same cut, and orienting an oriented model changes
+    nothing.  Pass it to :func:`orient` as ``classification`` to reuse it.
+
+    Parameters
+    ----------
+    model : anything :func:`meshvis.classify` accepts
+    **classify_kw : passed to :func:`meshvis.classify`
+
+    Returns
+    -------
+    Classification
+        Of the canonically wound copy of the model (its ``soup``).
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> box = trimesh.creation.box()
+    >>> c = classify_for_orient(box, seed=0)
+    >>> bool((orient(box, classification=c).flipped == orient(box, seed=0).flipped).all())
+    True
+    """
+    from meshvis.geometry.winding import canonically_wound
+    from meshvis.io import as_soup
+
+    _validate.keywords(classify_kw, classify)
+    return classify(canonically_wound(as_soup(model)), **classify_kw)
+
+
+def _input_side(soup: Soup, classified: Soup) -> np.ndarray:
+    """(m,) int8: the side of each face of ``classified`` that is the front of ``soup``'s face.
+
+    Raises ParameterError when the two are not the same faces (up to their corner order).
+    """
+    from meshvis.geometry.duplicates import winding_parity
+
+    f, g = soup.faces, classified.faces
+    if f.shape != g.shape or not np.array_equal(np.sort(f, axis=1), np.sort(g, axis=1)):
+        raise ParameterError("the classification is of another model (its faces differ)")
+    return (winding_parity(f) != winding_parity(g)).astype(np.int8)
 
 
 def orient(
@@ -721,6 +813,11 @@ def orient(
 ) -> OrientResult:
     """Turn every face so that its front side faces the outside.
 
+    A face's side comes from evidence that does not depend on how the face came in wound
+    (the cut and the rays run on the canonically wound model, :func:`classify_for_orient`);
+    the input's winding is kept only where the evidence leaves a face open.  So orienting
+    the output again changes nothing.
+
     Parameters
     ----------
     model : anything :func:`meshvis.classify` accepts
@@ -728,12 +825,19 @@ def orient(
     two_sided : "keep", "duplicate" or "strongest" (see module docstring)
     semantics : "layer" (default) or "cavity" for hidden shells
     conflicts : "majority" or "duplicate" for flagged faces whose sample points disagree
-    classification : reuse an existing classification of the same model
+    classification : reuse a classification of the same model, from
+        :func:`classify_for_orient` (or :func:`meshvis.classify`: then its random rays
+        depend on the input's winding)
     **classify_kw : passed to :func:`meshvis.classify`
 
     Returns
     -------
     OrientResult
+
+    Raises
+    ------
+    ParameterError
+        An option is unknown, or ``classification`` is of another model.
 
     Examples
     --------
@@ -742,27 +846,40 @@ def orient(
     >>> r = orient((m.vertices, f), seed=0)
     >>> int(r.flipped.sum()) == len(f[::3])
     True
+    >>> bool(orient(r.soup, seed=0).flipped.any())  # orienting the output changes nothing
+    False
     """
+    from meshvis.io import as_soup
+
     _validate.repair_args(classification, Classification, classify_kw, classify)
     _check("front", front, ("ccw", "cw"))
     _check("two_sided", two_sided, ("keep", "duplicate", "strongest"))
     _check("semantics", semantics, ("layer", "cavity"))
     _check("conflicts", conflicts, ("majority", "duplicate"))
-    c = classification or classify(model, **classify_kw)
-    m = c.soup.n_faces
-    status, outer = _own_sides(c, two_sided)
+    soup = as_soup(model)
+    c = classification or classify_for_orient(soup, **classify_kw)
+    given = _input_side(soup, c.soup)
+    m = soup.n_faces
+    # seen from both sides: both sides outside, wholly or at some of their sample points
+    both = (c.outside > 0).all(axis=1) & ~c.degenerate & (two_sided == "keep")
+    status, outer, undecided = _own_sides(c, two_sided, given, both)
     p = patches(c)
-    lay, own_layer, n_parity = _hidden_sides(c, p, status, outer, semantics)
-    # kept two-sided faces follow their patch and what a viewer sees; the other options
-    # decided them on purpose, and degenerate faces have no side
+    lay, own_layer, by_parity = _hidden_sides(c, p, status, outer, semantics, undecided)
+    # kept two-sided faces follow their patch and decisive evidence of their own; the
+    # other options decided them on purpose, and degenerate faces have no side
     movable = (status != DEGENERATE) & ((status != TWO_SIDED) | (two_sided == "keep"))
     # both copies of a sheet stored twice with opposite winding stay as they are
-    paired = in_opposite_copy(c.pre.faces_welded)
+    paired = in_opposite_copy(
+        np.where(given[:, None] == 1, c.pre.faces_welded[:, [0, 2, 1]], c.pre.faces_welded)
+    )
     movable &= ~paired
-    voted, n_patch = _whole_patches(c, p, status, outer, own_layer, movable)
+    voted, n_patch = _whole_patches(c, p, status, outer, own_layer, by_parity, movable, both)
+    undecided &= ~voted
     seed = int(c.params.get("seed", 0))
-    seen, visibility = _visible_sides(c, p, status, outer, movable, seed)
-    flip = outer == 1
+    seen, visibility = _visible_sides(c, p, status, outer, movable, undecided, both, seed)
+    undecided &= ~seen
+    _kept_with_patch(p, outer, given, undecided, c.soup.areas)
+    flip = outer != given
     if front == "cw":
         flip = ~flip
     dup = np.zeros(m, bool)
@@ -770,18 +887,30 @@ def orient(
         dup |= status == TWO_SIDED
     if conflicts == "duplicate":
         dup |= status == CONFLICT
-    # degenerate faces, and kept two-sided faces that neither their patch nor a viewer
-    # decided, are written untouched; but a sliver, whose edges join its patch, then
-    # shows the side its patch shows
-    untouched = (status == TWO_SIDED) & (two_sided == "keep") & ~voted & ~seen
+    # degenerate faces, and kept two-sided faces that nothing decided, are written
+    # untouched; but a sliver, whose edges join its patch, then shows the side its patch
+    # shows
+    untouched = both & undecided & (outer == given)
     flip[untouched | paired | (status == DEGENERATE)] = False
     sliver = np.flatnonzero((status == DEGENERATE) & (p.clustering.cluster >= 0))
-    flip[sliver] = _patch_shows_back(p, flip, c.soup.areas, sliver)
+    side = _patch_side(p, given ^ flip, c.soup.areas, sliver)
+    flip[sliver] = (side >= 0) & (side != given[sliver])
     extra = np.flatnonzero(dup)
     source = np.concatenate([np.arange(m), extra])
-    out = c.soup.subset(source).flipped(np.concatenate([flip, ~flip[extra]]))
+    out = soup.subset(source).flipped(np.concatenate([flip, ~flip[extra]]))
     return OrientResult(
-        out, source, flip, dup, status, c, lay, n_parity, n_patch, visibility, int(paired.sum())
+        out,
+        source,
+        flip,
+        dup,
+        status,
+        c,
+        lay,
+        int(by_parity.sum()),
+        n_patch,
+        visibility,
+        int(paired.sum()),
+        input_side=given,
     )
 
 

@@ -556,7 +556,8 @@ def bracket(model, region, *, search, max_level: int = DEFAULT_MAX_LEVEL, **sear
     else:
         budget = search_kw.pop("budget", None)
         rays = VIEW_RAYS if budget is None else int(budget)
-        vis = search(soup, positions, caster=scene.caster, **{**search_kw, "budget": 0})
+        # one ray: the search only builds the result, whose sets are replaced below
+        vis = search(soup, positions, caster=scene.caster, **{**search_kw, "budget": 1})
         rng = np.random.default_rng(search_kw.get("seed", 0))
         vis.seen_side[:] = sample_views(scene, views, max(rays // len(views), 1), rng)
         vis.method = "random rays in the views"

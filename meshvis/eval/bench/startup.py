@@ -1,4 +1,4 @@
-"""Start-up cost of the command: ``meshvis info`` on a tiny model next to ``python -c pass``.
+"""Start-up cost of the command: ``meshvis info`` and others on a tiny model next to ``python -c pass``.
 
 Each command runs in a fresh process, the commands taking turns so that a change of the
 machine's load touches them alike; the table gives the median and the best of
@@ -6,7 +6,8 @@ machine's load touches them alike; the table gives the median and the best of
 median CPU time (user + system), which a busy machine inflates less than wall time.
 Then the steps of the start are timed one by one (CPU seconds) in fresh processes.  The
 default model (100 triangles) makes the work itself negligible: what is left is the
-fixed cost of starting the interpreter, importing and setting up the compiled kernels.
+fixed cost of starting the interpreter, importing and setting up the compiled kernels
+(``remove-interior`` adds a classification with rays, small on this model but not nothing).
 """
 
 from __future__ import annotations
@@ -40,13 +41,20 @@ def add_arguments(p) -> None:
     p.add_argument("--json", metavar="FILE", help="also write the numbers as JSON")
 
 
-def commands(model: str) -> dict[str, list[str]]:
-    """The measured commands, by name: bare Python, ``meshvis --version``, ``meshvis info``."""
+def commands(model: str, out_dir: str) -> dict[str, list[str]]:
+    """The measured commands, by name.
+
+    Bare Python, ``meshvis --version``, ``meshvis info``, a parser alone (``orient --help``)
+    and a whole repair (``remove-interior``, writing into ``out_dir``).
+    """
     me = [sys.executable, "-m", "meshvis"]
+    out = os.path.join(out_dir, "out" + os.path.splitext(model)[1])
     return {
         "python -c pass": [sys.executable, "-c", "pass"],
         "meshvis --version": [*me, "--version"],
         "meshvis info MODEL": [*me, "info", model],
+        "meshvis orient --help": [*me, "orient", "--help"],
+        "meshvis remove-interior": [*me, "remove-interior", model, "-o", out, "--force", "--quiet"],
     }
 
 
@@ -58,9 +66,9 @@ def mark(name):
     global t
     now = time.process_time(); steps[name] = now - t; t = now
 import numpy; mark("numpy")
-import scipy.sparse.csgraph, scipy.spatial; mark("scipy (sparse graphs, k-d tree)")
 import numba; mark("numba, imported")
 import meshvis.cli.main, meshvis.geometry.diagnostics, meshvis.io; mark("meshvis modules")
+import scipy.linalg.cython_blas; mark("scipy's BLAS (numba's set-up imports it)")
 from meshvis.geometry._kernels import exact_groups
 exact_groups(numpy.zeros((1, 3), numpy.uint64), numpy.zeros(1, numpy.uint64))
 mark("numba, first compiled kernel called")
@@ -102,20 +110,23 @@ def run(model: str, repeat: int = 5) -> dict:
         (median minus the median of ``python -c pass``), ``model``, ``load`` (the load
         average before the runs), ``target``.
     """
-    cmds = commands(model)
+    import tempfile
+
     env = {**os.environ, "PYTHONDONTWRITEBYTECODE": "0"}
-    for cmd in cmds.values():  # one untimed run each: byte code and kernel caches in place
-        subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, check=True)
-    load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
-    seconds: dict[str, list[float]] = {name: [] for name in cmds}
-    cpu: dict[str, list[float]] = {name: [] for name in cmds}
-    for _ in range(repeat):
-        for name, cmd in cmds.items():
-            before = _children_cpu()
-            t0 = time.perf_counter()
+    with tempfile.TemporaryDirectory(prefix="meshvis-startup-") as out_dir:
+        cmds = commands(model, out_dir)
+        for cmd in cmds.values():  # one untimed run each: byte code and kernel caches in place
             subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, check=True)
-            seconds[name].append(time.perf_counter() - t0)
-            cpu[name].append(_children_cpu() - before)
+        load = os.getloadavg()[0] if hasattr(os, "getloadavg") else None
+        seconds: dict[str, list[float]] = {name: [] for name in cmds}
+        cpu: dict[str, list[float]] = {name: [] for name in cmds}
+        for _ in range(repeat):
+            for name, cmd in cmds.items():
+                before = _children_cpu()
+                t0 = time.perf_counter()
+                subprocess.run(cmd, env=env, stdout=subprocess.DEVNULL, check=True)
+                seconds[name].append(time.perf_counter() - t0)
+                cpu[name].append(_children_cpu() - before)
     median = {k: statistics.median(v) for k, v in seconds.items()}
     base = median["python -c pass"]
     return {
@@ -143,11 +154,11 @@ def format(r: dict) -> str:
     load = "" if r["load"] is None else f", load average {r['load']:.2f}"
     lines = [
         f"start-up: {r['model']}, median of {r['repeat']} runs each{load}",
-        f"{'command':<22} {'median s':>9} {'best s':>8} {'over python s':>14} {'CPU s':>7}",
+        f"{'command':<24} {'median s':>9} {'best s':>8} {'over python s':>14} {'CPU s':>7}",
     ]
     for name in r["median"]:
         lines.append(
-            f"{name:<22} {r['median'][name]:9.3f} {r['best'][name]:8.3f} {r['over_python'][name]:14.3f}"
+            f"{name:<24} {r['median'][name]:9.3f} {r['best'][name]:8.3f} {r['over_python'][name]:14.3f}"
             f" {r['cpu_median'][name]:7.3f}"
         )
     over = r["over_python"]["meshvis info MODEL"]
