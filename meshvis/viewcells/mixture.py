@@ -11,11 +11,11 @@ view space-direction distribution at least :data:`UNIFORM_FLOOR`, since its rays
 the random cameras of the pixel-error estimate (§4.5).
 
 >>> mix = Mixture(("uniform", "two-point"))
->>> mix.update("uniform", contribution=10, rays=1000)
->>> mix.update("two-point", contribution=90, rays=1000)
+>>> mix.update("uniform", contribution=5, rays=1000)
+>>> mix.update("two-point", contribution=95, rays=1000)
 >>> p = mix.probabilities({"uniform": True, "two-point": True})
->>> round(p["two-point"], 2)
-0.8
+>>> round(p["uniform"], 2), round(p["two-point"], 2)  # the uniform share lifted to its floor
+(0.1, 0.9)
 """
 
 from __future__ import annotations
