@@ -121,15 +121,19 @@ def adjust_text(reference: LayoutResult, *, iterations: int = 300, obstacle_cell
 
     Parameters
     ----------
-    reference : a LayoutResult (usually :func:`two_step`'s) whose anchors, texts and font
+    reference : LayoutResult
+        A LayoutResult (usually :func:`two_step`'s) whose anchors, texts and font
         are reused
-    iterations : adjustText iterations (``iter_lim``); no time limit is used
-    obstacle_cell : size in pixels of the blocks the model's pixels are given to
+    iterations : int
+        AdjustText iterations (``iter_lim``); no time limit is used.
+    obstacle_cell : int
+        Size in pixels of the blocks the model's pixels are given to
         adjustText as obstacles
 
     Returns
     -------
-    LayoutResult with ``method="adjusttext"``; ``timings["boxes"]`` is adjustText's time.
+    LayoutResult
+        With ``method="adjusttext"``; ``timings["boxes"]`` is adjustText's time.
     """
     from meshvis._extras import import_extra
 

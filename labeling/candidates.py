@@ -32,6 +32,7 @@ from scipy import ndimage
 
 from meshvis.errors import ParameterError
 
+from ._kernels import boundary_endpoints
 from .internal_area import InternalArea
 
 #: side codes of a leader: the direction it leaves the model in
@@ -73,12 +74,17 @@ class Candidates:
 
     Attributes
     ----------
-    ex, ey : (h, w) float64, endpoint on the boundary of ``A_I`` (NaN outside ``A_I``)
+    ex, ey : (h, w) float64
+        Endpoint on the boundary of ``A_I`` (NaN outside ``A_I``)
     length : (h, w) float64, ``|a e|`` from the pixel centre (NaN outside ``A_I``)
-    side : (h, w) int8, side code (:data:`WEST` ... :data:`RADIAL`), -1 outside ``A_I``
-    eid : (h, w) int64, endpoint id (index into ``endpoints``), -1 outside ``A_I``
-    endpoints : (n_e, 2) float64, the distinct endpoints
-    d_max : float, the longest candidate over all of ``A_I`` (appendix I, §6.1 step 3)
+    side : (h, w) int8
+        Side code (:data:`WEST` ... :data:`RADIAL`), -1 outside ``A_I``
+    eid : (h, w) int64
+        Endpoint id (index into ``endpoints``), -1 outside ``A_I``
+    endpoints : (n_e, 2) float64
+        The distinct endpoints
+    d_max : float
+        The longest candidate over all of ``A_I`` (appendix I, §6.1 step 3)
     """
 
     ex: np.ndarray
@@ -90,20 +96,22 @@ class Candidates:
     d_max: float
 
 
-def _edt_in_box(mask: np.ndarray) -> tuple[np.ndarray, tuple[np.ndarray, np.ndarray]]:
-    """Exact EDT of ``mask`` with feature indices, computed on its bounding box plus one pixel."""
+def _nearest_outside(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """The inside pixels of ``mask`` (flat indices, row-major) and the row and column of each one's nearest outside pixel.
+
+    The exact EDT's feature transform runs on the bounding box of ``mask`` plus one pixel
+    (every inside pixel lies there, and so does its nearest outside pixel).
+    """
     rows = np.flatnonzero(mask.any(axis=1))
     cols = np.flatnonzero(mask.any(axis=0))
     r0, r1 = max(rows[0] - 1, 0), min(rows[-1] + 2, mask.shape[0])
     c0, c1 = max(cols[0] - 1, 0), min(cols[-1] + 2, mask.shape[1])
-    d, (ri, ci) = ndimage.distance_transform_edt(mask[r0:r1, c0:c1], return_indices=True)
-    dist = np.zeros(mask.shape)
-    R = np.broadcast_to(np.arange(mask.shape[0])[:, None], mask.shape).copy()
-    C = np.broadcast_to(np.arange(mask.shape[1])[None, :], mask.shape).copy()
-    dist[r0:r1, c0:c1] = d
-    R[r0:r1, c0:c1] = ri + r0
-    C[r0:r1, c0:c1] = ci + c0
-    return dist, (R, C)
+    box = mask[r0:r1, c0:c1]
+    ri, ci = ndimage.distance_transform_edt(box, return_distances=False, return_indices=True)
+    inside = np.flatnonzero(box.ravel())
+    row, col = np.divmod(inside, box.shape[1])
+    flat = (row + r0) * mask.shape[1] + (col + c0)
+    return flat, ri.ravel()[inside] + r0, ci.ravel()[inside] + c0
 
 
 def _radial(
@@ -112,31 +120,23 @@ def _radial(
     """Nearest-boundary candidates: (length, ex, ey, key) on the grid of ``mask``.
 
     ``X``, ``Y``: image coordinates of the pixel centres of ``mask``; ``key`` = flat index
-    into ``mask`` of the nearest outside pixel.
+    into ``mask`` of the nearest outside pixel (-1 outside ``mask``).
 
     The EDT gives every inside pixel its nearest outside pixel ``q``; the endpoint of all
     pixels that share ``q`` is ``q`` moved half a pixel back along their mean direction,
     i.e. onto the boundary of ``A_I``.
     """
     hp, wp = mask.shape
-    _, (ri, ci) = _edt_in_box(mask)
-    key = ri * wp + ci
-    inside = np.flatnonzero(mask.ravel())
-    k = key.ravel()[inside]
-    qx = ci.ravel()[inside] + X[0, 0]
-    qy = ri.ravel()[inside] + Y[0, 0]
-    dx, dy = qx - X.ravel()[inside], qy - Y.ravel()[inside]
-    norm = np.maximum(np.hypot(dx, dy), 1e-12)
-    # mean direction per nearest outside pixel: sums over the pixel grid, no sort needed
-    mx = np.bincount(k, dx / norm, hp * wp)[k]
-    my = np.bincount(k, dy / norm, hp * wp)[k]
-    mn = np.maximum(np.hypot(mx, my), 1e-12)
-    ex = np.full(hp * wp, np.nan)
-    ey = np.full(hp * wp, np.nan)
-    ex[inside] = qx - 0.5 * (mx / mn)
-    ey[inside] = qy - 0.5 * (my / mn)
-    length = np.full(hp * wp, np.inf)
-    length[inside] = np.hypot(ex[inside] - X.ravel()[inside], ey[inside] - Y.ravel()[inside])
+    inside, ri, ci = _nearest_outside(mask)
+    key, ex, ey, length = boundary_endpoints(
+        inside,
+        ri * wp + ci,
+        ci + X[0, 0],
+        ri + Y[0, 0],
+        np.ascontiguousarray(X.ravel()[inside]),
+        np.ascontiguousarray(Y.ravel()[inside]),
+        hp * wp,
+    )
     return length.reshape(hp, wp), ex.reshape(hp, wp), ey.reshape(hp, wp), key
 
 

@@ -73,11 +73,16 @@ def layout_frames(
 
     Parameters
     ----------
-    model : as for :func:`meshvis.labeling.layout`
-    cameras : the cameras, in order
-    coherence : pass each frame the previous result (f6, f7); False lays frames out alone
-    caster : a RayCaster of the model to reuse
-    **options : passed to :func:`meshvis.labeling.layout` (layout, size, texts, method, weights, ...)
+    model : Soup, path, trimesh object, or a list of them
+        As for :func:`meshvis.labeling.layout`.
+    cameras : sequence of Camera
+        The cameras, in order.
+    coherence : bool
+        Pass each frame the previous result (f6, f7); False lays frames out alone.
+    caster : RayCaster, optional
+        A ray caster of the model to reuse.
+    **options
+        Passed to :func:`meshvis.labeling.layout` (layout, size, texts, method, weights, ...).
 
     Returns
     -------

@@ -40,11 +40,16 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from ._kernels import lower_f4_near
 from .membership import dist_threshold
 
 
 class _Buckets:
-    """Indices of points grouped by grid cell, for "points within d of p" queries."""
+    """Indices of points grouped by grid cell, for "points within d of p" queries.
+
+    The points of cell (i, j) are ``order[start[j * nx + i] : start[j * nx + i + 1]]``;
+    :func:`._kernels.lower_f4_near` walks the cells around a new anchor.
+    """
 
     def __init__(self, x: np.ndarray, y: np.ndarray, cell: float):
         self.cell = float(max(cell, 4.0))
@@ -56,20 +61,7 @@ class _Buckets:
         key = (self.cy - self.y0) * self.nx + (self.cx - self.x0)
         self.order = np.argsort(key, kind="stable")
         self.start = np.searchsorted(key[self.order], np.arange(self.nx * self.ny + 1))
-
-    def near(self, px: float, py: float, d: float) -> np.ndarray:
-        """Indices of the points in the cells that touch the square ``p +- d``."""
-        i0 = max(int(np.floor((px - d) / self.cell)) - self.x0, 0)
-        i1 = min(int(np.floor((px + d) / self.cell)) - self.x0, self.nx - 1)
-        j0 = max(int(np.floor((py - d) / self.cell)) - self.y0, 0)
-        j1 = min(int(np.floor((py + d) / self.cell)) - self.y0, self.ny - 1)
-        if i0 > i1 or j0 > j1:
-            return np.zeros(0, np.int64)
-        pieces = [
-            self.order[self.start[j * self.nx + i0] : self.start[j * self.nx + i1 + 1]]
-            for j in range(j0, j1 + 1)
-        ]
-        return np.concatenate(pieces) if pieces else np.zeros(0, np.int64)
+        self.grid = np.array([self.cell, self.x0, self.y0, self.nx, self.ny], np.float64)
 
 
 @dataclass
@@ -78,8 +70,10 @@ class GreedyResult:
 
     Attributes
     ----------
-    area_order : (k,) int, areas in the order they were labelled
-    pick : (k,) int, chosen candidate (index into the candidate arrays) of each of them
+    area_order : (k,) int
+        Areas in the order they were labelled
+    pick : (k,) int
+        Chosen candidate (index into the candidate arrays) of each of them
     feasibility : (k,) float, ``F`` of the chosen candidate when it was chosen
     priority : (k,) float, ``P_i = -sum F`` of the area when it was chosen
     """
@@ -124,28 +118,6 @@ def _near_pick(F: np.ndarray, dx: np.ndarray, dy: np.ndarray, drift: float, keep
     return j if F[j] > 0 and F[best] <= keep * F[j] else best
 
 
-def _lower_f4(
-    near: np.ndarray,
-    new: np.ndarray,
-    w4: float,
-    static: np.ndarray,
-    cell: np.ndarray,
-    f4: np.ndarray,
-    f4w: np.ndarray,
-    S: np.ndarray,
-) -> None:
-    """Lower f4 of the candidates ``near`` to ``new`` in place.
-
-    The sums ``S`` of their (area, endpoint) cells are lowered with it.
-    """
-    if len(near):
-        new_w = new**w4 if w4 != 1 else new
-        delta = static[near] * (new_w - f4w[near])
-        S += np.bincount(cell[near], weights=delta, minlength=S.size).reshape(S.shape)
-        f4[near] = new
-        f4w[near] = new_w
-
-
 def greedy_layout(
     area: np.ndarray,
     ax: np.ndarray,
@@ -166,14 +138,21 @@ def greedy_layout(
 
     Parameters
     ----------
-    area : (N,) int, area index (0 .. n_areas-1) of each candidate, **sorted ascending**
-    ax, ay : (N,) float, anchor (pixel centre) of each candidate
-    eid : (N,) int, endpoint id of each candidate (row of ``endpoints``)
-    endpoints : (n_e, 2) float, the distinct endpoints
-    static : (N,) float, product of the weighted memberships that do not depend on the
+    area : (N,) int
+        Area index (0 .. n_areas-1) of each candidate, **sorted ascending**
+    ax, ay : (N,) float
+        Anchor (pixel centre) of each candidate
+    eid : (N,) int
+        Endpoint id of each candidate (row of ``endpoints``)
+    endpoints : (n_e, 2) float
+        The distinct endpoints
+    static : (N,) float
+        Product of the weighted memberships that do not depend on the
         placed leaders: ``f2^w2 f3^w3 f6^w6 f7^w7``
-    n_areas : int, number of areas
-    d_a, d_e : float, distance thresholds of Eq. 4 and Eq. 6, pixels (0 disables)
+    n_areas : int
+        Number of areas
+    d_a, d_e : float
+        Distance thresholds of Eq. 4 and Eq. 6, pixels (0 disables)
     w4, w5 : weights of f4 and f5
     follow : (n_areas, 2) float, optional: per area the previous frame's anchor moved with
         the model (NaN: none).  The area takes its best candidate within ``drift`` pixels
@@ -200,6 +179,9 @@ def greedy_layout(
     alive = count > 0
     done = np.zeros(len(area), bool)
     abk = _Buckets(ax, ay, d_a) if d_a > 0 and len(area) else None
+    ax, ay = np.ascontiguousarray(ax, np.float64), np.ascontiguousarray(ay, np.float64)
+    S_flat = S.reshape(-1)  # a view: the compiled f4 update writes through it
+    acc = np.zeros(S.size)
     order, picks, feas, prio = [], [], [], []
     while alive.any():
         f5w = f5**w5 if w5 != 1 else f5
@@ -220,11 +202,10 @@ def greedy_layout(
         alive[i] = False
         done[lo:hi] = True
         if abk is not None:
-            near = abk.near(ax[pick], ay[pick], d_a)
-            near = near[~done[near]]
-            new = np.minimum(f4[near], dist_threshold(ax[near] - ax[pick], ay[near] - ay[pick], d_a))
-            changed = new < f4[near]
-            _lower_f4(near[changed], new[changed], w4, static, cell, f4, f4w, S)
+            lower_f4_near(
+                float(ax[pick]), float(ay[pick]), float(d_a), float(w4), ax, ay, done, static, cell,
+                f4, f4w, S_flat, acc, abk.grid, abk.order, abk.start,
+            )  # fmt: skip
         if d_e > 0:
             e = endpoints[eid[pick]]
             np.minimum(f5, dist_threshold(endpoints[:, 0] - e[0], endpoints[:, 1] - e[1], d_e), out=f5)

@@ -25,15 +25,24 @@ class IdBuffer:
 
     Attributes
     ----------
-    ids : (h, w) int64, part id seen by each pixel, -1 for background
-    face : (h, w) int64, face index seen by each pixel, -1 for background
-    depth : (h, w) float64, distance along the primary ray (inf for background)
-    image : (h, w, 3) uint8, the shaded picture
+    ids : (h, w) int64
+        Part id seen by each pixel, -1 for background
+    face : (h, w) int64
+        Face index seen by each pixel, -1 for background
+    depth : (h, w) float64
+        Distance along the primary ray (inf for background)
+    image : (h, w, 3) uint8
+        The shaded picture
     camera : Camera
-    areas : (n_parts,) int64, visible pixel count ``A_i`` of each part
+        The view.
+    areas : (n_parts,) int64
+        Visible pixel count ``A_i`` of each part
     part_names : list of str
-    sphere_center : (2,) float, the projected centre of the model's bounding sphere (pixels)
-    sphere_diameter : float, ``d_S``: the projected diameter of the bounding sphere (pixels)
+        The name of every part.
+    sphere_center : (2,) float
+        The projected centre of the model's bounding sphere (pixels)
+    sphere_diameter : float
+        ``d_S``: the projected diameter of the bounding sphere (pixels).
     """
 
     ids: np.ndarray
@@ -114,11 +123,16 @@ def id_buffer(
 
     Parameters
     ----------
-    soup : Soup, the model; its ``part_id`` gives the object ids
+    soup : Soup
+        The model; its ``part_id`` gives the object ids
     camera : Camera
-    size : (width, height) in pixels
-    caster : RayCaster, optional, reused between frames
-    color_by : colouring of the shaded picture (see :func:`meshvis.rays.render.render`)
+        The view.
+    size : (2,) int
+        ``(width, height)`` in pixels.
+    caster : RayCaster, optional
+        A ray caster of the model, reused between frames.
+    color_by : str or None
+        Colouring of the shaded picture (see :func:`meshvis.rays.render.render`).
 
     Returns
     -------

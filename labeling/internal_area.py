@@ -24,6 +24,8 @@ import numpy as np
 
 from meshvis.errors import ParameterError
 
+from ._kernels import scanline_mask
+
 SHAPES = ("hull", "circle", "rectangle")
 
 
@@ -34,13 +36,20 @@ class InternalArea:
     Attributes
     ----------
     kind : "hull", "circle" or "rectangle"
-    margin : float, growth in pixels
-    polygon : (k, 2) float, the corners of the boundary in order, not closed
-    pad : int, padding of the raster grid on every side
-    mask : (h + 2 pad, w + 2 pad) bool, pixel centres inside the polygon (padded grid)
-    left, right : (h + 2 pad,) float, x of the boundary on each padded row (NaN: row empty)
-    top, bottom : (w + 2 pad,) float, y of the boundary on each padded column (NaN: empty)
-    integral : (h + 2 pad + 1, w + 2 pad + 1) int32 summed-area table of ``mask``
+    margin : float
+        Growth in pixels
+    polygon : (k, 2) float
+        The corners of the boundary in order, not closed
+    pad : int
+        Padding of the raster grid on every side
+    mask : (h + 2 pad, w + 2 pad) bool
+        Pixel centres inside the polygon (padded grid)
+    left, right : (h + 2 pad,) float
+        X of the boundary on each padded row (NaN: row empty)
+    top, bottom : (w + 2 pad,) float
+        Y of the boundary on each padded column (NaN: empty)
+    integral : (h + 2 pad + 1, w + 2 pad + 1) int32
+        Summed-area table of ``mask``
     """
 
     kind: str
@@ -186,9 +195,11 @@ def internal_area(
 
     Parameters
     ----------
-    model_mask : (h, w) bool, pixels that see the model
+    model_mask : (h, w) bool
+        Pixels that see the model
     kind : "hull" (default), "circle" or "rectangle"
-    margin : float, growth in pixels; default 2 % of the image's smaller side
+    margin : float
+        Growth in pixels; default 2 % of the image's smaller side
 
     Returns
     -------
@@ -230,11 +241,7 @@ def internal_area(
     hp, wp = h + 2 * pad, w + 2 * pad
     left, right = _scan(polygon, hp, pad, axis=1)
     top, bottom = _scan(polygon, wp, pad, axis=0)
-    xc = np.arange(wp) + 0.5 - pad
-    with np.errstate(invalid="ignore"):
-        mask = (xc[None, :] >= left[:, None]) & (xc[None, :] <= right[:, None])
-    integral = np.zeros((hp + 1, wp + 1), np.int32)
-    integral[1:, 1:] = mask.cumsum(axis=0, dtype=np.int32).cumsum(axis=1, dtype=np.int32)
+    mask, integral = scanline_mask(left, right, np.arange(wp) + 0.5 - pad)
     return InternalArea(
         kind=kind,
         margin=margin,

@@ -58,8 +58,11 @@ def to_svg(result: LayoutResult, *, show_area: bool = False, canvas: Sequence[fl
     Parameters
     ----------
     result : LayoutResult
-    show_area : also draw the boundary of the internal area ``A_I`` (dashed)
-    canvas : (x0, y0, x1, y1) to use instead of ``result.canvas``
+        The layout to draw.
+    show_area : bool
+        Also draw the boundary of the internal area ``A_I`` (dashed).
+    canvas : (4,) float, optional
+        ``(x0, y0, x1, y1)`` to use instead of ``result.canvas``.
     """
     x0, y0, x1, y1 = canvas if canvas is not None else result.canvas
     w, h = result.size

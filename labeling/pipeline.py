@@ -531,6 +531,7 @@ def _inside_image(place, style: TextStyle, size: tuple[int, int], start: int | N
 
 def _view_maps(
     idbuf: IdBuffer,
+    mask: np.ndarray,
     area: str,
     margin: float | None,
     layout: str,
@@ -540,11 +541,11 @@ def _view_maps(
 ) -> tuple:
     """Compute the internal area, the leader candidates and the salience, timing each stage.
 
-    Returns the internal area ``A_I`` (stage ``area``), every pixel's leader candidate
+    ``mask`` is ``idbuf.model_mask``.  Returns the internal area ``A_I`` (stage ``area``), every pixel's leader candidate
     (``candidates``, Steps 2-3), the distance to its area's silhouette (``salience``,
     Step 4), and the clock.
     """
-    ia = internal_area(idbuf.model_mask, area, margin)
+    ia = internal_area(mask, area, margin)
     t = clock.tick("area", t)
     cand = leader_candidates(ia, layout, prefer, SIDE_KEEP)
     t = clock.tick("candidates", t)
@@ -664,28 +665,43 @@ def solve(
     Parameters
     ----------
     idbuf : IdBuffer
-    texts : one label text per part ("" = do not label)
-    layout : a key of :data:`labeling.candidates.LAYOUTS`
-    area : internal area shape, "hull", "circle" or "rectangle"
-    margin : growth of the internal area in pixels (default 2 % of the image's smaller side)
-    weights : Weights of Eq. 11 (paper defaults)
-    d_a : anchor distance threshold of Eq. 4, as a fraction of ``d_S``
-    d_e : endpoint distance threshold of Eq. 6, as a fraction of ``d_S``; default: the box
+        The view's ID buffer.
+    texts : sequence of str
+        One label text per part ("" = do not label).
+    layout : str
+        A key of :data:`labeling.candidates.LAYOUTS`.
+    area : {"hull", "circle", "rectangle"}
+        Shape of the internal area.
+    margin : float, optional
+        Growth of the internal area in pixels (default 2 % of the image's smaller side).
+    weights : Weights, optional
+        Weights of Eq. 11 (paper defaults).
+    d_a : float
+        Anchor distance threshold of Eq. 4, as a fraction of ``d_S``.
+    d_e : float, optional
+        Endpoint distance threshold of Eq. 6, as a fraction of ``d_S``; default: the box
         height (west/east layouts) or the mean box width (others) plus the box gap, as the
         paper recommends (§7.2)
-    previous : the previous frame's result, for the coherence terms f6 and f7 (Eq. 8-9)
-    method : "fuzzy" (this paper) or "two-step" (classic baseline: the most salient point of
+    previous : LayoutResult, optional
+        The previous frame's result, for the coherence terms f6 and f7 (Eq. 8-9).
+    method : {"fuzzy", "two-step"}
+        "fuzzy" (this paper) or "two-step" (classic baseline: the most salient point of
         each area, then its candidate leader, then the same box corrections)
-    font_size : label font size in pixels (default: :func:`labeling.text.default_font_size`;
+    font_size : int, optional
+        Label font size in pixels (default: :func:`labeling.text.default_font_size`;
         reduced for west/east layouts until the columns fit the image)
-    min_pixels : parts with fewer visible pixels are treated as invisible (default
-        :data:`MIN_PIXELS`)
-    spacing : Spacing of the boxes
-    compute_metrics : measure the result (:func:`labeling.metrics.frame_metrics`)
-    inside : keep every box inside the image: shrink the font (down to
+    min_pixels : int
+        Parts with fewer visible pixels are treated as invisible (default
+        :data:`MIN_PIXELS`).
+    spacing : Spacing, optional
+        Spacing of the boxes.
+    compute_metrics : bool
+        Measure the result (:func:`labeling.metrics.frame_metrics`).
+    inside : bool
+        Keep every box inside the image: shrink the font (down to
         :data:`MIN_FONT_SIZE`), then leave out the labels that still do not fit
         (``unplaced``, named in ``params["outside_image"]``); False lets boxes reach beyond
-        the image (the pictures' canvas grows to hold them)
+        the image (the pictures' canvas grows to hold them).
 
     Returns
     -------
@@ -698,14 +714,15 @@ def solve(
     clock = _Stopwatch()
     t = time.perf_counter()
     invisible, skipped, labelled = _sort_parts(idbuf, texts, min_pixels)
-    if len(labelled) == 0 or not idbuf.model_mask.any():
+    mask = idbuf.model_mask
+    if len(labelled) == 0 or not mask.any():
         empty = dict(layout=layout, method=method, area=area, margin=margin, font_size=font_size)
         return _nothing_to_label(idbuf, invisible, skipped, **empty, timings=clock.timings)
     slot = np.full(len(names), -1, np.int64)
     slot[labelled] = np.arange(len(labelled))
     prev = None if previous is None else _previous_frame(previous, idbuf, slot, len(labelled))
     prefer = _preferred_sides(idbuf, labelled, prev)
-    ia, cand, dist_sil, t = _view_maps(idbuf, area, margin, layout, prefer, clock, t)
+    ia, cand, dist_sil, t = _view_maps(idbuf, mask, area, margin, layout, prefer, clock, t)
     px = _pixels(idbuf, cand, dist_sil, labelled, len(names))
     (h, w), d_s = idbuf.shape, idbuf.sphere_diameter
     style = _fit_font(len(labelled), layout, h, int(font_size or default_font_size(h)))
@@ -800,16 +817,23 @@ def layout(
 
     Parameters
     ----------
-    model : Soup, path, trimesh object, or a list of them (combined; see
-        :func:`labeling.inputs.load_models`)
-    camera : Camera; default :func:`fit_camera` from ``azimuth``, ``elevation``, ``up``,
-        ``fit_margin``
-    layout : "left", "right", "left-right" (default), "top", "bottom", "top-bottom", "silhouette"
-    size : (width, height) in pixels
-    texts : label texts: a mapping {part name or index: text} or one text per part
-    caster : a RayCaster of the same model to reuse (frames, benchmarks)
-    color_by : colouring of the shaded picture
-    **options : passed to :func:`solve` (area, margin, weights, d_a, d_e, previous, method,
+    model : Soup, path, trimesh object, or a list of them
+        Combined when several (see :func:`labeling.inputs.load_models`).
+    camera : Camera, optional
+        Default: :func:`fit_camera` from ``azimuth``, ``elevation``, ``up``,
+        ``fit_margin``.
+    layout : {"left", "right", "left-right", "top", "bottom", "top-bottom", "silhouette"}
+        Where the boxes go (default left-right).
+    size : (2,) int
+        ``(width, height)`` in pixels.
+    texts : mapping or sequence of str, optional
+        Label texts: a mapping ``{part name or index: text}`` or one text per part
+    caster : RayCaster, optional
+        A ray caster of the same model to reuse (frames, benchmarks).
+    color_by : str or None
+        Colouring of the shaded picture.
+    **options
+        Passed to :func:`solve` (area, margin, weights, d_a, d_e, previous, method,
         font_size, min_pixels, spacing, inside)
 
     Returns

@@ -16,20 +16,34 @@ class Label:
 
     Attributes
     ----------
-    part : int, part id in the model
-    name : str, part name
-    text : str, label text
-    anchor : (2,) float, the anchor ``a`` (centre of a pixel of the part)
-    anchor_3d : (3,) float, the surface point seen at the anchor
-    endpoint : (2,) float, the candidate endpoint ``e`` on the boundary of ``A_I``
-    leader : (k, 2) float, the drawn leader, from the anchor to the box
-    box : (4,) float, (x0, y0, x1, y1)
-    side : str, "west", "east", "north", "south" or "radial"
-    rank : int, greedy order (0 = placed first)
-    feasibility : float, ``F`` of the chosen candidate (Eq. 12)
-    priority : float, ``P_i`` of the area when chosen (Eq. 14)
-    shift : float, how far the box was shifted from the candidate endpoint (pixels)
-    tier : int, 0 next to ``A_I``, higher = pushed further out
+    part : int
+        Part id in the model
+    name : str
+        Part name
+    text : str
+        Label text
+    anchor : (2,) float
+        The anchor ``a`` (centre of a pixel of the part)
+    anchor_3d : (3,) float
+        The surface point seen at the anchor
+    endpoint : (2,) float
+        The candidate endpoint ``e`` on the boundary of ``A_I``
+    leader : (k, 2) float
+        The drawn leader, from the anchor to the box
+    box : (4,) float
+        ``(x0, y0, x1, y1)``.
+    side : str
+        "west", "east", "north", "south" or "radial"
+    rank : int
+        Greedy order (0 = placed first)
+    feasibility : float
+        ``F`` of the chosen candidate (Eq. 12).
+    priority : float
+        ``P_i`` of the area when chosen (Eq. 14).
+    shift : float
+        How far the box was shifted from the candidate endpoint (pixels)
+    tier : int
+        0 next to ``A_I``, higher = pushed further out.
     """
 
     part: int
@@ -82,21 +96,38 @@ class LayoutResult:
 
     Attributes
     ----------
-    labels : list of Label, in greedy order
-    invisible : list of (part id, name) of parts with no visible pixel
-    unplaced : list of (part id, name) of visible parts that got no valid box
-    skipped : list of (part id, name) of parts with an empty label text
-    image : (h, w, 3) uint8, the shaded picture
-    ids : (h, w) int64, the object-ID buffer
+    labels : list of Label
+        In greedy order
+    invisible : list of (int, str)
+        ``(part id, name)`` of parts with no visible pixel.
+    unplaced : list of (int, str)
+        ``(part id, name)`` of visible parts that got no valid box.
+    skipped : list of (int, str)
+        ``(part id, name)`` of parts with an empty label text.
+    image : (h, w, 3) uint8
+        The shaded picture
+    ids : (h, w) int64
+        The object-ID buffer
     camera : Camera
-    layout : str, layout name
-    method : str, "fuzzy", "two-step" or "adjusttext"
-    area_polygon : (k, 2) float, boundary of ``A_I``
-    font_size : int ; box_height : float
-    sphere_diameter : float, ``d_S`` in pixels
-    params : dict, the parameters used (weights, d_a, d_e, ...)
-    metrics : dict, see :mod:`labeling.metrics`
-    timings : dict, seconds per stage
+        The view.
+    layout : str
+        Layout name
+    method : str
+        "fuzzy", "two-step" or "adjusttext"
+    area_polygon : (k, 2) float
+        Boundary of ``A_I``
+    font_size : int
+        Label font size in pixels.
+    box_height : float
+        Box height in pixels.
+    sphere_diameter : float
+        ``d_S`` in pixels.
+    params : dict
+        The parameters used (weights, d_a, d_e, ...)
+    metrics : dict
+        See :mod:`labeling.metrics`
+    timings : dict
+        Seconds per stage
     """
 
     labels: list[Label]

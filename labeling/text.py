@@ -35,6 +35,17 @@ def font(size: int):
     return ImageFont.truetype(font_file(), int(size))
 
 
+#: texts whose measured widths are kept: a live view measures the same few dozen texts
+#: at a few font sizes every frame
+LENGTH_CACHE = 8192
+
+
+@lru_cache(maxsize=LENGTH_CACHE)
+def _length(size: int, text: str) -> float:
+    """Width of ``text`` at ``size`` pixels, without padding (Pillow's advance width)."""
+    return float(font(size).getlength(text))
+
+
 def default_font_size(height: int) -> int:
     """Font size in pixels for an image ``height`` pixels high (11 px at 512)."""
     return int(max(7, round(0.0215 * height)))
@@ -65,9 +76,8 @@ class TextStyle:
 
     def box_widths(self, texts: Sequence[str]) -> np.ndarray:
         """Width of the box of each text."""
-        f = font(self.font_size)
-        return np.array([f.getlength(t) + 2 * self.pad_x for t in texts], np.float64)
+        return np.array([_length(self.font_size, t) + 2 * self.pad_x for t in texts], np.float64)
 
     def text_width(self, text: str) -> float:
         """Width of ``text`` in pixels, without padding."""
-        return float(font(self.font_size).getlength(text))
+        return _length(self.font_size, text)

@@ -36,12 +36,9 @@ MAX_RAYS_PER_NODE = 65_536
 #: 1 KB glTF made remove-interior take 10 minutes; the shared real models have at most 4
 MAX_FACE_COPIES = 64
 #: rays a classification may ask for, per byte of its input (the file, or the arrays of a
-#: model given in memory).  What it asks for is bounded before any work: every face flagged,
-#: 2 sides x ``samples_per_face`` x ``rays_per_point`` rays and as many reverse rays, or
-#: 2 x ``rays_per_node``, whichever is more (512 per face at the defaults, so a file needs
-#: 2 bytes per face; the shared real models have 10-150).  A 47 MB binary PLY of a
-#: 1.34 M-face city of real models may ask for 12 G rays, asks for at most 686 M and casts
-#: 40 M; a 5 KB glTF that places a million faces is refused before its analysis
+#: model given in memory), bounded before any work as if every face were flagged (512 rays
+#: per face at the defaults, so a file needs 2 bytes per face; real files have 10-150): a
+#: tiny file that places millions of faces is refused before its analysis (docs/scale.md)
 RAYS_PER_INPUT_BYTE = 256
 #: ... or this many, whatever the input (about 20 s of rays on two cores)
 MIN_RAY_CAP = 1 << 24

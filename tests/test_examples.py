@@ -1,4 +1,8 @@
-"""The four scripts in examples/ run and write valid models and pictures."""
+"""The scripts in examples/ run and write valid models and pictures.
+
+``gallery.py`` reads the shared real models and takes about a minute; CI runs it in its own
+step (``.ci/run``) before it builds the docs, whose build fails on a missing picture.
+"""
 
 from __future__ import annotations
 
@@ -22,8 +26,12 @@ OUTPUTS = {
 }
 
 
+#: run by CI's own step, not by the suite
+GALLERY = "gallery.py"
+
+
 def test_every_example_is_tested():
-    assert {p.name for p in EXAMPLES.glob("*.py") if not p.name.startswith("_")} == set(OUTPUTS)
+    assert {p.name for p in EXAMPLES.glob("*.py") if not p.name.startswith("_")} == set(OUTPUTS) | {GALLERY}
 
 
 @pytest.mark.slow

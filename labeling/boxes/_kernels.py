@@ -5,7 +5,8 @@ under it; its leader crosses no box, leader or path) and blocks no later label's
 Testing every candidate with array operations costs as much for the first valid one as
 for the last; walking them in order of cost and stopping at the first that passes costs
 a few tests per label.  The predicates are those of :mod:`meshvis.labeling.geometry2d`,
-written for one pair at a time, with the same comparisons (so the same answers).
+written for one pair at a time (:mod:`meshvis.labeling._kernels`), with the same
+comparisons (so the same answers).
 """
 
 from __future__ import annotations
@@ -15,57 +16,10 @@ import math
 import numba
 import numpy as np
 
+from .._kernels import hits_box as _hits_box
+from .._kernels import meet as _meet
+
 _JIT = dict(cache=True, nogil=True, error_model="numpy")
-
-
-@numba.njit(**_JIT)
-def _hits_box(px, py, qx, qy, x0, y0, x1, y1):
-    """Segment p-q passes through the interior of box (x0, y0, x1, y1) (``segment_hits_box``)."""
-    if not (min(px, qx) < x1 and x0 < max(px, qx) and min(py, qy) < y1 and y0 < max(py, qy)):
-        return False
-    t_enter, t_exit = 0.0, 1.0
-    for p, d, lo, hi in ((px, qx - px, x0, x1), (py, qy - py, y0, y1)):
-        if d == 0.0:
-            if not (p > lo and p < hi):
-                return False
-            continue
-        t1, t2 = (lo - p) / d, (hi - p) / d
-        t_enter = max(t_enter, min(t1, t2))
-        t_exit = min(t_exit, max(t1, t2))
-    return t_enter < t_exit
-
-
-@numba.njit(**_JIT)
-def _orient(ax, ay, bx, by, cx, cy):
-    v = (bx - ax) * (cy - ay) - (by - ay) * (cx - ax)
-    return 1.0 if v > 0 else (-1.0 if v < 0 else 0.0)
-
-
-@numba.njit(**_JIT)
-def _on_segment(ax, ay, bx, by, cx, cy):
-    return min(ax, bx) <= cx <= max(ax, bx) and min(ay, by) <= cy <= max(ay, by)
-
-
-@numba.njit(**_JIT)
-def _meet(ax, ay, bx, by, cx, cy, dx, dy):
-    """Closed segments a-b and c-d meet, touching included (``segments_intersect``)."""
-    if not (
-        min(ax, bx) <= max(cx, dx)
-        and min(cx, dx) <= max(ax, bx)
-        and min(ay, by) <= max(cy, dy)
-        and min(cy, dy) <= max(ay, by)
-    ):
-        return False
-    o1, o2 = _orient(ax, ay, bx, by, cx, cy), _orient(ax, ay, bx, by, dx, dy)
-    o3, o4 = _orient(cx, cy, dx, dy, ax, ay), _orient(cx, cy, dx, dy, bx, by)
-    if o1 * o2 < 0 and o3 * o4 < 0:
-        return True
-    return (
-        (o1 == 0 and _on_segment(ax, ay, bx, by, cx, cy))
-        or (o2 == 0 and _on_segment(ax, ay, bx, by, dx, dy))
-        or (o3 == 0 and _on_segment(cx, cy, dx, dy, ax, ay))
-        or (o4 == 0 and _on_segment(cx, cy, dx, dy, bx, by))
-    )
 
 
 @numba.njit(**_JIT)
@@ -146,3 +100,110 @@ def first_free(
         if c < best:
             best, fallback = c, i
     return -1, fallback
+
+
+@numba.njit(**_JIT)
+def _leaders_meet(anchors, ports, assign, i, j):
+    a, b = anchors[i], ports[assign[i]]
+    c, d = anchors[j], ports[assign[j]]
+    return _meet(a[0], a[1], b[0], b[1], c[0], c[1], d[0], d[1])
+
+
+@numba.njit(**_JIT)
+def uncross_ports(anchors, ports, limit):
+    """Swap the ports of crossing leaders ``anchor -> port`` (for :func:`.stacking.uncross`).
+
+    The first crossing pair in row-major order is swapped, then only the two moved
+    leaders are tested again.  Returns the port of each anchor and the number of swaps.
+    """
+    n = anchors.shape[0]
+    assign = np.arange(n)
+    x = np.zeros((n, n), np.bool_)
+    for i in range(n):
+        for j in range(i + 1, n):
+            x[i, j] = x[j, i] = _leaders_meet(anchors, ports, assign, i, j)
+    swaps = 0
+    while swaps < limit:
+        first_i, first_j = -1, -1
+        for i in range(n):
+            for j in range(i + 1, n):
+                if x[i, j]:
+                    first_i, first_j = i, j
+                    break
+            if first_i >= 0:
+                break
+        if first_i < 0:
+            break
+        assign[first_i], assign[first_j] = assign[first_j], assign[first_i]
+        swaps += 1
+        for k in (first_i, first_j):
+            for m in range(n):
+                if m != k:
+                    x[k, m] = x[m, k] = _leaders_meet(anchors, ports, assign, k, m)
+    return assign, swaps
+
+
+@numba.njit(**_JIT)
+def radial_candidates(E, N, own, anchor, w, h, tier_step, clearance, n_t, below, size, centre, attach, costs):
+    """The candidate lists of :func:`.silhouette._radial_candidates` in one pass.
+
+    ``E``, ``N`` (e, 2): endpoints and their push-out directions; ``own``: the label's own
+    endpoint; ``size`` = (W, H); ``centre``: last frame's box centre (NaN: none);
+    ``attach`` (A, 2): attach points in half sizes; ``costs`` = (behind-port cost,
+    behind-port cosine, outside-image cost, coherence cost).  Candidates are walked in
+    (endpoint, tier, attach) order, with the arithmetic of the array version in the same
+    order.  Returns boxes (K, 4), leaders (L, 3, 2), the leader of each box, cost, tier
+    and endpoint move.
+    """
+    behind_cost, behind_cos, outside_cost, coherence_cost = costs
+    n_e, n_a = E.shape[0], attach.shape[0]
+    cap = n_e * n_t * n_a
+    boxes = np.empty((cap, 4))
+    cost = np.empty(cap)
+    tiers = np.empty(cap, np.int64)
+    shifts = np.empty(cap)
+    lid = np.empty(cap, np.int64)
+    leaders = np.empty((n_e * n_t, 3, 2))
+    hw, hh = w / 2, h / 2
+    base = math.hypot(own[0] - anchor[0], own[1] - anchor[1])
+    follow = not math.isnan(centre[0]) and not math.isinf(centre[0])
+    k = 0
+    n_l = 0
+    for ie in range(n_e):
+        moved = math.hypot(E[ie, 0] - own[0], E[ie, 1] - own[1])
+        longer = math.hypot(E[ie, 0] - anchor[0], E[ie, 1] - anchor[1]) - base
+        bend = (h + longer) if moved > 0 else 0.0
+        for it in range(n_t):
+            push = clearance + it * tier_step
+            px, py = E[ie, 0] + push * N[ie, 0], E[ie, 1] + push * N[ie, 1]
+            first = True
+            for ia in range(n_a):
+                ox, oy = attach[ia, 0] * hw, attach[ia, 1] * hh
+                along = (N[ie, 0] * ox + N[ie, 1] * oy) / math.hypot(ox, oy)
+                c = (
+                    it * tier_step
+                    + bend
+                    + ((1.0 - along) * h + (behind_cost if along <= behind_cos else 0.0))
+                )
+                if not c < below:
+                    continue
+                cx, cy = px + ox, py + oy
+                x0, y0, x1, y1 = cx - hw, cy - hh, cx + hw, cy + hh
+                c = c + (outside_cost if (x0 < 0 or y0 < 0 or x1 > size[0] or y1 > size[1]) else 0.0)
+                if follow:
+                    c = c + coherence_cost * math.hypot(cx - centre[0], cy - centre[1])
+                if not c < below:
+                    continue
+                if first:
+                    leaders[n_l, 0, 0], leaders[n_l, 0, 1] = anchor[0], anchor[1]
+                    leaders[n_l, 1, 0], leaders[n_l, 1, 1] = E[ie, 0], E[ie, 1]
+                    leaders[n_l, 2, 0], leaders[n_l, 2, 1] = px, py
+                    n_l += 1
+                    first = False
+                boxes[k, 0], boxes[k, 1], boxes[k, 2], boxes[k, 3] = x0, y0, x1, y1
+                cost[k] = c
+                tiers[k] = it
+                shifts[k] = moved
+                lid[k] = n_l - 1
+                k += 1
+    return boxes[:k], leaders[:n_l], lid[:k], cost[:k], tiers[:k], shifts[:k]

@@ -109,6 +109,8 @@ class Context:
     def row_box(self, k: int, side: int, x: np.ndarray, tier: np.ndarray) -> np.ndarray:
         """Flag box of label k whose leader port is at ``x``, in ``tier``."""
         w, h, sp = self.widths[k], self.height, self.sp
+        if np.ndim(x) == 0 and np.ndim(tier) == 0:  # one box: plain floats cost far less than arrays
+            return np.array(self._one_row_box(float(w), side, float(x), float(tier)))
         x = np.asarray(x, np.float64)
         tier = np.asarray(tier, np.float64)
         left_flag = x < self.center[0]
@@ -122,6 +124,19 @@ class Context:
             y1 = y0 + h
         x0, y0, y1 = np.broadcast_arrays(x0, y0, y1)
         return np.stack([x0, y0, x0 + w, y1], axis=-1)
+
+    def _one_row_box(self, w: float, side: int, x: float, tier: float) -> tuple[float, float, float, float]:
+        """:meth:`row_box` of one label of width ``w`` (the same arithmetic on floats)."""
+        h, sp = self.height, self.sp
+        x0 = x + sp.inset - w if x < self.center[0] else x - sp.inset
+        step = h + sp.gap
+        if side == NORTH:
+            y1 = self.row_y[NORTH] - tier * step
+            y0 = y1 - h
+        else:
+            y0 = self.row_y[SOUTH] + tier * step
+            y1 = y0 + h
+        return x0, y0, x0 + w, y1
 
     def row_leader(self, k: int, side: int, x: float, tier: int) -> np.ndarray:
         """Leader polyline of label k in a row: anchor, port at ``x`` and, beyond tier 0, the box edge."""

@@ -89,12 +89,18 @@ def place_boxes(
 
     Parameters
     ----------
-    anchors, endpoints : (n, 2) float, the anchors and candidate endpoints (pixels)
-    sides : (n,) int, side code of each label
-    widths : (n,) float, box widths; ``height`` : box height
+    anchors, endpoints : (n, 2) float
+        The anchors and candidate endpoints (pixels)
+    sides : (n,) int
+        Side code of each label
+    widths : (n,) float
+        Box widths.
+    height : float
+        Box height.
     area : InternalArea
     image_size : (width, height)
-    rank : (n,) int, greedy placement order (lower = placed first); default 0..n-1
+    rank : (n,) int
+        Greedy placement order (lower = placed first); default 0..n-1
     spacing : Spacing
     previous : (n, 4) float, optional: each label's box centre along the west, east,
         north and south side in the previous frame (y for west/east, x for north/south;

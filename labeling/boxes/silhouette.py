@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..geometry2d import boxes_overlap, polyline_length, segment_hits_box
-from ._kernels import first_free
+from ._kernels import first_free, radial_candidates
 from .collisions import _boxes_free, _leaders_free, _outside_image, _place, _placed_arrays
 from .context import NEAR_REACH, Context
 from .costs import BEHIND_PORT_COS, BEHIND_PORT_COST, BLOCKED_RAY_COST, COHERENCE_COST, OUTSIDE_IMAGE_COST
@@ -33,6 +33,8 @@ _ROTATE_TIERS = 3
 
 #: attach points of a box: offsets of the box centre from the port, in half widths/heights
 _ATTACH = np.array([[1, 0], [-1, 0], [0, 1], [0, -1], [1, 1], [1, -1], [-1, 1], [-1, -1]], np.float64)
+#: the penalties of a candidate, as :func:`._kernels.radial_candidates` takes them
+_COSTS = (float(BEHIND_PORT_COST), float(BEHIND_PORT_COS), float(OUTSIDE_IMAGE_COST), float(COHERENCE_COST))
 
 
 def _facing(normals: np.ndarray, offsets: np.ndarray) -> np.ndarray:
@@ -65,13 +67,18 @@ def _radial_candidates(
     Returns
     -------
     boxes : (K, 4)
-    leaders : (L, 3, 2), anchor -> E -> port, one per (endpoint, tier)
-    lid : (K,) int, the leader of each box
+    leaders : (L, 3, 2)
+        Anchor -> E -> port, one per (endpoint, tier)
+    lid : (K,) int
+        The leader of each box
     cost : (K,) pixels of leader: the push-out ``t * step``, plus for a moved endpoint
         the longer inside part and one box height for the bend; then ``(1 - along) h``
         (boxes centred on the ray before corner flags), :data:`~.costs.BEHIND_PORT_COST` for
         boxes behind the port, :data:`~.costs.OUTSIDE_IMAGE_COST` for boxes outside the image
     tiers, shifts : (K,) tier and endpoint move (pixels)
+
+    The lists are built by the compiled :func:`._kernels.radial_candidates` (a label
+    searches several times per frame, each list of a few hundred candidates).
     """
     pts, normals = ctx.boundary
     h, w, a = ctx.height, ctx.widths[k], ctx.anchors[k]
@@ -83,37 +90,22 @@ def _radial_candidates(
         js = np.concatenate([-js, js])
         q = (ctx.boundary_index(k) + js[(js != 0) & (np.abs(js) <= m // 2)]) % m
         E, N = np.concatenate([E, pts[q]]), np.concatenate([N, normals[q]])
-    tier_step = RADIAL_TIER * h + ctx.sp.gap
-    n_t = _radial_tiers(ctx, reach)
-    t = np.arange(n_t)
-    off = _ATTACH * np.array([w / 2, h / 2])  # (A, 2)
-    along = _facing(N[:, None, :], off[None])  # (E, A)
-    moved = np.hypot(*(E - ctx.endpoints[k]).T)
-    longer = np.hypot(*(E - a).T) - np.hypot(*(ctx.endpoints[k] - a))
-    cost = (
-        (t * tier_step)[None, :, None]
-        + ((moved > 0) * (h + longer))[:, None, None]
-        + ((1.0 - along) * h + BEHIND_PORT_COST * (along <= BEHIND_PORT_COS))[:, None, :]
+    return radial_candidates(
+        np.ascontiguousarray(E, np.float64),
+        np.ascontiguousarray(N, np.float64),
+        np.asarray(ctx.endpoints[k], np.float64),
+        np.asarray(a, np.float64),
+        float(w),
+        float(h),
+        float(RADIAL_TIER * h + ctx.sp.gap),
+        float(ctx.sp.clearance),
+        _radial_tiers(ctx, reach),
+        float(below),
+        np.array([ctx.W, ctx.H], np.float64),
+        np.asarray(ctx.centres[k], np.float64),
+        _ATTACH,
+        _COSTS,
     )
-    ie, it, ia = np.nonzero(cost < below)
-    port = E + (ctx.sp.clearance + t[:, None, None] * tier_step) * N  # (T, E, 2)
-    c = port[it, ie] + off[ia]
-    half = np.array([w / 2, h / 2])
-    boxes = np.concatenate([c - half, c + half], axis=1)
-    cost = cost[ie, it, ia] + OUTSIDE_IMAGE_COST * _outside_image(ctx, boxes)
-    if np.isfinite(ctx.centres[k, 0]):
-        # along a camera path: a pixel of distance from where the box was (moved with its
-        # anchor) costs as much as a pixel of leader
-        cost = cost + COHERENCE_COST * np.hypot(*(c - ctx.centres[k]).T)
-    keep = cost < below
-    lid = (ie * n_t + it)[keep]
-    # np.nonzero walks (endpoint, tier, attach) in order, so lid is sorted: number its runs
-    new = np.ones(len(lid), bool)
-    new[1:] = lid[1:] != lid[:-1]
-    used, lid = lid[new], np.cumsum(new) - 1
-    ue, ut = np.divmod(used, n_t)
-    leaders = np.stack([np.broadcast_to(a, (len(used), 2)), E[ue], port[ut, ue]], axis=1)
-    return boxes[keep], leaders, lid.ravel(), cost[keep], it[keep], moved[ie[keep]]
 
 
 def _cheapest(

@@ -39,11 +39,14 @@ class Placement:
 
     Attributes
     ----------
-    leader : (k, 2) float, polyline from the anchor to the box
+    leader : (k, 2) float
+        Polyline from the anchor to the box
     box : (4,) float, (x0, y0, x1, y1)
-    side : int, side code
+    side : int
+        Side code
     tier : int, 0 next to ``A_I``, higher = pushed further out
-    shift : float, distance of the box's port from the candidate endpoint along the side
+    shift : float
+        Distance of the box's port from the candidate endpoint along the side
     """
 
     leader: np.ndarray

@@ -9,7 +9,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from ..geometry2d import segments_intersect
+from ._kernels import uncross_ports
 from .context import Context
 from .costs import SHIFTED
 from .spacing import Placement
@@ -55,26 +55,16 @@ def uncross(anchors: np.ndarray, ports: np.ndarray, max_swaps: int | None = None
 
     Returns
     -------
-    assignment : (n,) int, port index of each anchor
+    assignment : (n,) int
+        Port index of each anchor
     swaps : int
     """
+    anchors = np.ascontiguousarray(anchors, np.float64).reshape(-1, 2)
+    ports = np.ascontiguousarray(ports, np.float64).reshape(-1, 2)
     n = len(anchors)
-    assign = np.arange(n)
     limit = n * n + 1 if max_swaps is None else max_swaps
-    swaps = 0
-    segs = np.stack([anchors, ports[assign]], axis=1)
-    x = segments_intersect(segs, segs)
-    np.fill_diagonal(x, False)
-    while swaps < limit and x.any():
-        i, j = np.unravel_index(np.argmax(np.triu(x, 1)), x.shape)
-        assign[[i, j]] = assign[[j, i]]
-        swaps += 1
-        segs[[i, j], 1] = ports[assign[[i, j]]]
-        rows = segments_intersect(segs[[i, j]], segs)  # only the two moved leaders changed
-        x[[i, j], :] = rows
-        x[:, [i, j]] = rows.T
-        np.fill_diagonal(x, False)
-    return assign, swaps
+    assign, swaps = uncross_ports(anchors, ports, limit)
+    return assign, int(swaps)
 
 
 def coherent_order(desired: np.ndarray, previous: np.ndarray, pitch: float) -> np.ndarray:
@@ -91,7 +81,8 @@ def coherent_order(desired: np.ndarray, previous: np.ndarray, pitch: float) -> n
 
     Returns
     -------
-    (n,) int, a permutation of ``range(n)``
+    (n,) int
+        A permutation of ``range(n)``
     """
     desired = np.asarray(desired, np.float64)
     previous = np.asarray(previous, np.float64)

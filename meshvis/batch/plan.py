@@ -54,7 +54,8 @@ def discover(inputs: Sequence[str]) -> list[tuple[str, str]]:
 
     Parameters
     ----------
-    inputs : paths of files (taken as they are, whatever their extension), folders
+    inputs : sequence of str
+        Paths of files (taken as they are, whatever their extension), folders
         (searched recursively for files with a known model extension) and glob patterns
         (``*``, ``?``, ``[...]``; ``**`` spans folders).  Hidden files and folders, and
         files named like batch outputs (``*.orient.*``, ``*.remove-interior.*``,

@@ -45,13 +45,20 @@ def run_batch(
 
     Parameters
     ----------
-    tasks : from :func:`plan`
-    jobs : local worker processes (default :func:`default_jobs`); ignored with ``scheduler``
-    time_limit : seconds per file (None: no limit); an exceeding file is ``"timeout"``
-    scheduler : address of a Dask scheduler (``tcp://host:8786``), or None to run locally
-    resume : skip tasks that are complete from an earlier run (see :func:`completed_row`)
-    on_start : ``on_start(index)`` when a task is handed to a worker
-    on_done : ``on_done(index, row)`` when a task ends (also for skipped tasks)
+    tasks : sequence of FileTask
+        The files, from :func:`plan`.
+    jobs : int, optional
+        Local worker processes (default :func:`default_jobs`); ignored with ``scheduler``.
+    time_limit : float, optional
+        Seconds per file (None: no limit); a file that exceeds it is ``"timeout"``.
+    scheduler : str, optional
+        Address of a Dask scheduler (``tcp://host:8786``), or None to run locally.
+    resume : bool
+        Skip tasks that are complete from an earlier run (see :func:`completed_row`).
+    on_start : callable, optional
+        Called as ``on_start(index)`` when a task is handed to a worker.
+    on_done : callable, optional
+        Called as ``on_done(index, row)`` when a task ends (also for skipped tasks).
 
     Returns
     -------

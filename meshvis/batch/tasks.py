@@ -41,13 +41,19 @@ class FileTask:
 
     Attributes
     ----------
-    input : path of the model file
-    name : output name without operation and extension (relative to the output folder)
-    output, report : paths of the output model and of its JSON report
-    op : one of :data:`OPERATIONS`
-    options : algorithm options (``seed``, ``rays_per_node``, ...: the ``dest`` names of
+    input : str
+        Path of the model file.
+    name : str
+        Output name without operation and extension (relative to the output folder).
+    output, report : str
+        Paths of the output model and of its JSON report.
+    op : str
+        One of :data:`OPERATIONS`.
+    options : dict
+        Algorithm options (``seed``, ``rays_per_node``, ...: the ``dest`` names of
         the command-line options); the others keep the defaults of ``meshvis <op>``
-    runner : ``module:function`` performing the operation (see :data:`DEFAULT_RUNNER`)
+    runner : str
+        ``module:function`` performing the operation (see :data:`DEFAULT_RUNNER`).
     """
 
     input: str

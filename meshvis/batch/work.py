@@ -147,10 +147,12 @@ def run_file(task: FileTask) -> dict:
     Parameters
     ----------
     task : FileTask
+        The file, its operation and its options.
 
     Returns
     -------
-    dict with the keys :data:`COLUMNS`
+    dict
+        The summary row, with the keys :data:`COLUMNS`.
     """
     from meshvis.io import check_output, load
     from meshvis.io.writing import check_not_read

@@ -66,13 +66,19 @@ class BaselineResult:
 
     Attributes
     ----------
-    method : name of the baseline (a key of :data:`BASELINES`)
-    task : "orient", "remove" or "layers"
-    values : (m,) per input face: ``flipped`` (bool) for orient, ``keep`` (bool) for
+    method : str
+        Name of the baseline (a key of :data:`BASELINES`).
+    task : {"orient", "remove", "layers"}
+        The task.
+    values : (m,) array or None
+        (m,) per input face: ``flipped`` (bool) for orient, ``keep`` (bool) for
         remove, ``layer`` (int64, 1 = outer) for layers; None when the run failed
-    seconds : wall time of the call, welding included
-    ok : False when the library failed; ``message`` says how
-    params : the knobs used
+    seconds : float
+        Wall time of the call, welding included.
+    ok : bool
+        False when the library failed; ``message`` says how.
+    params : dict
+        The knobs used.
     """
 
     method: str

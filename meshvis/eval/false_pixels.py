@@ -44,8 +44,12 @@ class FacePixels:
 
     Attributes
     ----------
-    view : (k,) int32, face : (k,) int64, pixels : (k,) int64
+    view : (k,) int32
         Sparse table: view ``view[i]`` shows face ``face[i]`` on ``pixels[i]`` pixels.
+    face : (k,) int64
+        The face of each entry.
+    pixels : (k,) int64
+        The pixels of each entry.
     model_pixels : (VIEWS,) int64
         Pixels showing any face, per view.
     directions : (VIEWS, 3) float64

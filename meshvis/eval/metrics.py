@@ -99,9 +99,12 @@ class RemovalScores:
 
     Attributes
     ----------
-    precision : A(removed ∩ hidden) / A(removed); 1.0 when nothing was removed
-    recall : A(removed ∩ hidden) / A(hidden); 1.0 when nothing is hidden
-    error : A(removed ⊕ hidden) / A(evaluated): area decided wrongly, either way
+    precision : float
+        A(removed ∩ hidden) / A(removed); 1.0 when nothing was removed.
+    recall : float
+        A(removed ∩ hidden) / A(hidden); 1.0 when nothing is hidden.
+    error : float
+        A(removed ⊕ hidden) / A(evaluated): the area decided wrongly, either way.
     """
 
     precision: float

@@ -67,8 +67,7 @@ VERSION = 1
 CONFIRM_RAYS = 2048
 #: ... and a face whose counts leave open on which side of the :data:`DOMINANCE` line it is
 #: (:func:`meshvis.repair.evidence.near_the_line`) rounds of as many rays again, up to this
-#: many in all: on the van Gogh room two faces escaped 4.0x and 5.6x as often through one
-#: side in 2,048 rays and 2.2x and 3.2x in 32,768
+#: many in all: 2,048 rays can put a face near the line on the wrong side of it
 SETTLE_RAYS = 32768
 
 
@@ -146,6 +145,7 @@ def reference(model, *, seed: int = 0, cache: str | os.PathLike | None = None, p
     Parameters
     ----------
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model.
     seed : int
         Seed of the one random generator; same model and seed give the same reference.
     cache : path, optional

@@ -21,17 +21,15 @@ from meshvis._threads import in_threads
 SLACK = 1e-12
 #: angular slack of the wedge test at a shared corner (as in the vectorised version)
 WEDGE_SLACK = 1e-9
-#: widening of each face's projection interval on its own axes (unit-diagonal coordinates,
-#: so a projection is below 1): above the rounding of a 3-term dot product in any order or
-#: with fused multiply-adds (a few 1e-16), so that the interval contains the one of any
-#: other evaluation order and the gaps can only shrink (more reports, never fewer)
+#: widening of each face's projection interval on its own axes (unit-diagonal coordinates):
+#: above the rounding of a 3-term dot product in any order (a few 1e-16), so gaps can only
+#: shrink and an evaluation order never hides a pair (more reports, never fewer)
 PROJ_SLACK = 1e-15
 
 # The kernels are serial and release the GIL; the large ones (the narrow phase, the face
 # axes, the corner gather) run on slices in threads (meshvis._threads.in_threads), and
 # their helpers are left to LLVM's inlining: numba's parallel loops and its own inlining
-# (inline="always") cost them about 7 s of compilation on first use and no speed
-# (docs/performance.md, "First use").
+# (inline="always") cost them seconds of compilation on first use and gain no speed.
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")

@@ -35,14 +35,21 @@ class Analysis:
 
     Attributes
     ----------
-    faces_welded : (m, 3) int32 or int64, welded corner ids (:func:`adjacency.weld`)
-    table : EdgeTable of the welded faces
-    degenerate : (m,) bool, smallest altitude at most :data:`DEGENERATE_TOL` times the
+    faces_welded : (m, 3) int32 or int64
+        Welded corner ids (:func:`adjacency.weld`)
+    table : EdgeTable
+        The edges of the welded faces.
+    degenerate : (m,) bool
+        Smallest altitude at most :data:`DEGENERATE_TOL` times the
         diagonal, or zero area
-    collapsed : (m,) bool, two corners welded into one (weld tolerance)
-    duplicate_first : (m,) int64, :func:`adjacency.duplicate_faces`
-    flags : dict of :func:`intersect.intersection_flags`, or None when not run
-    seconds : dict, time of each step
+    collapsed : (m,) bool
+        Two corners welded into one (weld tolerance)
+    duplicate_first : (m,) int64
+        The first copy of every face (:func:`adjacency.duplicate_faces`).
+    flags : dict or None
+        The flags of :func:`intersect.intersection_flags`; None when not run.
+    seconds : dict
+        Time of each step
     """
 
     faces_welded: np.ndarray
@@ -82,6 +89,7 @@ def analyse(
     Parameters
     ----------
     soup : Soup
+        The model.
     eps : float, optional
         Distance tolerance of the intersection tests (fraction of the diagonal; default
         :data:`meshvis.geometry.intersect.EPS`).

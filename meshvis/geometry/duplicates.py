@@ -40,11 +40,13 @@ def opposite_copies(faces_welded: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    faces_welded : (m, 3) int64, welded faces (:func:`meshvis.geometry.adjacency.weld`)
+    faces_welded : (m, 3) int64
+        Welded faces (:func:`meshvis.geometry.adjacency.weld`)
 
     Returns
     -------
-    (k, 2) int64, face pairs ``(i, j)``, ``i < j``, sorted by ``i``
+    (k, 2) int64
+        Face pairs ``(i, j)``, ``i < j``, sorted by ``i``
 
     Examples
     --------
@@ -93,12 +95,15 @@ def hidden_copies(pairs: np.ndarray, outside: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    pairs : (k, 2) int64, from :func:`opposite_copies`
-    outside : (m, 2) float or bool, per face and side (0 front, 1 back): outside when > 0
+    pairs : (k, 2) int64
+        From :func:`opposite_copies`
+    outside : (m, 2) float or bool
+        Per face and side (0 front, 1 back): outside when > 0
 
     Returns
     -------
-    (m,) bool, the copies to drop
+    (m,) bool
+        The copies to drop
 
     Examples
     --------

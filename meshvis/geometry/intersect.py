@@ -137,13 +137,15 @@ def candidate_pairs(lower: np.ndarray, upper: np.ndarray, *, overwrite: bool = F
 
     Parameters
     ----------
-    lower, upper : (m, 3) float arrays, box corners (inflate them by the tolerance first)
+    lower, upper : (m, 3) float arrays
+        Box corners (inflate them by the tolerance first)
     overwrite : bool
         The arrays are float64 temporaries of the caller: shift them in place (less memory).
 
     Returns
     -------
-    (p, 2) int32 (int64 from 2**31 boxes), pairs ``i < j`` whose closed boxes overlap, sorted
+    (p, 2) int32 array
+        Pairs ``i < j`` whose closed boxes overlap, sorted (int64 from 2**31 boxes on).
 
     Examples
     --------
@@ -332,12 +334,18 @@ def classify_pairs(
 
     Parameters
     ----------
-    triangles : (m, 3, 3) float64 corners, normalised to unit bounding-box diagonal
-    faces_welded : (m, 3) int array, welded corner ids (adjacency)
-    pairs : (p, 2) int array, candidate pairs
-    eps : float, distance tolerance for intersection and coplanarity (absolute, unit diagonal)
-    near : float, distance below which a non-adjacent pair is "too close"
-    angle_eps : float, radians
+    triangles : (m, 3, 3) float64 corners
+        Normalised to unit bounding-box diagonal
+    faces_welded : (m, 3) int array
+        Welded corner ids (adjacency)
+    pairs : (p, 2) int array
+        Candidate pairs
+    eps : float
+        Distance tolerance for intersection and coplanarity (absolute, unit diagonal)
+    near : float
+        Distance below which a non-adjacent pair is "too close"
+    angle_eps : float
+        Radians
     fold_angle : float
         Radians: the largest angle between the half-planes of two faces on one edge that
         still counts as one face folded onto the other.
@@ -350,7 +358,12 @@ def classify_pairs(
 
     Returns
     -------
-    intersects, coplanar, too_close : (p,) bool, per pair (see the module notes)
+    intersects : (p,) bool
+        The pair's triangles cross (see the module notes).
+    coplanar : (p,) bool
+        The pair's triangles overlap in one plane.
+    too_close : (p,) bool
+        A non-adjacent pair closer than ``near``.
     """
     from meshvis.geometry._kernels import narrow_phase
 
@@ -487,7 +500,9 @@ def intersection_flags(
     Parameters
     ----------
     vertices : (n, 3) float array
+        Corner coordinates.
     faces : (m, 3) int array
+        Corner indices of every triangle.
     eps : float, optional
         Distance tolerance as a fraction of the bounding-box diagonal (default :data:`EPS`,
         1e-6).  Pairs closer than this may be flagged; pairs that intersect always are.

@@ -303,7 +303,8 @@ def ray_starts(
     Returns
     -------
     source, face : (r,) int64 arrays; side : (r,) int8 array; origins : (r, 3) float64 array;
-    cluster_rows : (c,) int64 array, the rows of cluster rays
+    cluster_rows : (c,) int64 array
+        The rows of cluster rays
     """
     total = 0
     for i in range(len(counts)):

@@ -16,7 +16,7 @@ written here as numba kernels over flat arrays:
   such a node lies on its terminal's side of every minimum cut, so it is merged into that
   terminal and its edges become terminal links of its neighbours (two passes, which may
   settle those in turn); on the monastery's last graph this leaves 66 % of the nodes and
-  41 % of the edges to the search (docs/performance.md, "Settled nodes");
+  41 % of the edges to the search (``meshvis bench classify`` prints the nodes settled);
 * the loop ends when neither tree can grow.  The source tree is then exactly the set of
   nodes reachable from the source in the residual graph: a node in it is reached along its
   tree path, and a node outside it would have been adopted by the growth stage.
@@ -24,8 +24,8 @@ written here as numba kernels over flat arrays:
 That set is the same for every maximum flow (the smallest source side among the minimum
 cuts), so the labels do not depend on which maximum flow the search happens to find: this
 kernel and PyMaxflow give the same labels (``tests/graphcut/test_boykov_kolmogorov.py``
-checks it on random graphs with ties and on the graphs of bundled models;
-``docs/bench/solver_identity.py`` on every shared model).  Where two minimum cuts have
+checks it on random graphs with ties and on the graphs of bundled models, and
+``meshvis bench stability`` on graphs whose weights span twelve orders of magnitude).  Where two minimum cuts have
 exactly the same value, float rounding of the flow decides which one either returns.  A
 node linked to
 neither terminal and reachable from neither is free and counts as INSIDE, as the
@@ -33,7 +33,8 @@ object-based definition wants (DESIGN.md §4).
 
 Why not PyMaxflow: its graph is built edge by edge through Python wrappers and kept as C++
 structures; on the monastery's 1.4 M edges building it took a third of each cut, and the
-kernel here is also faster on the search itself (docs/performance.md, "Max-flow kernel").
+kernel here is also faster on the search itself (``classify(..., solver="pymaxflow")`` gives
+the same labels, to time against the default).
 
 Arc layout: the arcs leaving node ``v`` are ``first[v] .. first[v + 1] - 1``; arc ``a``
 goes to ``head[a]`` with residual capacity ``rcap[a]``, and ``sister[a]`` is its reverse.

@@ -81,11 +81,18 @@ class Classification:
         Per input face and side (0 = front/counter-clockwise, 1 = back): 1.0 outside,
         0.0 inside; for flagged (intersecting/coplanar) faces, the outside fraction of the
         side's sample-point area.
-    degenerate : (m,) bool, zero-area faces (not classified; both sides reported inside)
-    flagged : (m,) bool, faces classified through sample points
-    cluster : (m,) int64, cluster id (-1 for flagged and degenerate faces)
-    nodes, graph, counts, cut : the internals, for inspection and layer peeling
-    stages : list of Stage; rounds : per-round statistics
+    degenerate : (m,) bool
+        Zero-area faces (not classified; both sides reported inside)
+    flagged : (m,) bool
+        Faces classified through sample points
+    cluster : (m,) int64
+        Cluster id (-1 for flagged and degenerate faces)
+    nodes, graph, counts, cut : NodeSet, VisibilityGraph, VisibilityCounts, Cut
+        The internals, for inspection and layer peeling.
+    stages : list of Stage
+        The stages run or skipped, with their times.
+    rounds : list of dict
+        Per-round statistics.
     """
 
     soup: Soup
@@ -207,6 +214,7 @@ def ray_allocation(nodes: NodeSet, rays: int, point_rays: int) -> np.ndarray:
     Parameters
     ----------
     nodes : NodeSet
+        The half-space nodes.
     rays : int
         Rays of a one-face cluster node.
     point_rays : int
@@ -282,28 +290,42 @@ def classify(
     Parameters
     ----------
     model : Soup, trimesh.Trimesh, (vertices, faces) or path
-    rays_per_node : ray budget per half-space node (before the cluster factor, see
+        The model.
+    rays_per_node : int
+        Ray budget per half-space node (before the cluster factor, see
         :func:`ray_allocation`); progressive sampling may stop earlier
-    seed : seed of the one random generator; same input and seed give identical output
-    hints : :class:`~meshvis.graphcut.hints.Hints` or dict of inside/outside points and boxes
-    samples_per_face : sample points per intersecting/coplanar face (appendix H §3.1)
-    rays_per_point : ray budget of each sample-point node (default ``rays_per_node``).
+    seed : int
+        Seed of the one random generator; same input and seed give identical output.
+    hints : Hints or dict, optional
+        Inside/outside points and boxes (:class:`~meshvis.graphcut.hints.Hints`).
+    samples_per_face : int
+        Sample points per intersecting/coplanar face (appendix H §3.1).
+    rays_per_point : int, optional
+        Ray budget of each sample-point node (default ``rays_per_node``).
         Most rays of a model with many intersecting faces come from their sample points;
         ``rays_per_node // samples_per_face`` gives a flagged face's side the budget of an
-        unflagged face's, at a measured cost in accuracy (docs/performance.md, "Rays per
-        sample point")
-    sampling_scheme : 1 (uniform) or 2 (uniform + edges, default)
-    use_filter : apply the directed cosine filter (Eq. 8–9)
-    opening : a side whose escaping ray share exceeds this is not pulled inside by the
+        unflagged face's, at a measured cost in accuracy (``meshvis bench real --rays-per-point``).
+    sampling_scheme : {1, 2}
+        1 (uniform) or 2 (uniform + edges, default).
+    use_filter : bool
+        Apply the directed cosine filter (Eq. 8–9).
+    opening : float or None
+        A side whose escaping ray share exceeds this is not pulled inside by the
         prior of its opposite side (an opening, not a crack; see
         :func:`meshvis.graphcut.weights.inside_prior`); None follows the paper exactly
-    progressive : sample in rounds and stop when labels settle (else one full round)
-    tolerance : stop when a round changes less than this fraction of the total side area
-    solver : "bk" (compiled Boykov–Kolmogorov), "pymaxflow" (the same through PyMaxflow,
+    progressive : bool
+        Sample in rounds and stop when labels settle (else one full round).
+    tolerance : float
+        Stop when a round changes less than this fraction of the total side area.
+    solver : {"bk", "pymaxflow", "scipy"}
+        "bk" (compiled Boykov–Kolmogorov), "pymaxflow" (the same through PyMaxflow,
         the same labels) or "scipy" (integer capacities)
-    offset : push of ray origins off surfaces, relative to the bounding-box diagonal
-    caster : reuse a prebuilt :class:`~meshvis.rays.caster.RayCaster` of the same model
-    progress : callback ``progress(stage, fraction)``
+    offset : float, optional
+        Push of ray origins off surfaces, relative to the bounding-box diagonal.
+    caster : RayCaster, optional
+        A prebuilt :class:`~meshvis.rays.caster.RayCaster` of the same model to reuse.
+    progress : callable, optional
+        Called as ``progress(stage, fraction)``.
 
     Returns
     -------

@@ -59,13 +59,21 @@ def min_cut(
 
     Parameters
     ----------
-    n : number of nodes; i, j : (k,) edge ends; cap_ij, cap_ji : (k,) capacities i→j and j→i
-    cap_source : (n,) capacity source→node; cap_sink : (n,) capacity node→sink
-    solver : "bk", "pymaxflow" or "scipy"
+    n : int
+        Number of nodes.
+    i, j : (k,) int
+        Edge ends.
+    cap_ij, cap_ji : (k,) float
+        Capacities i→j and j→i.
+    cap_source, cap_sink : (n,) float
+        Capacities source→node and node→sink.
+    solver : {"bk", "pymaxflow", "scipy"}
+        The max-flow solver.
 
     Returns
     -------
-    Cut, with ``outside[v]`` True where v stays connected to the source.
+    Cut
+        With ``outside[v]`` True where v stays connected to the source.
     """
     if solver == "bk":
         outside, value, settled = min_cut_bk(n, i, j, cap_ij, cap_ji, cap_source, cap_sink)
@@ -155,8 +163,10 @@ class VisibilityGraph:
 
     Parameters
     ----------
-    n : number of half-space nodes
-    weights : :class:`~meshvis.graphcut.weights.Weights`
+    n : int
+        Number of half-space nodes.
+    weights : Weights
+        The edge and terminal weights (:class:`~meshvis.graphcut.weights.Weights`).
     """
 
     def __init__(self, n: int, weights: Weights):

@@ -30,10 +30,14 @@ class Preprocessed:
         ``flagged`` = (intersects | coplanar) and not degenerate: these faces get
         sample-point nodes.  ``too_close`` faces only may not join a cluster across an
         edge (appendix H §2, edge flag rule 4): each is its own single-face cluster.
-    partner_pairs : (k, 2) int64, the face pairs behind the flags
+    partner_pairs : (k, 2) int64
+        The face pairs behind the flags
     clustering : Clustering
+        The patches of consistently oriented faces.
     faces_welded : (m, 3) int64
-    analysis : Analysis, the pass shared with ``meshvis info`` (its ``counts``)
+        The faces on welded corners.
+    analysis : Analysis
+        The pass shared with ``meshvis info`` (its ``counts``)
     """
 
     intersects: np.ndarray
@@ -59,7 +63,8 @@ def preprocess(
 
     Parameters
     ----------
-    soup : Soup, the model
+    soup : Soup
+        The model
     eps : float, optional
         Distance tolerance of the intersection/coplanarity tests (fraction of the diagonal).
     weld_tol : float

@@ -13,10 +13,9 @@ import scipy.sparse as sp
 
 from meshvis.graphcut import _kernels
 
-#: escape share above which a side counts as open to the outside (see :func:`inside_prior`).
-#: Measured: the holes in the bottom of the Stanford bunny let 2.1% of its inner side's
-#: rays escape, a box with one wall 60% open 4.4%, hairline cracks and a few missing faces
-#: well under 1%
+#: escape share above which a side counts as open to the outside (see :func:`inside_prior`):
+#: between what defects let out (hairline cracks, a few missing faces, the bunny's holes)
+#: and what real openings do (``meshvis bench stability`` sweeps crack widths)
 DEFAULT_OPENING = 0.03
 
 

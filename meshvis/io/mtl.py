@@ -155,7 +155,8 @@ def publish_new(
 
     Parameters
     ----------
-    data_or_src : bytes (the image) or str (a file to copy)
+    data_or_src : bytes or str
+        The image's bytes, or the path of a file to copy.
     folder : str
         The output's folder.
     wanted : str
@@ -249,13 +250,19 @@ class PbrDescription:
     Attributes
     ----------
     name : str
-    base_color : (4,) float in [0, 1]
+        The material's name.
+    base_color : (4,) float
+        RGBA in [0, 1].
     image : bytes or None
         PNG or JPEG bytes of the base colour texture.
     mime : str or None
+        The texture's MIME type.
     metallic, roughness : float or None
+        The PBR factors, where the MTL gives them.
     double_sided : bool
-    alpha_mode : str or None ("OPAQUE", "MASK", "BLEND")
+        Both sides are drawn.
+    alpha_mode : {"OPAQUE", "MASK", "BLEND"} or None
+        glTF's alpha mode.
     """
 
     name: str

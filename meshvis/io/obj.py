@@ -170,6 +170,7 @@ def read_obj(path: str, label: str | None = None) -> Soup:
     Parameters
     ----------
     path : str
+        The OBJ file.
     label : str, optional
         Name of the file in messages.
 

@@ -391,6 +391,7 @@ class PlySource:
     Parameters
     ----------
     layout : PlyLayout
+        The header's elements and properties.
     elements : dict
         Every element's columns as read, by element name.
     columns : dict

@@ -91,6 +91,7 @@ class TrimeshSource:
     Parameters
     ----------
     obj : trimesh.Trimesh or trimesh.Scene
+        The trimesh object the soup was made from.
     nodes, geometries : list
         Per piece (a geometry node of the scene; the mesh itself for a ``Trimesh``): the
         node and geometry names (None for a ``Trimesh``).

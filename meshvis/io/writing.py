@@ -85,7 +85,8 @@ def save(
 
     Parameters
     ----------
-    soup : Soup (or anything :func:`meshvis.soup.as_soup` accepts)
+    soup : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model to write.
     path : str or path-like
         The extension picks the format.
     face_groups : (m,) int, optional

@@ -16,9 +16,9 @@ corners builds its scene about twice as fast on its distinct vertices, and every
 keeps the float32 corners it would have on the full buffer, so the hits are the same.
 
 Threads or processes?  ``embreex`` releases the GIL while it traces, so two threads
-trace a large batch 1.5–1.8 times as fast as one on a 2-core machine (docs/performance.md);
-processes would have to rebuild the scene and copy the rays and results, and measure
-slower.  ``meshvis bench rays`` measures all three side by side.
+trace a large batch faster than one on a machine with a free core; processes would have
+to rebuild the scene and copy the rays and results, and measure slower.  ``meshvis bench
+rays`` measures all three side by side (docs/benchmarks.md, "Ray backend").
 """
 
 from __future__ import annotations
@@ -41,15 +41,12 @@ from meshvis.rays import _kernels
 DEFAULT_OFFSET = 1e-5
 #: push for rays that decide which side of a face is seen (the reference of DESIGN.md §10,
 #: from-region visibility, the per-face evidence of ``orient``), a tenth of the default: a
-#: surface nearer to a face than the push is jumped over (on the pandora level faces with
-#: surfaces within about 1e-5 diagonals of their fronts escaped 6 % of their front rays
-#: pushed by 1e-5, 0.5 % pushed by 1e-6 and 0.02 % by 1e-7)
+#: surface nearer to a face than the push is jumped over, and real scenes have surfaces
+#: within 1e-5 diagonals of each other
 VISIBILITY_OFFSET = 1e-6
-#: rays per chunk handed to one thread; a batch of two chunks or more is split over the
-#: threads of the kept pool (:func:`meshvis._threads.pool`).  Handing a chunk to the pool
-#: costs tens of microseconds, Embree traces 2 k rays in 0.3-1 ms: from 4 k rays two
-#: threads pay (the monastery's from-region search traces 114 batches of 4-32 k rays;
-#: docs/performance.md, "Ray backend")
+#: rays per chunk handed to one thread of the kept pool (:func:`meshvis._threads.pool`):
+#: handing over a chunk costs tens of microseconds, Embree traces 2 k rays in about a
+#: millisecond, so from two chunks on threads pay (``meshvis bench rays``)
 CHUNK = 1 << 11
 #: rays traced by every caster of this process and the seconds Embree took (read by the
 #: benchmarks: ``meshvis bench scale --real`` reports them per command)

@@ -200,7 +200,8 @@ def escape_queries(
     Returns
     -------
     o32, d32, dist, ok : as :func:`meshvis.rays._kernels.segment_queries`
-    back : (k * rays,) bool, the ray leaves through the back
+    back : (k * rays,) bool
+        The ray leaves through the back
     """
     k = len(face)
     out = (*query_buffers(k * rays), np.empty(k * rays, np.bool_))

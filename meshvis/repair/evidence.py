@@ -64,27 +64,22 @@ LAST_RAYS = 2048
 #: its faces undecided, and 2048 rays for each would cost 30x the rest of ``orient``
 LAST_SHARE = 1.0
 #: :func:`until_decisive` gives its faces this many more rays in its first round, twice
-#: as many in each round after it, up to this many: a face seen through 4.6 % of its back
-#: directions escaped none of 64 back rays in 5 % of the cases (0.954^64), and on the
-#: pandora level 210 lone faces of 0.15 % of the decisive area had kept their side that
-#: way, after fewer than 8 escapes
+#: as many in each round after it, up to this many: a side seen through a few percent of
+#: its directions escapes none of 64 rays in one case of twenty (0.954^64 at 4.6 %)
 RARE_FIRST_RAYS = 192
 RARE_MOST_RAYS = 4096
-#: ... and casts at most this many times the rays of the first round, largest faces first
-#: (on the pandora level its rounds cast 1.1-1.2 times them), or at least
-#: :data:`RARE_MIN_BUDGET` rays: a model with a few faces tested would otherwise give a
-#: lone face no round at all
+#: ... and casts at most this many times the rays of the first round, largest faces first,
+#: or at least :data:`RARE_MIN_BUDGET` rays: a model with a few faces tested would
+#: otherwise give a lone face no round at all
 RARE_SHARE = 2.0
 RARE_MIN_BUDGET = 1 << 16
 #: :func:`until_settled` starts with this many more rays per face
 SETTLE_FIRST_RAYS = 1024
 #: ... and goes on while a true ratio of :data:`DOMINANCE` has at least this chance
 SETTLE_LEVEL = 0.05
-#: ... or this chance, for a face whose counts already pass the line: a face about to
-#: leave the side it shows.  The teapot's face 1601, seen 1.8x as often through its back,
-#: escaped 0 : 14 of 2,560 rays with seed 4 (a chance of 0.044 at 4x) and left its
-#: consistently wound patch; 1 % for every face near the line spent the budget on faces
-#: below it (the van Gogh room as it is, seeds 0-3: 0.0069 -> 0.0326 % confirmed error)
+#: ... or this chance, for a face whose counts already pass the line (about to leave the
+#: side it shows): leaving needs stronger evidence than staying, and the stricter level for
+#: every face near the line would spend the budget on faces below it
 LEAVING_LEVEL = 0.01
 #: evidence is decisive from this many escaping rays ...
 MIN_ESCAPES = 8
@@ -158,17 +153,22 @@ def escapes(
 
     Parameters
     ----------
-    soup : Soup, the model ``caster`` was built on
+    soup : Soup
+        The model ``caster`` was built on
     caster : RayCaster of ``soup``
-    faces : (k,) int64, faces to cast from, each at most once
-    rays : int, rays per face
-    stream : RayStream of ``soup``, the rays' random numbers
+    faces : (k,) int64
+        Faces to cast from, each at most once
+    rays : int
+        Rays per face
+    stream : RayStream
+        The rays' random numbers (a stream of ``soup``)
     through : (k,) int, optional: cast through this side of each face only (0 front,
         1 back), uniformly on its hemisphere; default both, uniformly on the sphere
 
     Returns
     -------
-    (k, 2) int64, escaping rays that left through the front (column 0) and the back
+    (k, 2) int64
+        Escaping rays that left through the front (column 0) and the back
     """
     faces = np.asarray(faces, np.int64)
     out = np.zeros((len(faces), 2), np.int64)
@@ -335,15 +335,25 @@ def more_rays(
     Parameters
     ----------
     soup, caster : the model and its RayCaster
-    faces : (k,) int64, the faces tested
-    escaped : (k, 2) int64, escaping rays per face and side so far (updated)
-    cast : (k,) int64, rays cast per face so far (updated)
-    which : (j,) int, positions in ``faces`` that get more rays
-    rays : int, rays per face; share : float, the cap; stream : RayStream of ``soup``
+    faces : (k,) int64
+        The faces tested
+    escaped : (k, 2) int64
+        Escaping rays per face and side so far (updated)
+    cast : (k,) int64
+        Rays cast per face so far (updated)
+    which : (j,) int
+        Positions in ``faces`` that get more rays
+    rays : int
+        Rays per face.
+    share : float
+        The cap.
+    stream : RayStream
+        The rays' random numbers (a stream of ``soup``).
 
     Returns
     -------
-    (i,) int64, the positions of ``which`` that were cast from (all, or the largest under
+    (i,) int64
+        The positions of ``which`` that were cast from (all, or the largest under
     the cap), sorted
     """
     cap = int(share * 2 * FIRST_RAYS * len(faces)) // rays
@@ -380,8 +390,10 @@ def until_decisive(
     ----------
     soup, caster, faces, escaped, cast, which, stream : as :func:`more_rays` (``which``: the
         positions in ``faces`` that get the rounds)
-    shown : (k,) int, the side (0 front, 1 back) each face shows
-    share : float, the cap in place of :data:`RARE_SHARE` (the floor stays)
+    shown : (k,) int
+        The side (0 front, 1 back) each face shows
+    share : float
+        The cap in place of :data:`RARE_SHARE` (the floor stays)
 
     Examples
     --------
@@ -542,17 +554,23 @@ def seen_side(
     Parameters
     ----------
     soup, caster : the model and its RayCaster
-    faces : (k,) int64, faces to test
-    shown : (k,) int, the side (0 front, 1 back) each face would show without this test
-    stream : RayStream of ``soup``
+    faces : (k,) int64
+        Faces to test
+    shown : (k,) int
+        The side (0 front, 1 back) each face would show without this test
+    stream : RayStream
+        The rays' random numbers (a stream of ``soup``)
     dominance : float or (k,) float, the dominance that makes a face's evidence decisive
         (:func:`decisive`)
 
     Returns
     -------
-    side : (k,) int8, the side that escapes more often (``shown`` on a tie)
-    sure : (k,) bool, the evidence is decisive (:func:`decisive`)
-    rays : int, rays cast
+    side : (k,) int8
+        The side that escapes more often (``shown`` on a tie)
+    sure : (k,) bool
+        The evidence is decisive (:func:`decisive`)
+    rays : int
+        Rays cast
     """
     shown = np.asarray(shown, np.int64)
     escaped, cast = seen_counts(soup, caster, faces, shown, stream)
@@ -564,13 +582,16 @@ def more_seen(escaped: np.ndarray, shown: np.ndarray) -> np.ndarray:
 
     Parameters
     ----------
-    escaped : (k, 2) int, escapes per face from its front and its back
-    shown : (k,) int, the side (0 front, 1 back) each face shows without the evidence, or
-        -1 for a face that shows neither yet (a tie gives it -1)
+    escaped : (k, 2) int
+        Escapes per face from its front and its back
+    shown : (k,) int
+        The side (0 front, 1 back) each face shows without the evidence, or -1 for a face
+        that shows neither yet (a tie gives it -1)
 
     Returns
     -------
-    (k,) int8, the side seen more often
+    (k,) int8
+        The side seen more often
 
     Examples
     --------

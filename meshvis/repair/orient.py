@@ -78,36 +78,20 @@ from meshvis.soup import Soup
 ONE_SIDED, TWO_SIDED, HIDDEN, CONFLICT, DEGENERATE = 0, 1, 2, 3, 4
 STATUS_NAMES = ("one-sided", "two-sided", "hidden", "conflict", "degenerate")
 #: a flagged face (it crosses another surface) is not spoken for by its patch's winding
-#: across that surface either, even in a patch the input winds consistently: its own rays
-#: turn it where the side they see more often wins a sign test at this level
-#: (:func:`meshvis.repair.evidence.significant`), not only at 4x.  On the monastery as it
-#: is the faces this turns (seen 1.4-3x as often from one side) were 0.448 % of 0.45 %
-#: error; the unflagged faces of a consistently wound scan keep the 4x rule, because
-#: their sides genuinely differ a little (the test on every face of pymeshlab_face000
-#: turns 2,355 of them)
+#: across that surface: its own rays turn it where the side they see more often wins a
+#: sign test at this level (:func:`meshvis.repair.evidence.significant`), not only at 4x.
+#: Unflagged faces keep the 4x rule: the two sides of a scan differ a little everywhere
 CROSSING_LEVEL = 1e-3
-#: a flagged face whose own rays barely escaped (fewer than
-#: :data:`meshvis.repair.evidence.MIN_ESCAPES`) is left to the cut's sample points, which
-#: disagree between seeds there, and a face seen from both sides that its patch does not
-#: speak for keeps its winding; the largest such faces get the last round's rays
-#: (:data:`meshvis.repair.evidence.LAST_RAYS`), at most this many times the rays of the
-#: first round (on the monastery the largest 476 of 42,000 such faces; with seed 2 three
-#: of them, 0.097 % of the decisive area, had taken the wrong side); the faces that round
-#: does not reach get the doubling rounds of
-#: :func:`meshvis.repair.evidence.until_decisive` under the same cap (on the van Gogh
-#: room as a soup, with seed 1, two flagged faces of 0.084 % together, seen only through
-#: their fronts, had escaped none of 128 rays and kept their patches' sides).  Every lone face (a
-#: patch of one face) whose rays barely escaped gets the doubling rounds of
-#: :func:`meshvis.repair.evidence.until_decisive` instead, whatever the cut said of its
-#: sides: nothing but its own rays speaks for it (on the pandora level, whose lone faces
-#: are seen through a few percent of their directions, the error fell from 0.250 % to
-#: 0.071 % of the decisive area as it is and from 0.274 % to 0.089 % as a soup, seed 0;
-#: docs/benchmarks.md)
+#: flagged faces whose own rays barely escaped (fewer than
+#: :data:`meshvis.repair.evidence.MIN_ESCAPES`) would be left to the cut's sample points,
+#: which disagree between seeds there: the largest get the last round's rays, at most this
+#: many times the rays of the first round, the rest the doubling rounds of
+#: :func:`meshvis.repair.evidence.until_decisive` under the same cap.  A lone face (a patch
+#: of one face) gets those rounds whatever the cut said: only its own rays speak for it
 UNSEEN_SHARE = 0.25
 #: a flagged face whose sign test leans to the side it does not show (below this level, but
 #: not below :data:`CROSSING_LEVEL`) gets :data:`LEANING_RAYS` more rays before the test
-#: decides: on the monastery one large face (0.105 % of the decisive area) passed the test
-#: or not by the seed (p = 4e-4 on 168 escapes, 7e-3 on 171)
+#: decides, so that a large face near the level does not take its side by the seed
 LEANING_LEVEL = 0.05
 #: rays per leaning face: about 2.5x the escapes it had, so that a face seen 1.5x as often
 #: from one side ends far from the test's edge
@@ -115,20 +99,13 @@ LEANING_RAYS = 4096
 #: ... for at most this many times the rays of the first round, largest faces first
 LEANING_SHARE = 0.5
 #: a cluster whose hidden side escapes at least this share of the opening threshold does
-#: not speak for its faces: the cut labels it differently from seed to seed (on the pandora level, with seeds 1 and 3, a 486-face
-#: cluster whose front escapes 2 % of its rays, threshold 3 %, was cut as inside, and its
-#: faces seen only from the front were not tested: 0.40 % of the decisive area the recount
-#: confirms, against 0.15 % with seeds 0 and 2)
+#: not speak for its faces: near the threshold the cut labels it differently from seed to
+#: seed, so its faces are tested with rays of their own
 OPENING_NEAR = 0.5
 #: an open patch of several faces whose faces' own rays, pooled (area times escape
 #: share), see one side this many times as much as the other shows that side as a whole
-#: (the per-face dominance of :mod:`meshvis.repair.evidence`).  The patch vote counts
-#: only the faces the cut settled on one side: on cycloidal.ply 142 such faces turned a
-#: 1,118-face patch whose faces' rays escape through its front only; on the van Gogh room
-#: a patch of 248 faces whose rays escape 17 times as often through the front showed
-#: its back; and on the van Gogh room as a soup, with seed 0, a patch of 24 faces that the
-#: cut called hidden, not consistently wound, gave no vote, and its largest face (0.033 %
-#: of the decisive area), which escaped none of its 128 rays, kept its layer's side
+#: (the per-face dominance of :mod:`meshvis.repair.evidence`): the patch vote counts only
+#: the faces the cut settled on one side, which can be a few faces against the rest
 POOLED_DOMINANCE = 4.0
 
 
@@ -138,24 +115,35 @@ class OrientResult:
 
     Attributes
     ----------
-    soup : the oriented output soup (input faces, some flipped, plus any duplicates)
-    source : (k,) int64, input face of every output face
-    flipped : (m,) bool, input faces written turned over
-    duplicated : (m,) bool, input faces written in both orientations
-    status : (m,) int8, one of ``STATUS_NAMES`` per input face
-    parity_faces : int, hidden faces whose side came from ray parity (:func:`parity_side`)
-    patch_faces : int, faces turned to agree with the vote of their patch
-    visibility : dict, the per-face visibility test: faces ``tested``, faces ``turned``
+    soup : Soup
+        The oriented output (input faces, some flipped, plus any duplicates).
+    source : (k,) int64
+        Input face of every output face
+    flipped : (m,) bool
+        Input faces written turned over
+    duplicated : (m,) bool
+        Input faces written in both orientations
+    status : (m,) int8
+        One of ``STATUS_NAMES`` per input face
+    parity_faces : int
+        Hidden faces whose side came from ray parity (:func:`parity_side`)
+    patch_faces : int
+        Faces turned to agree with the vote of their patch
+    visibility : dict
+        The per-face visibility test: faces ``tested``, faces ``turned``
         to show the side a viewer sees, ``rays`` cast, ``pooled_patches`` (patches
         given the side their faces' rays see, pooled)
-    double_sided : int, faces kept as they are because they are one copy of a sheet stored
+    double_sided : int
+        Faces kept as they are because they are one copy of a sheet stored
         twice with opposite winding (:mod:`meshvis.geometry.duplicates`)
-    view : Visibility or None, the from-region visibility of :func:`orient_from` (then
+    view : Visibility or None
+        The from-region visibility of :func:`orient_from` (then
         ``classification`` is None)
-    input_side : (m,) int8 or None, the side of each face of ``classification.soup`` that
-        is the input's front: :func:`orient` classifies the faces in their canonical
-        winding (:func:`classify_for_orient`), so a face listed the other way round there
-        has its input front on side 1
+    input_side : (m,) int8 or None
+        The side of each face of ``classification.soup`` that is the input's front:
+        :func:`orient` classifies the faces in their canonical winding
+        (:func:`classify_for_orient`), so a face listed the other way round there has its
+        input front on side 1.
     """
 
     soup: Soup
@@ -246,8 +234,10 @@ def surface_vote(
 
     Returns
     -------
-    side : (m,) int8, the side of each face in the winning set (0 where there is no vote)
-    decisive : (m,) bool, the face's patch has votes and they are not tied
+    side : (m,) int8
+        The side of each face in the winning set (0 where there is no vote)
+    decisive : (m,) bool
+        The face's patch has votes and they are not tied
     """
     node = clustering.side_node
     votes = np.zeros(clustering.n_nodes)
@@ -280,15 +270,22 @@ def parity_side(
 
     Parameters
     ----------
-    c : Classification of the model
-    faces : (k,) int, faces to decide
-    seed : seed of the ray directions; rays : rays per face and side
-    max_crossings : crossings followed per ray at most
+    c : Classification
+        The classification of the model.
+    faces : (k,) int
+        Faces to decide
+    seed : int
+        Seed of the ray directions.
+    rays : int
+        Rays per face and side.
+    max_crossings : int
+        Crossings followed per ray at most.
 
     Returns
     -------
-    (k,) int8, 0 when the front should face out, 1 when the back should, -1 when parity
-    does not tell
+    (k,) int8
+        0 when the front should face out, 1 when the back should, -1 when parity does not
+        tell.
     """
     from meshvis.geometry.adjacency import components, duplicate_faces, edges, face_adjacency
     from meshvis.rays.samples import cosine_hemisphere
@@ -337,11 +334,14 @@ class Patches:
 
     Attributes
     ----------
-    clustering : the orientation double cover (:func:`meshvis.graphcut.clusters.cluster_sides`)
+    clustering : Clustering
+        The orientation double cover (:func:`meshvis.graphcut.clusters.cluster_sides`)
         over every face with three distinct welded corners (:func:`_joining`)
-    closed : (m,) bool, the face's patch is closed: every edge of every face of it is a
+    closed : (m,) bool
+        The face's patch is closed: every edge of every face of it is a
         manifold edge between two faces of the patch
-    size : (m,) int64, faces in the face's patch (0 for a face in none)
+    size : (m,) int64
+        Faces in the face's patch (0 for a face in none)
     """
 
     clustering: Clustering
@@ -765,8 +765,10 @@ def classify_for_orient(model: Any, **classify_kw: Any) -> Classification:
 
     Parameters
     ----------
-    model : anything :func:`meshvis.classify` accepts
-    **classify_kw : passed to :func:`meshvis.classify`
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.classify` accepts.
+    **classify_kw
+        Passed to :func:`meshvis.classify`.
 
     Returns
     -------
@@ -820,15 +822,21 @@ def orient(
 
     Parameters
     ----------
-    model : anything :func:`meshvis.classify` accepts
-    front : "ccw" (counter-clockwise front, the usual convention) or "cw"
-    two_sided : "keep", "duplicate" or "strongest" (see module docstring)
-    semantics : "layer" (default) or "cavity" for hidden shells
-    conflicts : "majority" or "duplicate" for flagged faces whose sample points disagree
-    classification : reuse a classification of the same model, from
-        :func:`classify_for_orient` (or :func:`meshvis.classify`: then its random rays
-        depend on the input's winding)
-    **classify_kw : passed to :func:`meshvis.classify`
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.classify` accepts.
+    front : {"ccw", "cw"}
+        Winding of the front side: counter-clockwise (the usual convention) or clockwise.
+    two_sided : {"keep", "duplicate", "strongest"}
+        Faces with both sides outside (see the module docstring).
+    semantics : {"layer", "cavity"}
+        Hidden shells face outward at their layer, or every second layer inward.
+    conflicts : {"majority", "duplicate"}
+        Flagged faces whose sample points disagree: the area majority, or both orientations.
+    classification : Classification, optional
+        A classification of the same model to reuse, from :func:`classify_for_orient` (or
+        :func:`meshvis.classify`: then its random rays depend on the input's winding).
+    **classify_kw
+        Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...).
 
     Returns
     -------

@@ -15,7 +15,7 @@ sample points get less: unless ``rays_per_point`` is given, each sample point of
 intersecting face gets ``rays_per_node // samples_per_face`` rays, which gives a flagged
 face's side the budget of an unflagged face's
 (:func:`~meshvis.repair.remove_modes.cut_rays_per_point`).  Measured on
-the real scenes (docs/performance.md, "Rays per sample point"): ``both`` keeps its false
+the real scenes (``meshvis bench real`` with and without ``--rays-per-point``): ``both`` keeps its false
 pixels at 0-3 per million and removes as much of the hidden area or more, in about two
 thirds of the time.
 
@@ -73,13 +73,20 @@ class RemovalResult:
 
     Attributes
     ----------
-    kept, removed : Soup, the faces kept and removed (attributes preserved)
-    keep : (m,) bool per input face
-    classification : Classification or None (``visibility="view"`` needs none)
-    visibility : Visibility or None, the from-region search (``"view"`` and ``"both"``)
-    reason_code : (m,) int8, index into :data:`REASONS` per input face
-    mode : str, the ``visibility`` used
-    soup : Soup, the input model
+    kept, removed : Soup
+        The faces kept and removed (attributes preserved)
+    keep : (m,) bool
+        Kept, per input face.
+    classification : Classification or None
+        The cut (``visibility="view"`` needs none).
+    visibility : Visibility or None
+        The from-region search (``"view"`` and ``"both"``)
+    reason_code : (m,) int8
+        Index into :data:`REASONS` per input face
+    mode : str
+        The ``visibility`` used
+    soup : Soup
+        The input model
     """
 
     kept: Soup
@@ -139,10 +146,12 @@ def remove_interior(
 
     Parameters
     ----------
-    model : anything :func:`meshvis.classify` accepts
-    classification : reuse an existing classification of the same model (in ``"both"``, one
-        whose sample points got another ray budget than this function's own cut gives them
-        is used as it is, with a warning: the faces kept can differ)
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.classify` accepts.
+    classification : Classification, optional
+        An existing classification of the same model to reuse (in ``"both"``, one whose
+        sample points got another ray budget than this function's own cut gives them is
+        used as it is, with a warning: the faces kept can differ).
     visibility : {"object", "view", "both"}
         The graph cut alone, sight from ``region`` alone, or both must call a face hidden
         (default :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`, ``"both"``; pass
@@ -166,7 +175,8 @@ def remove_interior(
         ``region`` (``points:...`` or ``path:CAMERAS.json``;
         :func:`meshvis.visible_from` with ``conservative=True``): nothing visible from them
         is removed.  No cut; ``visibility`` is not used.
-    **classify_kw : passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
+    **classify_kw
+        Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
         in ``"both"`` an unset ``rays_per_point`` is ``rays_per_node // samples_per_face``
         (module notes)
 

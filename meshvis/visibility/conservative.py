@@ -96,6 +96,7 @@ class ConservativeSet:
     parameters : dict
         ``base_level``, ``max_level``, ``tolerance``.
     seconds : float
+        Time taken.
     """
 
     visible_side: np.ndarray
@@ -189,15 +190,18 @@ class FrustumScene:
     Attributes
     ----------
     soup : Soup
+        The model.
     triangles : (m, 3, 3) float64
+        Its triangles' corners.
     welded : (m, 3) int64
         Corners welded where their coordinates are equal (no tolerance: a blocker's
         triangles must share their edges exactly).
-    face_edge, edge_start, edge_face : int64 arrays
+    face_edge, edge_start, edge_face : ndarray of int64
         The edge of each face side and the faces of each edge.
     filler : (m,) int8
         :func:`fillers`.
     bvh : Bvh
+        The float64 bounding volume hierarchy of the triangles.
     caster : RayCaster
         Traces the seed rays.
     """
@@ -298,7 +302,8 @@ def conservative_from(
 
     Parameters
     ----------
-    model : Soup or anything :func:`meshvis.io.as_soup` accepts
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.io.as_soup` accepts.
     region : str, Region or list of Viewpoint
         ``"points:x,y,z;..."`` (each point looks everywhere) or ``"path:CAMERAS.json"``
         (each camera looks into its view, or everywhere without a target; see
@@ -492,10 +497,13 @@ def sample_views(
     Parameters
     ----------
     scene : FrustumScene
+        The prepared model.
     views : list of Viewpoint
+        Where the rays start, and the directions they take.
     rays : int
         Rays per viewpoint (cast in batches of :data:`SAMPLE_BATCH`).
     rng : numpy.random.Generator
+        The random generator of the directions.
 
     Returns
     -------
@@ -532,7 +540,8 @@ def bracket(model, region, *, search, max_level: int = DEFAULT_MAX_LEVEL, **sear
 
     Parameters
     ----------
-    model : Soup or anything :func:`meshvis.io.as_soup` accepts
+    model : Soup, trimesh object, (vertices, faces) or path
+        Anything :func:`meshvis.io.as_soup` accepts.
     region : str or Region
         ``points:...`` or ``path:CAMERAS.json`` (:func:`conservative_from`).
     search : callable

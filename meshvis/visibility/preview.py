@@ -22,6 +22,7 @@ def preview(soup: Soup, vis: Visibility, *, size: int = 512, azimuth: float = 30
     soup : Soup
         The model ``vis`` was computed on.
     vis : Visibility
+        The result of :func:`meshvis.visible_from` on ``soup``.
     size : int
         Height of the picture (each panel is square).
     azimuth, elevation : float
@@ -29,7 +30,8 @@ def preview(soup: Soup, vis: Visibility, *, size: int = 512, azimuth: float = 30
 
     Returns
     -------
-    (size, 2 * size, 3) uint8
+    (size, 2 * size, 3) uint8 array
+        The two panels.
 
     Examples
     --------

@@ -222,6 +222,7 @@ class Points(Region):
     Parameters
     ----------
     points : (k, 3) float
+        The viewers.
     """
 
     kind: str = "points"

@@ -49,9 +49,13 @@ class Sightings:
     Attributes
     ----------
     face : (n,) int64
+        The face seen.
     side : (n,) int8
-    origin, direction : (n, 3) float64, the ray from the viewer
-    point : (n, 3) float64, where the ray hit
+        The side seen (0 front, 1 back).
+    origin, direction : (n, 3) float64
+        The ray from the viewer
+    point : (n, 3) float64
+        Where the ray hit
     """
 
     face: np.ndarray

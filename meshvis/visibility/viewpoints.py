@@ -43,6 +43,7 @@ class Viewpoint:
     Attributes
     ----------
     position : (3,) float64
+        Where the viewer stands.
     roots : (r, 3, 3) float64
         ``axis``, ``right``, ``up`` of each root (see the module notes); ``axis`` is a unit
         vector orthogonal to ``right`` and ``up``.

@@ -43,21 +43,15 @@ SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
 FIRST_ROUND_CHUNKS = 16
 #: default stop rule: fewer new faces than this per million rays (GVS §3.5 uses 50) ...
 MIN_NEW_PER_MILLION = 50.0
-#: ... or less new visible area than this fraction of the model's area per million rays.  What
-#: a viewer misses is area, not a face count: on finely tessellated models the faces found
-#: late are small and keep the count up after the area found has dried up, while faces seen
-#: through a rare gap are mostly large ones (zdm2_level), which the later rounds reach first
-#: (:func:`_round_order`).  At 1e-4 the search on the so101 assembly stopped with 77 false
-#: pixels per million (worst view 1,546); at 1e-5 it meets 30 / 300 (docs/benchmarks.md)
+#: ... or less new visible area than this fraction of the model's area per million rays:
+#: what a viewer misses is area, not a face count (on a finely tessellated model the small
+#: faces found late keep the count up after the area has dried up; ``meshvis bench real``
+#: measures the false pixels this leaves)
 MIN_NEW_AREA_PER_MILLION = 1e-5
-#: the stop rule must hold twice: at the end of a window, and again on the first window of the
-#: next round, which gives the largest unseen faces 4 x the seed rays (the rest of the round,
-#: its smallest faces, is left out).  A round goes from large faces to small ones, so the rule
-#: first holds part-way through a round, among its smaller faces, while large faces seen
-#: through rare gaps have had only that round's seeds: on the so101 assembly, the rule holding once, seed 0 stopped at 9.1 false
-#: pixels per million (16 of its 21 missed visible faces 165 to 1,504 x the median face area,
-#: after 256 seeds each) and seed 3 at 43.3; holding twice, seeds 0 to 3 end at 2.0 to 2.5
-#: with 1.03 to 1.41 x the rays (docs/benchmarks.md, "Seed spread of the default search")
+#: the stop rule must hold twice: at the end of a window, and again on the first window of
+#: the next round, which gives the largest unseen faces 4 x the seed rays.  A round goes from
+#: large faces to small ones, so the rule first holds among a round's smaller faces, while
+#: large faces seen through rare gaps have had only that round's seeds
 CONFIRM_NEXT_ROUND = True
 #: the stop rule is judged over at least this many rays (GVS counts new faces per million
 #: rays) or, on small models, this many rays per face, whichever is fewer
@@ -77,9 +71,7 @@ DEFAULT_MIN_BUDGET = 1 << 22
 #: with ``faces=``, sightings are propagated only on the faces asked about and on this many
 #: rings of faces around them (faces sharing a vertex): spreading from every sighting would
 #: search the whole visible model, and without the rings the faces seen only from a viewer
-#: of their visible neighbours are lost (the monastery's faces the cut calls hidden: worst
-#: view 329 false pixels per million with no ring, 47 with 3, 79 spreading everywhere at
-#: 1.6 x the rays; docs/benchmarks.md)
+#: of their visible neighbours are lost
 PROPAGATE_RINGS = 3
 #: sightings propagated in one batch (bounded memory: ~100 rays each)
 PROPAGATE_BATCH = 1 << 15
@@ -111,9 +103,13 @@ class Visibility:
     skipped : dict
         Faces that got no rays, by reason, and mutated rays refused by the region.
     region : Region
+        Where the viewers are.
     method : str
+        ``guided`` or ``random``.
     seed : int
+        Seed of the random rays.
     seconds : float
+        Wall time of the search.
     stopped : str
         Why sampling stopped: ``"all seen"``, ``"few new faces"``, ``"budget"``, ``"rounds done"``.
     conservative : ConservativeSet or None
@@ -258,6 +254,7 @@ def visible_from(
     Parameters
     ----------
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model.
     region : str or Region
         Where viewers may be (see :func:`meshvis.visibility.regions.parse_region`):
         ``"outside"``, ``"upper-hemisphere"``, ``"box:x0,y0,z0,x1,y1,z1"``,

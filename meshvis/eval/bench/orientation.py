@@ -114,7 +114,8 @@ def soup_of(soup, seed: int = 0):
     Returns
     -------
     soup : Soup
-    turned : (m,) bool, the faces turned over
+    turned : (m,) bool
+        The faces turned over
     """
     from meshvis.soup import Soup
 

@@ -58,17 +58,14 @@ QUICK = (
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
 #: random sampling for the curve gets this many times the rays of guided sampling
 CURVE_RANDOM_FACTOR = 4
-#: the converged search that ``view`` is judged against: the stop rule at a tenth of GVS's
-#: face count (5 new faces per million rays) and at the default area threshold (1e-5 of the
-#: model's area per million rays), capped only by :data:`meshvis.limits.MAX_RAYS`, with the
-#: next seed (with the same seed the default search is the start of the converged one, and
-#: removes all it removes by construction)
+#: the converged search that ``view`` is judged against: a tenth of GVS's face count and
+#: the default area threshold per million rays, with the next seed (with the same seed the
+#: default search would be the start of it and agree by construction)
 CONVERGED_MIN_NEW = 5.0
 CONVERGED_MIN_NEW_AREA = 1e-5
 #: converged searches (seeds seed+1 .. seed+K) whose sightings, with the reference's, make
-#: the estimate of the truly hidden area (:func:`unseen_by_all`): the three take 7 minutes on
-#: the largest scene (so101) and about 1.5 on the monastery, and from K = 2 to 3 the share
-#: ``view`` removes rises by 0.02 to 2 points (docs/benchmarks.md)
+#: the estimate of the truly hidden area (:func:`unseen_by_all`); more searches cost
+#: minutes per scene and move the estimate little (the run reports every K)
 SEARCHES = 3
 #: the methods whose share of the area no search saw is reported for every K = 1 .. SEARCHES
 BY_K_METHODS = ("object (graph cut)", "view (guided, outside)", "both")

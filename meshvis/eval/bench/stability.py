@@ -30,7 +30,8 @@ Every case also checks that no float in the classification report, the node area
 graph weights (before and after the cosine filter) is NaN or infinite.
 
 ``--quick`` runs fewer scales and widths on smaller models (well under a minute).  The
-explanation of the crack threshold is in ``docs/stability.md``.
+crack threshold is explained in ``docs/limitations.md`` ("Cracks near the opening
+threshold") and the results are in ``docs/benchmarks.md`` ("Stability").
 """
 
 from __future__ import annotations
