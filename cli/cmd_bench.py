@@ -1,4 +1,4 @@
-"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|orient-twice|real|scale|labeling|labeling-sweep|startup|conservative``: reproducible measurements."""
+"""``meshvis bench rays|classify|accuracy|stability|compare|orientation|orient-twice|real|scale|labeling|labeling-sweep|startup|conservative|pvs``: reproducible measurements."""
 
 from __future__ import annotations
 
@@ -55,6 +55,7 @@ def add_parser(sub) -> None:
         "real",
         "startup",
         "conservative",
+        "pvs",
     ):
         try:
             mod = __import__(f"meshvis.eval.bench.{name.replace('-', '_')}", fromlist=["add_arguments"])

@@ -183,7 +183,7 @@ def region_option(p: argparse.ArgumentParser, default: str | None, what: str) ->
         default=default,
         metavar="REGION",
         help=f"{what}; regions: outside, upper-hemisphere[:ux,uy,uz], box:x0,y0,z0,x1,y1,z1, "
-        "points:x,y,z;..., path:CAMERAS.json",
+        "points:x,y,z;..., path:CAMERAS.json, cells:PVS.npz (remove-interior: the view cells of meshvis pvs)",
     )
 
 

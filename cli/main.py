@@ -26,6 +26,7 @@ COMMANDS = {
     "remove-interior": "meshvis.cli.cmd_repair",
     "layers": "meshvis.cli.cmd_repair",
     "visible": "meshvis.cli.cmd_visible",
+    "pvs": "meshvis.cli.cmd_pvs",
     "label": "meshvis.cli.cmd_label",
     "view": "meshvis.cli.cmd_view",
     "batch": "meshvis.cli.cmd_batch",

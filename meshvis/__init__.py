@@ -8,6 +8,7 @@ The package is layered; each subpackage uses only the ones above it in this list
 * :mod:`meshvis.geometry` -- connectivity, welding, intersection tests, diagnostics;
 * :mod:`meshvis.graphcut` -- inside/outside by visibility graph cut (appendix H);
 * :mod:`meshvis.visibility` -- from-region visibility by guided sampling (GVS);
+* :mod:`meshvis.viewcells` -- the PVS of every view cell (AGVS on a view-cell hierarchy);
 * :mod:`meshvis.repair` -- orientation, inside removal and layers built on the cut;
 * :mod:`meshvis.batch` -- one repair over many files;
 * :mod:`meshvis.labeling` -- external labels (appendix I), on :mod:`meshvis.rays`;
@@ -111,6 +112,8 @@ _LAZY = {
     "remove_hidden": "meshvis.repair.trimesh_style",
     "visible_from": "meshvis.visibility.visible",
     "parse_region": "meshvis.visibility.regions",
+    "pvs": "meshvis.viewcells.agvs",
+    "PVS": "meshvis.viewcells.result",
 }
 
 __all__ = [

@@ -69,3 +69,5 @@ MAX_FRAMES = 1_000
 #: and ID buffer (11 bytes a pixel) until the sequence is written, so 2**27 pixels (512
 #: frames of 512 x 512) hold about 1.5 GB
 MAX_SEQUENCE_PIXELS = 1 << 27
+#: bits of the PVS of all view cells together (cells x faces, a bit each): 2**34 bits are 2 GiB
+MAX_PVS_BITS = 1 << 34

@@ -26,6 +26,7 @@ LAYERS = {
     "meshvis.geometry": 2,
     "meshvis.graphcut": 3,
     "meshvis.visibility": 3,
+    "meshvis.viewcells": 4,
     "meshvis.repair": 4,
     "meshvis.batch": 5,
     "meshvis.labeling": 5,

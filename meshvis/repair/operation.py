@@ -218,7 +218,11 @@ def check_options(op: str, options: Mapping[str, Any] | Any) -> None:
     by_region = (op == "orient" and o["from_region"]) or (
         op in ("remove-interior", "layers") and o["visibility"] != "object"
     )
-    if by_region:
+    if by_region and op == "remove-interior" and str(o["from_region"]).strip().lower().startswith("cells:"):
+        from meshvis.viewcells.removal import cells_path
+
+        cells_path(o["from_region"])  # a PVS file of meshvis pvs
+    elif by_region:
         parse_region(o["from_region"])
     if op == "remove-interior" and o["conservative"]:
         from meshvis.visibility.viewpoints import parse_viewpoints

@@ -200,7 +200,8 @@ def remove_interior(
         :data:`~meshvis.repair.remove_modes.DEFAULT_VISIBILITY`), the graph cut alone, or
         both must call a face hidden.
     region : str or Region
-        Where viewers may be, for ``"view"`` and ``"both"`` (see :func:`meshvis.parse_region`).
+        Where viewers may be, for ``"view"`` and ``"both"`` (see :func:`meshvis.parse_region`),
+        or ``cells:PVS.npz``: the view cells of a PVS file (:func:`meshvis.pvs`).
     level : {"face", "patch", "part"}
         Remove single faces, or whole edge-connected patches / named parts whose faces are all hidden.
     keep_border : int
@@ -274,7 +275,7 @@ def remove_interior(
     elif visibility == "view":
         soup = as_soup(model)
         caster = RayCaster(soup, offset=VISIBILITY_OFFSET, walls=walls(soup, transparent))
-        vis = view or visible_from(soup, region, budget=budget, seed=seed, up=up, caster=caster)
+        vis = view or _sight(soup, region, budget=budget, seed=seed, up=up, caster=caster)
         keep = vis.seen.copy()
         code = np.where(keep, _KEPT_SEEN, _GONE_VIEW)
     else:
@@ -289,13 +290,13 @@ def remove_interior(
             keep = by_cut
             code = np.where(keep, _KEPT_CUT, _GONE_CUT)
         else:
-            vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut, caster=caster)
+            vis = _sight(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut, caster=caster)
             keep = by_cut | vis.seen
             code = np.where(by_cut, _KEPT_CUT, np.where(vis.seen, _KEPT_RESCUED, _GONE_BOTH))
     code = code.astype(np.int8)
     keep = _widen(soup, keep, code, level, int(keep_border))
     check = None
-    if check_rays:
+    if check_rays and not _is_cells(region):  # a PVS file's cells are checked by meshvis bench pvs
         bound = parse_region(region, up=up).bind(soup)
         check = self_check(caster, bound, ~keep, rays=check_rays, seed=seed)
     see_through = 0 if caster.walls is None else int((~caster.walls).sum())
@@ -314,6 +315,20 @@ def _sight_caster(c: Classification, transparent: str) -> RayCaster:
     if clear is None:
         return c.caster.with_offset(VISIBILITY_OFFSET)
     return RayCaster(c.soup, offset=VISIBILITY_OFFSET, walls=clear, vertex_groups=c.caster.vertex_groups)
+
+
+def _is_cells(region) -> bool:
+    """Whether ``region`` names the view cells of a PVS file (``cells:PVS.npz``)."""
+    return isinstance(region, str) and region.strip().lower().startswith("cells:")
+
+
+def _sight(soup: Soup, region, **search: Any) -> Visibility:
+    """The from-region search, or what the view cells of a PVS file see (``cells:PVS.npz``)."""
+    if _is_cells(region):
+        from meshvis.viewcells.removal import cells_visibility
+
+        return cells_visibility(soup, region)
+    return visible_from(soup, region, **search)
 
 
 def _cut_keywords(visibility: str, classify_kw: dict[str, Any]) -> dict[str, Any]:

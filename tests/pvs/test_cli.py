@@ -1,0 +1,140 @@
+"""``meshvis pvs``: one summary line, its outputs, arguments refused before the model is read; and
+``remove-interior --from cells:PVS.npz``."""
+
+from __future__ import annotations
+
+import json
+import os
+
+import numpy as np
+import pytest
+
+import meshvis
+from meshvis.cli.main import main
+from meshvis.viewcells import PVS
+
+
+def _error(capsys, argv) -> str:
+    assert main([str(a) for a in argv]) == 2
+    err = capsys.readouterr().err.strip()
+    assert len(err.splitlines()) == 1 and err.startswith("meshvis: error: "), err
+    return err
+
+
+@pytest.mark.parametrize(
+    "extra, words",
+    [
+        (["--cells", "grid:2,2"], "grid:NX,NY,NZ"),
+        (["--cells", "octree"], "unknown cells"),
+        (["--cells", "missing.json"], "view cells file not found"),
+        (["--view-space", "sphere"], "unknown view space"),
+        (["--view-space", "box:0,0,0,1,1"], "expected 6"),
+        (["--top-view", "{tmp}/top.gif"], "'.gif' pictures"),
+    ],
+)
+def test_refused_before_the_model_is_read(capsys, tmp_path, extra, words):
+    argv = [
+        "pvs",
+        "missing.obj",
+        "-o",
+        tmp_path / "p.npz",
+        *[str(e).replace("{tmp}", str(tmp_path)) for e in extra],
+    ]
+    err = _error(capsys, argv)
+    assert words in err and "missing.obj" not in err
+    assert os.listdir(tmp_path) == []
+
+
+def _closed_room(levels, tmp_path):
+    """The split space and, beyond the view space, a closed box with a box inside it."""
+    soup, idx = levels.split_space()
+    outer, inner = (
+        levels.box_quads((5, 0.5, 0.5), (6, 1.5, 1.5)),
+        levels.box_quads((5.3, 0.8, 0.8), (5.7, 1.2, 1.2)),
+    )
+    groups = {name: soup.triangles[idx[name]].tolist() for name in idx}
+    full, index = levels.soup_of({**groups, "shell": outer, "inside": inner})
+    path = tmp_path / "level.obj"
+    meshvis.save(full, str(path))
+    return str(path), index
+
+
+@pytest.mark.slow
+def test_pvs_writes_its_outputs_and_prints_one_line(levels, tmp_path, capsys):
+    model, _ = _closed_room(levels, tmp_path)
+    out = tmp_path / "level.pvs.npz"
+    argv = [
+        "pvs",
+        model,
+        "-o",
+        out,
+        "--cells",
+        "grid:2,1,1",
+        "--view-space",
+        "box:0,0,0,4,2,2",
+        "--rays",
+        "400000",
+    ]
+    argv += [
+        "--report",
+        tmp_path / "r.json",
+        "--top-view",
+        tmp_path / "top.png",
+        "--cell-view",
+        tmp_path / "cell.png",
+    ]
+    assert main([str(a) for a in argv]) == 0
+    lines = capsys.readouterr().out.strip().splitlines()
+    assert len(lines) == 1 and "pvs: 2 cells" in lines[0] and "stopped: budget" in lines[0]
+    report = json.loads((tmp_path / "r.json").read_text())
+    assert report["cells"]["cells"] == 2 and report["rays"]["total"] >= 400_000
+    assert set(report["left_out"]) >= {"faces_no_cell_sees", "tree_leaves_without_view_space"}
+    assert (tmp_path / "top.png").stat().st_size > 0 and (tmp_path / "cell.png").stat().st_size > 0
+    assert PVS.load(out, meshvis.load(model)).cells.n_cells == 2
+    # an existing output is refused without --force
+    err = _error(capsys, argv)
+    assert "exists" in err
+
+
+@pytest.mark.slow
+def test_remove_interior_removes_what_no_cell_sees(levels, tmp_path, capsys):
+    model, index = _closed_room(levels, tmp_path)
+    out = tmp_path / "level.pvs.npz"
+    argv = [
+        "pvs",
+        model,
+        "-o",
+        out,
+        "--cells",
+        "grid:2,1,1",
+        "--view-space",
+        "box:0,0,0,4,2,2",
+        "--rays",
+        "2000000",
+    ]
+    assert main([str(a) for a in argv]) == 0
+    kept = tmp_path / "kept.obj"
+    report = tmp_path / "removal.json"
+    argv = [
+        "remove-interior",
+        model,
+        "-o",
+        kept,
+        "--visibility",
+        "view",
+        "--from",
+        f"cells:{out}",
+        "--report",
+        report,
+    ]
+    assert main([str(a) for a in argv]) == 0
+    keep = np.asarray(json.loads(report.read_text())["per_face"]["keep"])
+    # gone: the box inside the closed box, and the closed box's side facing away from the view space
+    gone = set(np.flatnonzero(~keep))
+    far_side = {f for f in index["shell"] if meshvis.load(model).normals[f][0] > 0.5}
+    assert gone == set(index["inside"]) | far_side
+    # a missing PVS file is refused before the model is read
+    err = _error(
+        capsys, ["remove-interior", "missing.obj", "-o", kept, "--force", "--from", "cells:none.npz"]
+    )
+    assert "PVS file not found" in err

@@ -1,0 +1,112 @@
+"""The PVS file, the judge, the pixel-error estimate and the mixture."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+import trimesh
+
+from meshvis.errors import ModelError
+from meshvis.viewcells import PVS, pvs
+from meshvis.viewcells.estimate import ErrorEstimate, rays_needed
+from meshvis.viewcells.judge import pixel_errors, render_views, summary
+from meshvis.viewcells.mixture import FLOOR, UNIFORM_FLOOR, Mixture
+from meshvis.viewcells.strategies import MutationBuffer
+
+
+@pytest.fixture(scope="module")
+def split(levels):
+    """The split space's PVS on 2 x 2 cells, computed once for the module."""
+    soup, idx = levels.split_space()
+    return soup, idx, pvs(soup, "grid:2,2,1", view_space="box:0,0,0,4,2,2", budget=300_000, target_error=0)
+
+
+def test_a_pvs_file_reads_back_the_same_sets(split, tmp_path):
+    soup, _, result = split
+    path = tmp_path / "level.pvs.npz"
+    result.save(path)
+    back = PVS.load(path, soup)
+    assert np.array_equal(back.bits, result.bits)
+    assert np.array_equal(back.sides, result.sides)
+    assert back.cells.kind == "grid:2,2,1" and back.cells.n_cells == 4
+    assert [back.parts(c) for c in range(4)] == [result.parts(c) for c in range(4)]
+    # without the model the parts come from the file
+    alone = PVS.load(path)
+    assert alone.part_id is None and alone.parts(0) == result.parts(0)
+    assert alone.summary["rays"] == result.summary["rays"]
+
+
+def test_a_pvs_file_of_another_model_or_no_pvs_file_is_refused(split, tmp_path):
+    soup, _, result = split
+    path = tmp_path / "level.pvs.npz"
+    result.save(path)
+    with pytest.raises(ModelError, match="another model"):
+        PVS.load(path, trimesh.creation.box())
+    moved = type(soup)(soup.vertices + 1.0, soup.faces)
+    with pytest.raises(ModelError, match="another model"):
+        PVS.load(path, moved)
+    junk = tmp_path / "junk.npz"
+    junk.write_bytes(b"not a zip")
+    with pytest.raises(ModelError, match="not a PVS file"):
+        PVS.load(junk)
+    other = tmp_path / "other.npz"
+    np.savez(other, a=np.zeros(3))
+    with pytest.raises(ModelError, match="not a PVS file"):
+        PVS.load(other)
+
+
+def test_the_history_rebuilds_every_earlier_pvs(split):
+    _, _, result = split
+    last = len(result.batches["rays"]) - 1
+    assert np.array_equal(result.bits_at(last), result.bits)
+    sizes = [int(np.unpackbits(result.bits_at(b).view(np.uint8)).sum()) for b in range(last + 1)]
+    assert sizes == sorted(sizes) and sizes[0] > 0
+    assert result.summary["history"]["rays"][-1] == result.summary["rays"]["total"]
+
+
+def test_the_judge_counts_pixels_whose_face_is_not_in_the_cells_pvs(split):
+    soup, idx, result = split
+    table = render_views(soup, result.cells.view_space, points=16, path=4, size=24, seed=0)
+    assert table.n_views == 16 * 6 + 4
+    full = np.full_like(result.bits, np.iinfo(np.uint64).max)
+    assert pixel_errors(table, result.cells, full).max() == 0
+    empty = np.zeros_like(result.bits)
+    shown = np.bincount(table.view, weights=table.pixels, minlength=table.n_views)
+    assert np.allclose(pixel_errors(table, result.cells, empty), shown / 24**2 * 1e6)
+    s = summary(pixel_errors(table, result.cells, result.bits), table)
+    assert s["views"] == table.n_views and 0 <= s["mean"] <= s["worst"]
+
+
+def test_the_estimate_takes_the_rays_eq5_asks_for():
+    est = ErrorEstimate()
+    est.add(1000, 500)
+    assert est.per_million == pytest.approx(5e5) and est.enough
+    assert rays_needed(1e-5) == pytest.approx((1 - 1e-5) / (0.25 * 1e-5 * 0.1))
+    slow = ErrorEstimate()
+    for _ in range(10):
+        slow.add(1_000_000, 2)
+    # two per million needs 20 M rays: all ten batches, and still not enough
+    assert slow.window == 10_000_000 and not slow.enough and slow.per_million == pytest.approx(2.0)
+
+
+def test_the_mixture_follows_contribution_per_ray_with_floors():
+    mix = Mixture(("uniform", "two-point", "border"))
+    avail = {"uniform": True, "two-point": True, "border": True}
+    assert mix.probabilities(avail) == pytest.approx({"uniform": 1 / 3, "two-point": 1 / 3, "border": 1 / 3})
+    mix.update("uniform", 0, 1000)
+    mix.update("two-point", 10, 1000)
+    mix.update("border", 990, 1000)
+    p = mix.probabilities(avail)
+    assert p["uniform"] == pytest.approx(UNIFORM_FLOOR) and p["two-point"] == pytest.approx(FLOOR)
+    assert sum(p.values()) == pytest.approx(1.0)
+    assert mix.probabilities({"uniform": True})["border"] == 0.0
+
+
+def test_the_buffer_hands_out_the_least_mutated_newest_first():
+    buf = MutationBuffer(("x",), capacity=5)
+    buf.add(x=np.arange(3))
+    assert buf.take(2)["x"].tolist() == [1, 2]
+    buf.add(x=np.arange(10, 14))  # over capacity: the most mutated (1, 2) go first
+    assert len(buf) == 5
+    assert sorted(buf.take(5)["x"].tolist()) == [0, 10, 11, 12, 13]
+    assert buf.take(0) is None
