@@ -299,7 +299,7 @@ def _remove_outputs(soup, c, o: dict, tell: Callable[[str], None], up) -> tuple[
 
     with warnings.catch_warnings():  # the cut was made for this removal, with the budget asked for
         warnings.filterwarnings("ignore", message="the classification given gave its sample points")
-        r = remove_interior(soup, classification=c, **removal_kwargs(o, soup))
+        r = remove_interior(soup, classification=c, progress=o["progress"], **removal_kwargs(o, soup))
     for text in r.summary()[1:]:  # a search ended by its budget; the self-check
         tell(text)
     _save(r.kept, o["output"], tell)
@@ -541,7 +541,7 @@ def run_operation(
         # orient classifies the faces wound canonically (the cut orient makes itself)
         c = (classify_for_orient if op == "orient" else classify)(soup, progress=progress, **kw)
         more(c.summary())
-    report, line = _OUTPUTS[op](soup, c, o, tell, up)
+    report, line = _OUTPUTS[op](soup, c, {**o, "progress": progress}, tell, up)
     for text in _details(op, report):
         more(text)
     tell(f"{op}: {line}; {time.perf_counter() - t0:.1f} s")

@@ -227,7 +227,8 @@ def remove_interior(
     **classify_kw
         Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
         in ``"both"`` an unset ``rays_per_point`` is ``rays_per_node // samples_per_face``
-        (module notes); ``seed`` also seeds the search
+        (module notes); ``seed`` also seeds the search, and ``progress(stage, fraction)``
+        follows it too (stage ``"sight"``)
 
     Returns
     -------
@@ -262,6 +263,7 @@ def remove_interior(
     _validate.removal_args(keep_border, budget)
     check_rays = _validate.integer("check_rays", check_rays, 0)
     seed = int(classify_kw.get("seed", 0))
+    progress = classify_kw.get("progress")  # of the cut, and of the search by sight
     c: Classification | None = None
     vis: Visibility | None = None
     if conservative:
@@ -275,7 +277,7 @@ def remove_interior(
     elif visibility == "view":
         soup = as_soup(model)
         caster = RayCaster(soup, offset=VISIBILITY_OFFSET, walls=walls(soup, transparent))
-        vis = view or _sight(soup, region, budget=budget, seed=seed, up=up, caster=caster)
+        vis = view or _sight(soup, region, budget=budget, seed=seed, up=up, caster=caster, progress=progress)
         keep = vis.seen.copy()
         code = np.where(keep, _KEPT_SEEN, _GONE_VIEW)
     else:
@@ -290,7 +292,9 @@ def remove_interior(
             keep = by_cut
             code = np.where(keep, _KEPT_CUT, _GONE_CUT)
         else:
-            vis = _sight(soup, region, budget=budget, seed=seed, up=up, faces=~by_cut, caster=caster)
+            vis = _sight(
+                soup, region, budget=budget, seed=seed, up=up, faces=~by_cut, caster=caster, progress=progress
+            )
             keep = by_cut | vis.seen
             code = np.where(by_cut, _KEPT_CUT, np.where(vis.seen, _KEPT_RESCUED, _GONE_BOTH))
     code = code.astype(np.int8)

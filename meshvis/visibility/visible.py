@@ -23,6 +23,7 @@ A seen side is certain (a free line of sight was traced); an unseen one is an up
 from __future__ import annotations
 
 import time
+from collections.abc import Callable
 from dataclasses import dataclass, field
 from typing import TYPE_CHECKING
 
@@ -40,6 +41,8 @@ from meshvis.visibility.walls import DEFAULT_TRANSPARENT, walls
 if TYPE_CHECKING:
     from meshvis.visibility.conservative import ConservativeSet
 
+#: the stage name of the search in ``progress(stage, fraction)``
+PROGRESS_STAGE = "sight"
 #: seed rays per unseen face in successive rounds
 SEED_ROUNDS = (4, 16, 64, 256, 1024, 4096)
 #: the first round visits the faces in this many chunks (propagation runs after each)
@@ -217,6 +220,8 @@ class _State:
         #: some side seen, and the count and area of those faces
         self.seen = np.zeros(m, bool)
         self.n_seen, self.seen_area = 0, 0.0
+        #: ``progress(stage, fraction)``: told the share of the budget cast after every batch
+        self.progress: Callable[[str, float], None] | None = None
 
     @property
     def cast(self) -> int:
@@ -255,6 +260,9 @@ class _State:
         h["visible_area"].append(self.seen_area)
         h["faces_seen"].append(self.n_seen)
         h["seconds"].append(time.perf_counter() - self.start)
+        if self.progress is not None:  # the budget is a cap: the stop rule usually ends sooner
+            done = max(self.round / len(SEED_ROUNDS), self.cast / max(self.budget, 1))
+            self.progress(PROGRESS_STAGE, min(done, 1.0))
 
 
 def visible_from(
@@ -273,6 +281,7 @@ def visible_from(
     transparent: str = DEFAULT_TRANSPARENT,
     max_unseen: float = MAX_UNSEEN_PER_MILLION,
     conservative: bool = False,
+    progress: Callable[[str, float], None] | None = None,
 ) -> Visibility:
     """Which sides of the model's faces a viewer in ``region`` can see.
 
@@ -321,6 +330,11 @@ def visible_from(
         a ``points:`` or ``path:`` region, in ``result.conservative``
         (:func:`meshvis.visibility.conservative.bracket`; the search then looks from the
         viewpoints themselves).
+    progress : callable, optional
+        ``progress("sight", fraction)`` after every batch of rays, ``fraction`` the share of
+        the rounds of seed rays begun or of the budget cast, whichever is larger (the stop
+        rule usually ends the search before either); an exception it raises stops the
+        search.
 
     Returns
     -------
@@ -363,6 +377,7 @@ def visible_from(
     rng = np.random.default_rng(seed)
     state = _State(soup, budget, min_new, min_new_area)
     state.max_unseen = float(max_unseen)
+    state.progress = progress
     skipped = _presee(state, soup, region)
     if faces is not None:
         state.spread = _rings(soup, asked, PROPAGATE_RINGS)

@@ -225,3 +225,32 @@ def test_view_lines_end_the_search_when_they_find_few_unseen_faces():
     sealed = visible_from(meshvis.as_soup(trimesh.util.concatenate([cube, ball])), seed=0)
     assert sealed.stopped == "few unseen pixels" and sealed.rays["lines"] > 0
     assert sealed.seen[:12].all() and not sealed.seen[12:].any()
+
+
+class _Stop(Exception):
+    pass
+
+
+def test_the_search_by_sight_reports_progress_and_stops_when_told(scenes, tmp_path):
+    """remove_interior's default search tells its progress (through the library call and the
+    command's operation), never going back, and an exception from the callback stops it."""
+    from meshvis.repair.operation import run_operation
+
+    soup, _, _ = scenes.slot_box()
+    told: list[tuple[str, float]] = []
+    meshvis.remove_interior(soup, seed=0, progress=lambda stage, f: told.append((stage, f)))
+    assert told and {stage for stage, _ in told} == {"sight"}
+    fractions = [f for _, f in told]
+    assert fractions == sorted(fractions) and fractions[0] >= 0 and fractions[-1] <= 1
+    by_command: list[str] = []
+    out = str(tmp_path / "kept.obj")
+    run_operation(
+        "remove-interior", soup, {"output": out}, progress=lambda stage, f: by_command.append(stage)
+    )
+    assert "sight" in by_command
+
+    def stop(stage, fraction):
+        raise _Stop
+
+    with pytest.raises(_Stop):
+        meshvis.remove_interior(soup, seed=0, progress=stop)
