@@ -677,21 +677,34 @@ def component_labels(n, a, b):
     """
     parent = np.arange(n)
     for k in range(a.shape[0]):
-        x = _root(parent, a[k])
-        y = _root(parent, b[k])
-        if x < y:
-            parent[y] = x
-        elif y < x:
-            parent[x] = y
+        _join(parent, a[k], b[k])
+    return _labels(parent)
+
+
+@numba.njit(cache=True, nogil=True, inline="always")
+def _join(parent, i, j):
+    """Union of the sets of ``i`` and ``j``; the smaller root becomes the root."""
+    x = _root(parent, i)
+    y = _root(parent, j)
+    if x < y:
+        parent[y] = x
+    elif y < x:
+        parent[x] = y
+
+
+@numba.njit(cache=True, nogil=True)
+def _labels(parent):
+    """(n,) int64 set labels numbered in the order of each set's smallest element."""
+    n = parent.shape[0]
     label = np.empty(n, np.int64)
     count = 0
     for i in range(n):
-        r = _root(parent, i)
-        if r == i:
+        root = _root(parent, i)
+        if root == i:
             label[i] = count
             count += 1
         else:
-            label[i] = label[r]
+            label[i] = label[root]
     return label
 
 
@@ -787,22 +800,8 @@ def near_labels(pts, r):
                             dy = pts[i, 1] - pts[j, 1]
                             dz = pts[i, 2] - pts[j, 2]
                             if dx * dx + dy * dy + dz * dz <= r2:
-                                x = _root(parent, i)
-                                y = _root(parent, j)
-                                if x < y:
-                                    parent[y] = x
-                                elif y < x:
-                                    parent[x] = y
-    label = np.empty(n, np.int64)
-    count = 0
-    for i in range(n):
-        root = _root(parent, i)
-        if root == i:
-            label[i] = count
-            count += 1
-        else:
-            label[i] = label[root]
-    return label
+                                _join(parent, i, j)
+    return _labels(parent)
 
 
 @numba.njit(cache=True, nogil=True)
