@@ -218,10 +218,13 @@ def check_options(op: str, options: Mapping[str, Any] | Any) -> None:
     by_region = (op == "orient" and o["from_region"]) or (
         op in ("remove-interior", "layers") and o["visibility"] != "object"
     )
-    if by_region and op == "remove-interior" and str(o["from_region"]).strip().lower().startswith("cells:"):
-        from meshvis.viewcells.removal import cells_path
+    if by_region and op == "remove-interior":  # its region may name a PVS file of meshvis pvs
+        from meshvis.viewcells.removal import cells_path, is_cells_region
 
-        cells_path(o["from_region"])  # a PVS file of meshvis pvs
+        if is_cells_region(o["from_region"]):
+            cells_path(o["from_region"])
+        else:
+            parse_region(o["from_region"])
     elif by_region:
         parse_region(o["from_region"])
     if op == "remove-interior" and o["conservative"]:

@@ -300,7 +300,7 @@ def remove_interior(
     code = code.astype(np.int8)
     keep = _widen(soup, keep, code, level, int(keep_border))
     check = None
-    if check_rays and not _is_cells(region):  # a PVS file's cells are checked by meshvis bench pvs
+    if check_rays and not _is_cells(region):  # a PVS file's cells are judged by meshvis bench pvs
         bound = parse_region(region, up=up).bind(soup)
         check = self_check(caster, bound, ~keep, rays=check_rays, seed=seed)
     see_through = 0 if caster.walls is None else int((~caster.walls).sum())
@@ -322,8 +322,10 @@ def _sight_caster(c: Classification, transparent: str) -> RayCaster:
 
 
 def _is_cells(region) -> bool:
-    """Whether ``region`` names the view cells of a PVS file (``cells:PVS.npz``)."""
-    return isinstance(region, str) and region.strip().lower().startswith("cells:")
+    """:func:`meshvis.viewcells.removal.is_cells_region` (the layer above, imported when asked)."""
+    from meshvis.viewcells.removal import is_cells_region
+
+    return is_cells_region(region)
 
 
 def _sight(soup: Soup, region, **search: Any) -> Visibility:
