@@ -6,8 +6,9 @@ machine's load touches them alike; the table gives the median and the best of
 median CPU time (user + system), which a busy machine inflates less than wall time.
 Then the steps of the start are timed one by one (CPU seconds) in fresh processes.  The
 default model (100 triangles) makes the work itself negligible: what is left is the
-fixed cost of starting the interpreter, importing and setting up the compiled kernels
-(``remove-interior`` adds a classification with rays, small on this model but not nothing).
+fixed cost of starting the interpreter and importing what the command needs
+(``remove-interior`` adds a classification with rays and numba's compiled kernels, small
+on this model but not nothing).
 """
 
 from __future__ import annotations
@@ -58,7 +59,9 @@ def commands(model: str, out_dir: str) -> dict[str, list[str]]:
     }
 
 
-#: the steps of a computing command's start, timed in CPU seconds inside one fresh process
+#: the steps of a computing command's start, timed in CPU seconds inside one fresh process:
+#: ``meshvis info`` on the model, then what a model above
+#: :data:`meshvis.geometry._vectorised.SMALL_MODEL_FACES` faces adds (the compiled kernels)
 STEPS_CODE = """
 import json, sys, time
 steps, t = {}, time.process_time()
@@ -66,14 +69,14 @@ def mark(name):
     global t
     now = time.process_time(); steps[name] = now - t; t = now
 import numpy; mark("numpy")
-import numba; mark("numba, imported")
 import meshvis.cli.main, meshvis.geometry.diagnostics, meshvis.io; mark("meshvis modules")
-import scipy.linalg.cython_blas; mark("scipy's BLAS (numba's set-up imports it)")
-from meshvis.geometry._kernels import exact_groups
-exact_groups(numpy.zeros((1, 3), numpy.uint64), numpy.zeros(1, numpy.uint64))
-mark("numba, first compiled kernel called")
 from meshvis.geometry.diagnostics import diagnose
 diagnose(meshvis.io.load(sys.argv[1])); mark("the work of meshvis info")
+import numba; mark("larger models: numba, imported")
+import scipy.linalg.cython_blas; mark("larger models: scipy's BLAS (numba's set-up)")
+from meshvis.geometry._kernels import exact_groups
+exact_groups(numpy.zeros((1, 3), numpy.uint64), numpy.zeros(1, numpy.uint64))
+mark("larger models: numba, first compiled kernel called")
 print(json.dumps(steps))
 """
 
@@ -164,7 +167,9 @@ def format(r: dict) -> str:
     over = r["over_python"]["meshvis info MODEL"]
     verdict = "met" if over <= r["target"] else "missed"
     lines.append(f"meshvis info over python -c pass: {over:.3f} s (target <= {r['target']} s: {verdict})")
-    lines.append("steps of a computing command's start (CPU s, median of 3 fresh processes):")
+    lines.append(
+        "steps of meshvis info's start, then what a larger model adds (CPU s, median of 3 fresh processes):"
+    )
     lines += [f"  {name:<40} {sec:6.3f}" for name, sec in r["steps_cpu"].items()]
     return "\n".join(lines)
 
