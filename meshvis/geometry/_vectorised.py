@@ -41,7 +41,7 @@ NEAR_CELL_FLOOR = 2.0**-40
 #: with ``meshvis bench startup``, at this size the numpy analysis costs about what numba's
 #: set-up does, and above it the compiled kernels win
 SMALL_MODEL_FACES = 4096
-#: candidate pairs tested at once by :func:`flagged_pairs` (bounds the temporaries)
+#: candidate pairs met at once by :func:`flagged_pairs` (bounds the temporaries)
 PAIR_CHUNK = 1 << 16
 
 
@@ -453,15 +453,15 @@ def narrow_phase(
         inter[sl], copl[sl], close[sl], fold[sl] = faces.flags(i, j, eps, near, tau, cos_angle, cos_fold)
 
 
-def overlapping_boxes(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs ``i < j`` (two (p,) int64) of closed boxes ``[lo, hi]`` (m, 3) that overlap on every axis.
+def _sweep(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The boxes ``[lo, hi]`` (m, 3) sorted along one axis, and how many later boxes each meets there.
 
-    A sweep along one axis: after sorting by their lower end, each box meets the later boxes
-    that start before it ends, and the other two axes are compared on those.  The axis is
-    the one with the fewest such meetings (counted first, one binary search per box).
+    After sorting by their lower end, each box meets the later boxes that start before it
+    ends.  The axis is the one with the fewest such meetings (counted first, one binary
+    search per box).  Returns the order (m,) and the count (m,) of each sorted box.
     """
     m = len(lo)
-    best = None
+    best: tuple[np.ndarray, np.ndarray] | None = None
     for axis in range(3):
         order = np.argsort(lo[:, axis], kind="stable")
         count = np.searchsorted(lo[order, axis], hi[order, axis], side="right") - np.arange(1, m + 1)
@@ -469,14 +469,43 @@ def overlapping_boxes(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.nd
         if best is None or count.sum() < best[1].sum():
             best = (order, count)
     assert best is not None
-    order, count = best
-    row, pos = _expand(np.arange(1, m + 1), count)
-    a, b = order[row], order[pos]
+    return best
+
+
+def _overlapping(lo, hi, order, count, rows: slice) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs ``i < j`` of overlapping boxes met by the sorted boxes ``rows`` of :func:`_sweep`."""
+    start = np.arange(rows.start + 1, rows.stop + 1)
+    row, pos = _expand(start, count[rows])
+    a, b = order[rows.start + row], order[pos]
     meet = np.ones(len(a), bool)
     for d in range(3):
         meet &= (lo[a, d] <= hi[b, d]) & (lo[b, d] <= hi[a, d])
     a, b = a[meet], b[meet]
     return np.minimum(a, b), np.maximum(a, b)
+
+
+def overlapping_boxes(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """Pairs ``i < j`` (two (p,) int64) of closed boxes ``[lo, hi]`` (m, 3) that overlap on every axis.
+
+    Examples
+    --------
+    >>> lo = np.array([[0.0, 0, 0], [0.5, 0.5, 0.5], [3, 3, 3]])
+    >>> [x.tolist() for x in overlapping_boxes(lo, lo + 1)]
+    [[0], [1]]
+    """
+    order, count = _sweep(lo, hi)
+    return _overlapping(lo, hi, order, count, slice(0, len(lo)))
+
+
+def _row_chunks(count: np.ndarray, budget: int):
+    """Slices of rows whose counts add up to about ``budget`` (at least one row each)."""
+    total = np.cumsum(count)
+    begin = 0
+    while begin < len(count):
+        base = total[begin - 1] if begin else 0
+        end = max(int(np.searchsorted(total, base + budget, side="right")), begin + 1)
+        yield slice(begin, end)
+        begin = end
 
 
 def flagged_pairs(
@@ -491,14 +520,15 @@ def flagged_pairs(
     counts as coplanar), and the number of pairs tested.
     """
     m = len(lo)
-    a, b = overlapping_boxes(lo, hi)
+    order, count = _sweep(lo, hi)
     test = _PairFaces(*faces)
-    keys, codes = [np.zeros(0, np.int64)], [np.zeros(0, np.uint8)]
-    for s in range(0, len(a), PAIR_CHUNK):
-        i, j = a[s : s + PAIR_CHUNK], b[s : s + PAIR_CHUNK]
+    keys, codes, tested = [np.zeros(0, np.int64)], [np.zeros(0, np.uint8)], 0
+    for rows in _row_chunks(count, PAIR_CHUNK):
+        i, j = _overlapping(lo, hi, order, count, rows)
+        tested += len(i)
         inter, copl, close, fold = test.flags(i, j, *tolerances)
         code = (inter * INTERSECTS | (copl | fold) * COPLANAR | close * TOO_CLOSE).astype(np.uint8)
         hit = code > 0
         keys.append(i[hit] * m + j[hit])
         codes.append(code[hit])
-    return np.concatenate(keys), np.concatenate(codes), len(a)
+    return np.concatenate(keys), np.concatenate(codes), tested
