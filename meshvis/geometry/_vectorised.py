@@ -37,9 +37,11 @@ INTERSECTS, COPLANAR, TOO_CLOSE = 1, 2, 4
 #: coordinates stay below 2**40, far inside int64, whatever the radius
 NEAR_CELL_FLOOR = 2.0**-40
 
-#: models with at most this many faces are analysed by this module's numpy code: measured
-#: with ``meshvis bench startup``, at this size the numpy analysis costs about what numba's
-#: set-up does, and above it the compiled kernels win
+#: models with at most this many faces are analysed by this module's numpy code.  On the
+#: shared models of 100 to 6,320 faces ``meshvis info`` takes less CPU time this way than
+#: with numba's set-up (docs/startup.md); the numpy code is several times slower than the
+#: compiled kernels per face pair, so a command that loads numba for its rays anyway pays
+#: a little more at this size (0.1 to 0.2 s), and above it the compiled kernels win
 SMALL_MODEL_FACES = 4096
 #: candidate pairs met at once by :func:`flagged_pairs` (bounds the temporaries)
 PAIR_CHUNK = 1 << 16

@@ -170,7 +170,8 @@ def format(r: dict) -> str:
     lines.append(
         "steps of meshvis info's start, then what a larger model adds (CPU s, median of 3 fresh processes):"
     )
-    lines += [f"  {name:<40} {sec:6.3f}" for name, sec in r["steps_cpu"].items()]
+    width = max(len(name) for name in r["steps_cpu"])
+    lines += [f"  {name:<{width}} {sec:6.3f}" for name, sec in r["steps_cpu"].items()]
     return "\n".join(lines)
 
 
