@@ -16,7 +16,7 @@ import numba
 import numpy as np
 
 from meshvis._threads import in_threads
-from meshvis.geometry._vectorised import (  # the constants shared with the numpy formulations
+from meshvis.geometry._kernel_constants import (  # shared with the numpy formulations
     COPLANAR,
     INTERSECTS,
     NEAR_CELL_FLOOR,

@@ -21,21 +21,15 @@ from types import ModuleType
 
 import numpy as np
 
-# the tolerances and codes of both formulations are defined here, where importing them
-# does not import numba; meshvis.geometry._kernels takes them from this module
-#: relative slack of every reporting comparison (far above float64 reordering error)
-SLACK = 1e-12
-#: angular slack of the wedge test at a shared corner
-WEDGE_SLACK = 1e-9
-#: widening of each face's projection interval on its own axes (unit-diagonal coordinates):
-#: above the rounding of a 3-term dot product in any order (a few 1e-16), so gaps can only
-#: shrink and an evaluation order never hides a pair (more reports, never fewer)
-PROJ_SLACK = 1e-15
-#: bits of the pair codes of :func:`flagged_pairs` and ``_kernels.broad_narrow``
-INTERSECTS, COPLANAR, TOO_CLOSE = 1, 2, 4
-#: smallest cell of :func:`near_labels`, as a fraction of the points' largest extent: cell
-#: coordinates stay below 2**40, far inside int64, whatever the radius
-NEAR_CELL_FLOOR = 2.0**-40
+from meshvis.geometry._kernel_constants import (
+    COPLANAR,
+    INTERSECTS,
+    NEAR_CELL_FLOOR,
+    PROJ_SLACK,
+    SLACK,
+    TOO_CLOSE,
+    WEDGE_SLACK,
+)
 
 #: models with at most this many faces are analysed by this module's numpy code.  On the
 #: shared models of 100 to 6,320 faces ``meshvis info`` takes less CPU time this way than
@@ -455,7 +449,7 @@ def narrow_phase(
         inter[sl], copl[sl], close[sl], fold[sl] = faces.flags(i, j, eps, near, tau, cos_angle, cos_fold)
 
 
-def _sweep(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def sweep(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """The boxes ``[lo, hi]`` (m, 3) sorted along one axis, and how many later boxes each meets there.
 
     After sorting by their lower end, each box meets the later boxes that start before it
@@ -475,7 +469,7 @@ def _sweep(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
 
 
 def _overlapping(lo, hi, order, count, rows: slice) -> tuple[np.ndarray, np.ndarray]:
-    """Pairs ``i < j`` of overlapping boxes met by the sorted boxes ``rows`` of :func:`_sweep`."""
+    """Pairs ``i < j`` of overlapping boxes met by the sorted boxes ``rows`` of :func:`sweep`."""
     start = np.arange(rows.start + 1, rows.stop + 1)
     row, pos = _expand(start, count[rows])
     a, b = order[rows.start + row], order[pos]
@@ -495,7 +489,7 @@ def overlapping_boxes(lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.nd
     >>> [x.tolist() for x in overlapping_boxes(lo, lo + 1)]
     [[0], [1]]
     """
-    order, count = _sweep(lo, hi)
+    order, count = sweep(lo, hi)
     return _overlapping(lo, hi, order, count, slice(0, len(lo)))
 
 
@@ -511,26 +505,25 @@ def _row_chunks(count: np.ndarray, budget: int):
 
 
 def flagged_pairs(
-    lo: np.ndarray, hi: np.ndarray, faces: tuple, tolerances: tuple
-) -> tuple[np.ndarray, np.ndarray, int]:
+    lo: np.ndarray, hi: np.ndarray, swept: tuple[np.ndarray, np.ndarray], faces: tuple, tolerances: tuple
+) -> tuple[np.ndarray, np.ndarray]:
     """The pairs of overlapping boxes with a flag.
 
     ``lo``, ``hi`` (m, 3) are the boxes of the first ``m`` rows of ``faces``, the per-face
     arrays of :func:`pair_flags` (``_Narrow.faces`` of :mod:`meshvis.geometry.intersect`),
-    and ``tolerances`` its numbers.  Returns (k,) int64 keys ``i * m + j`` (``i < j``),
-    (k,) uint8 codes as :func:`meshvis.geometry._kernels.broad_narrow` gives them (a fold
-    counts as coplanar), and the number of pairs tested.
+    ``swept`` their :func:`sweep` and ``tolerances`` the numbers of :func:`pair_flags`.
+    Returns (k,) int64 keys ``i * m + j`` (``i < j``) and (k,) uint8 codes as
+    :func:`meshvis.geometry._kernels.broad_narrow` gives them (a fold counts as coplanar).
     """
     m = len(lo)
-    order, count = _sweep(lo, hi)
+    order, count = swept
     test = _PairFaces(*faces)
-    keys, codes, tested = [np.zeros(0, np.int64)], [np.zeros(0, np.uint8)], 0
+    keys, codes = [np.zeros(0, np.int64)], [np.zeros(0, np.uint8)]
     for rows in _row_chunks(count, PAIR_CHUNK):
         i, j = _overlapping(lo, hi, order, count, rows)
-        tested += len(i)
         inter, copl, close, fold = test.flags(i, j, *tolerances)
         code = (inter * INTERSECTS | (copl | fold) * COPLANAR | close * TOO_CLOSE).astype(np.uint8)
         hit = code > 0
         keys.append(i[hit] * m + j[hit])
         codes.append(code[hit])
-    return np.concatenate(keys), np.concatenate(codes), tested
+    return np.concatenate(keys), np.concatenate(codes)

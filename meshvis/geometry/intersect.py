@@ -90,7 +90,8 @@ import numpy as np
 from meshvis._threads import default_threads, in_threads, pool
 from meshvis.errors import ModelError, ParameterError
 from meshvis.geometry import _vectorised
-from meshvis.geometry._vectorised import COPLANAR, INTERSECTS, TOO_CLOSE, compiled, kernels
+from meshvis.geometry._kernel_constants import COPLANAR, INTERSECTS, TOO_CLOSE
+from meshvis.geometry._vectorised import compiled, kernels
 from meshvis.geometry.adjacency import WELD_TOL, weld
 
 #: default distance tolerance, as a fraction of the bounding-box diagonal
@@ -635,7 +636,8 @@ def _flagged_pairs(
     :data:`meshvis.geometry._vectorised.INTERSECTS`, ...) and the candidates looked at.
     Memory follows the flagged pairs: the candidates are tested in chunks as the grid meets
     them.  On a small model (:func:`meshvis.geometry._vectorised.compiled`) the numpy
-    formulation tests the same pairs: every pair of overlapping boxes.
+    formulation tests the same pairs, every pair of overlapping boxes, found by a sweep
+    (its candidates are the pairs the sweep meets).
     """
     from meshvis import limits
 
@@ -644,18 +646,16 @@ def _flagged_pairs(
         return np.zeros((0, 2), np.int64), np.zeros(0, np.uint8), 0
     lower = tri.min(axis=1) - pad
     upper = tri.max(axis=1) + pad
-    if not compiled(len(test.faces[1])):
-        # the boxes shifted as the grid shifts them, so that the overlap tests round alike;
-        # a small model stays far below the cap on the pairs (MIN_FACE_PAIRS)
+    small = not compiled(len(test.faces[1]))
+    if small:
+        # the boxes shifted as the grid shifts them, so that the overlap tests round alike
         origin = lower.min(axis=0)
-        keys, codes, candidates = _vectorised.flagged_pairs(
-            lower - origin, upper - origin, test.faces, test.tolerances
-        )
-        return _split_keys(keys, n).astype(np.int64), codes, candidates
-    from meshvis.geometry._kernels import broad_narrow
-
-    broad = _BroadPhase(lower, upper, overwrite=True)
-    candidates = broad.candidates
+        lo, hi = lower - origin, upper - origin
+        swept = _vectorised.sweep(lo, hi)
+        candidates = int(swept[1].sum())
+    else:
+        broad = _BroadPhase(lower, upper, overwrite=True)
+        candidates = broad.candidates
     cap = max(limits.MAX_FACE_PAIRS_PER_FACE * n, limits.MIN_FACE_PAIRS)
     if candidates > cap:
         raise ModelError(
@@ -663,6 +663,11 @@ def _flagged_pairs(
             f"{candidates // n} per face, more than the cap MAX_FACE_PAIRS_PER_FACE of meshvis.limits "
             f"({limits.MAX_FACE_PAIRS_PER_FACE}): many different faces are stacked in one place"
         )
+    if small:
+        keys, codes = _vectorised.flagged_pairs(lo, hi, swept, test.faces, test.tolerances)
+        return _split_keys(keys, n).astype(np.int64), codes, candidates
+    from meshvis.geometry._kernels import broad_narrow
+
     report(0.1)
     work = [(job, sl) for job in broad.jobs for sl in _chunks(job.counts)]
     bounds = broad.bounds
