@@ -989,3 +989,25 @@ def trace_frusta(
                 OPEN, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
                 planes, axis, far, delta, eta, mu, keep, blocks, starts, 0, seeds[i], sc, stack,
             )  # fmt: skip
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def first_hits(v, d, tri, lo, hi, first, count, order, out):  # pragma: no cover - compiled
+    """The triangle each ray ``v + s d[i]`` (``s > 0``) meets first, traced in float64; -1 if none.
+
+    Parameters
+    ----------
+    v : (3,) float64
+        Where the rays start.
+    d : (n, 3) float64
+        Their directions.
+    tri : (m, 3, 3) float64
+        The triangles.
+    lo, hi, first, count, order :
+        The :class:`~meshvis.geometry.bvh.Bvh` of ``tri``.
+    out : (n,) int64, out
+        The first triangle of each ray.
+    """
+    stack = np.empty(STACK, np.int64)
+    for i in range(len(d)):
+        out[i] = _first_hit(v, d[i], np.inf, -1, tri, lo, hi, first, count, order, stack)

@@ -18,7 +18,7 @@ by level (FastV §3.4), down to ``max_level``; there, it keeps every triangle it
 which no blocker is found among the rays that reach that triangle.
 
 A face is kept with the side that faces the point (both when the point lies within the
-margin of its plane).  Every test takes margins of ``tolerance`` times the scene's size
+margin of its plane, or the face's corners lie on one line, :func:`fillers`).  Every test takes margins of ``tolerance`` times the scene's size
 seen from the point (:func:`margins`), so that rounding -- ours, or the float32 scene that
 Embree traces -- can only keep more.  Two consequences a user sees: a face that only
 touches a visible one along the edge of an outline (the side of a box seen from above
@@ -69,6 +69,8 @@ LEVEL_CAP = 24
 FILLER_WIDTH = 1e-7
 #: rays per batch of :func:`sample_views`
 SAMPLE_BATCH = 1 << 20
+#: rays traced again in float64 per side that aimed rays hit (:func:`confirm_hits`)
+CONFIRM = 4
 #: rays in all of a camera path's views when cameras look into views and no budget is given
 VIEW_RAYS = 1 << 22
 
@@ -370,6 +372,7 @@ def conservative_from(
         sides = facing_sides(
             scene.triangles[faces], view.position, margins(scene, view.position, tolerance)[0]
         )
+        sides[scene.filler[faces] >= 0] = 2  # corners on one line: no side to tell
         visible_side[faces, 0] |= sides != 1
         visible_side[faces, 1] |= sides != 0
         point_faces.append(faces)
@@ -561,7 +564,8 @@ def sample_frusta(
     ``position`` through a uniformly random point of each cell.  Aimed at the frusta that
     :func:`conservative_from` keeps open at its limit (``open_frusta``), these rays find
     faces seen only through narrow gaps, which uniformly random rays rarely reach.  Every
-    side counted was hit first by a ray: a sampled lower bound, like :func:`sample_views`.
+    side counted was hit first by a ray, in the float32 Embree scene and again in float64
+    (:func:`confirm_hits`): a sampled lower bound, like :func:`sample_views`.
 
     Parameters
     ----------
@@ -608,9 +612,60 @@ def sample_frusta(
         d = d.reshape(-1, 3)
         d /= np.linalg.norm(d, axis=1, keepdims=True)
         hits = scene.caster.intersect(np.broadcast_to(position, d.shape), d)
-        ok = hits.face >= 0
-        seen[hits.face[ok], hits.side[ok]] = True
+        confirm_hits(scene, position, d, hits.face, hits.side, seen)
     return seen
+
+
+def confirm_hits(
+    scene: FrustumScene,
+    position: np.ndarray,
+    directions: np.ndarray,
+    face: np.ndarray,
+    side: np.ndarray,
+    seen: np.ndarray,
+    per_side: int = CONFIRM,
+) -> None:
+    """Mark in ``seen`` the sides that rays hit first, each confirmed by a float64 trace of the ray.
+
+    Rays aimed at narrow gaps and thin faces are where the float32 Embree scene can pass
+    between two faces that share an edge, and report a face behind them.  For each side
+    not yet in ``seen`` that some rays hit (``face``, ``side``: -1 for a miss), up to
+    ``per_side`` of those rays are traced again in float64 (:func:`._frusta_kernels.first_hits`);
+    the side is marked when one of them meets the same face first.
+
+    Parameters
+    ----------
+    scene : FrustumScene
+        The prepared model.
+    position : (3,) float64
+        Where the rays start.
+    directions : (n, 3) float64
+        Their directions.
+    face, side : (n,) int
+        What Embree hit first along each (face -1: nothing).
+    seen : (m, 2) bool, in/out
+        The sides seen so far.
+    per_side : int
+        Rays traced again per side.
+    """
+    idx = np.flatnonzero(face >= 0)
+    idx = idx[~seen[face[idx], side[idx]]]
+    if len(idx) == 0:
+        return
+    key = face[idx].astype(np.int64) * 2 + side[idx]
+    order = np.argsort(key, kind="stable")
+    key = key[order]
+    start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    rank = np.arange(len(key)) - np.repeat(start, np.diff(np.r_[start, len(key)]))
+    pick = idx[order[rank < per_side]]
+    got = np.empty(len(pick), np.int64)
+    bvh = scene.bvh
+    fk.first_hits(
+        np.asarray(position, np.float64), np.ascontiguousarray(directions[pick], np.float64),
+        scene.triangles, bvh.lo, bvh.hi, bvh.first, bvh.count, bvh.order, got,
+    )  # fmt: skip
+    good = got == face[pick]
+    seen[face[pick][good], side[pick][good]] = True
 
 
 def bracket(model, region, *, search, max_level: int = DEFAULT_MAX_LEVEL, **search_kw):

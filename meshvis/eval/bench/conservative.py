@@ -13,8 +13,11 @@ outside, around it), and for each:
   reference, plus what a jittered grid of :data:`LEAF_RAYS` x :data:`LEAF_RAYS` rays
   through each frustum the set keeps open at its subdivision limit hits first (faces seen
   through narrow gaps, where those frusta are), plus what :data:`AIMED` rays aimed at
-  random points of each face of the set still unseen hit first.  Every face it counts was
-  hit first by a ray from the point: still a lower bound of the exact set;
+  random points of each face of the set still unseen hit first (faces whose corners lie
+  on one line are not aimed at: such a ray runs along the surface).  Every face it counts was
+  hit first by a ray from the point, in the float32 Embree scene and again in float64
+  (rays aimed at gaps are where float32 passes between faces sharing an edge): still a
+  lower bound of the exact set;
 * misses against each reference, and the area ratio against each (``ratio``, ``ratio*``);
 * where the excess over the aimed reference comes from, as shares of its area: ``limit``,
   kept only by frusta at the subdivision limit
@@ -134,28 +137,37 @@ def aimed_seen(
     """Rays aimed at random points of each of ``faces``: what they see, and what hides the faces.
 
     Returns ``(seen, parts)``: (m, 2) bool, the sides that ``rays`` rays aimed at random
-    points of each of ``faces`` hit first; (len(faces),) int64, how many parts (``part``,
+    points of each of ``faces`` hit first (confirmed in float64:
+    :func:`~meshvis.visibility.conservative.confirm_hits`); (len(faces),) int64, how many parts (``part``,
     a label per face) those rays hit first, the face itself left out.  A face hidden by
     two parts or more can only be proved hidden by their union.
     """
     from meshvis.rays.samples import uniform_in_triangles
+    from meshvis.visibility.conservative import FILLER_WIDTH, confirm_hits
 
     out = np.zeros((scene.soup.n_faces, 2), bool)
     parts = np.zeros(len(faces), np.int64)
+    # a ray aimed at a face whose corners lie on one line runs along the surface, through
+    # the joint that face closes: such faces are not aimed at (other rays may hit them)
+    tri = scene.triangles[faces]
+    longest = np.linalg.norm(tri - np.roll(tri, 1, axis=1), axis=2).max(axis=1)
+    flat = 2.0 * scene.soup.areas[faces] <= FILLER_WIDTH * scene.soup.diagonal * longest
     per = max(1, (1 << 20) // max(rays, 1))
     for lo in range(0, len(faces), per):
-        chunk = faces[lo : lo + per]
+        chunk = faces[lo : lo + per][~flat[lo : lo + per]]
+        if len(chunk) == 0:
+            continue
         target = uniform_in_triangles(np.repeat(scene.triangles[chunk], rays, axis=0), rng)
         d = target - point
         d /= np.linalg.norm(d, axis=1, keepdims=True)
         hits = scene.caster.intersect(np.broadcast_to(point, d.shape), d)
+        confirm_hits(scene, point, d, hits.face, hits.side, out)
         ok = hits.face >= 0
-        out[hits.face[ok], hits.side[ok]] = True
         label = np.where(ok, part[np.maximum(hits.face, 0)], -1).reshape(len(chunk), rays)
         label[hits.face.reshape(len(chunk), rays) == chunk[:, None]] = -1
         label.sort(axis=1)
         distinct = (label[:, 1:] != label[:, :-1]) & (label[:, 1:] >= 0)
-        parts[lo : lo + len(chunk)] = (label[:, 0] >= 0) + distinct.sum(axis=1)
+        parts[lo : lo + per][~flat[lo : lo + per]] = (label[:, 0] >= 0) + distinct.sum(axis=1)
     return out, parts
 
 
