@@ -643,8 +643,8 @@ def confirm_hits(
         Their directions.
     face, side : (n,) int
         What Embree hit first along each (face -1: nothing).
-    seen : (m, 2) bool, in/out
-        The sides seen so far.
+    seen : (m, 2) bool
+        The sides seen so far; the confirmed sides are added to it.
     per_side : int
         Rays traced again per side.
     """
