@@ -3,11 +3,13 @@
 import numpy as np
 import pytest
 import trimesh
+from helpers import real_model
 
 from meshvis import classify
 from meshvis.errors import ParameterError
 from meshvis.graphcut.hints import Hints
 from meshvis.graphcut.mincut import cut_value, rounding_bound
+from meshvis.io import load
 from meshvis.soup import Soup
 
 
@@ -207,3 +209,19 @@ def test_crack_near_the_opening_threshold_gives_the_same_answer_for_every_seed()
         assert leaked.all() or not leaked.any()
         answers.add(bool(leaked.any()))
     assert len(answers) == 1
+
+
+def test_settled_nodes_cast_no_more_rays(monkeypatch):
+    import importlib
+
+    classify_module = importlib.import_module("meshvis.graphcut.classify")
+    soup = load(real_model("ferrari348_lowpoly.glb"))
+    c = classify(soup, seed=0)
+    left_out = sum(r.get("rays_left_out", 0) for r in c.rounds)
+    assert left_out > 0 and sum(r.get("settled_left_out", 0) for r in c.rounds) > 0
+    assert f"settled nodes left out {left_out} rays" in next(s.note for s in c.stages if s.name == "sampling")
+    monkeypatch.setattr(classify_module, "SETTLED_MARGIN", np.inf)  # nothing settles
+    every = classify(soup, seed=0)
+    assert sum(r.get("rays_left_out", 0) for r in every.rounds) == 0
+    assert c.counts.rays < every.counts.rays
+    assert (soup.areas * (c.hidden != every.hidden)).sum() / soup.total_area < 0.01
