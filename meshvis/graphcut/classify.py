@@ -13,9 +13,9 @@ every node; later rounds double the rays of the undecided nodes only — those w
 changed in the last round, those on the cut (linked to a node of the other label), those
 whose escape share is within a factor of two of the ``opening`` threshold and, after the
 first round, those whose two terminal links are within a factor of two — in the spirit of
-adaptive global visibility sampling (AGVS).  A node whose vote is decided with a margin
-(:func:`settled_nodes`) casts no more rays of its own, and each round says how many it
-left out.  A clean closed model stops after
+adaptive global visibility sampling (AGVS).  A sample-point node whose vote is decided
+with a margin (:func:`settled_nodes`) casts no more rays of its own, and each round says
+how many it left out.  A clean closed model stops after
 one small round.  Stages a model does not need (point nodes when nothing is
 flagged, hint rays without hints) are skipped, and the result says so; so are the nodes
 that the max flow settles before its search (their terminal link outweighs all their
@@ -55,7 +55,7 @@ CLUSTER_RAY_FACTOR_MAX = 64
 OPENING_Z = 3.0
 #: no escape in n rays bounds the escape share below this / n with 99.9 % (-ln 1e-3)
 ZERO_ESCAPE_BOUND = 6.9
-#: a node is settled, and gets no more rays, once its net terminal link outweighs this many
+#: a sample-point node is settled, and gets no more rays, once its net terminal link outweighs this many
 #: times all the capacity of its edges (:func:`settled_nodes`) ...
 SETTLED_MARGIN = 2.0
 #: ... with at least this many of its own rays counted
@@ -607,8 +607,9 @@ class _Sampling:
                 )
                 break
             active = self._undecided(prev_nodes)
-            # a node whose vote is decided with a margin casts no more rays of its own
-            settled = active & settled_nodes(self.graph.weights, counted) & ~near_threshold
+            # a sample point whose vote is decided with a margin casts no more rays of its own;
+            # a cluster's escape shares are also orient's evidence, and keep their rays
+            settled = active & settled_nodes(self.graph.weights, counted) & nodes.is_point & ~near_threshold
             self.rounds[-1]["settled_left_out"] = int(settled.sum())
             self.rounds[-1]["rays_left_out"] = int(np.minimum(cast, budget - cast)[settled].sum())
             self.left_out += self.rounds[-1]["rays_left_out"]
