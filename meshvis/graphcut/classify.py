@@ -13,7 +13,9 @@ every node; later rounds double the rays of the undecided nodes only — those w
 changed in the last round, those on the cut (linked to a node of the other label), those
 whose escape share is within a factor of two of the ``opening`` threshold and, after the
 first round, those whose two terminal links are within a factor of two — in the spirit of
-adaptive global visibility sampling (AGVS).  A clean closed model stops after
+adaptive global visibility sampling (AGVS).  A sample-point node whose vote is decided
+with a margin (:func:`settled_nodes`) casts no more rays of its own, and each round says
+how many it left out.  A clean closed model stops after
 one small round.  Stages a model does not need (point nodes when nothing is
 flagged, hint rays without hints) are skipped, and the result says so; so are the nodes
 that the max flow settles before its search (their terminal link outweighs all their
@@ -53,6 +55,11 @@ CLUSTER_RAY_FACTOR_MAX = 64
 OPENING_Z = 3.0
 #: no escape in n rays bounds the escape share below this / n with 99.9 % (-ln 1e-3)
 ZERO_ESCAPE_BOUND = 6.9
+#: a sample-point node is settled, and gets no more rays, once its net terminal link outweighs this many
+#: times all the capacity of its edges (:func:`settled_nodes`) ...
+SETTLED_MARGIN = 2.0
+#: ... with at least this many of its own rays counted
+SETTLED_MIN_RAYS = 8
 
 
 def sees_others(hits) -> np.ndarray:
@@ -230,6 +237,44 @@ def ray_allocation(nodes: NodeSet, rays: int, point_rays: int) -> np.ndarray:
     alloc[nodes.n_cluster :] = point_rays
     alloc[nodes.area <= 0] = 0
     return alloc
+
+
+def settled_nodes(weights, counted: np.ndarray) -> np.ndarray:
+    """(n,) bool: nodes whose vote is decided with a margin; they get no more rays.
+
+    A node whose net link to one terminal exceeds the capacity of all its edges is on
+    that terminal's side of every minimum cut (the settling of
+    :mod:`~meshvis.graphcut.boykov_kolmogorov`); one that exceeds it
+    :data:`SETTLED_MARGIN` times, on at least :data:`SETTLED_MIN_RAYS` rays of its own,
+    stays there while its estimates move within their spread, so more rays of its own
+    would not change the cut.  Its neighbours still cast theirs.
+
+    Parameters
+    ----------
+    weights : Weights
+        The graph's capacities (:func:`~meshvis.graphcut.weights.graph_weights`).
+    counted : (n,) int
+        Rays of each node counted so far (cast minus discarded).
+
+    Returns
+    -------
+    (n,) bool
+
+    Examples
+    --------
+    >>> from types import SimpleNamespace
+    >>> w = SimpleNamespace(edges_i=np.array([0]), edges_j=np.array([1]), cap_ij=np.array([1.0]),
+    ...     cap_ji=np.array([1.0]), cap_out=np.array([5.0, 1.5]), cap_in=np.array([0.0, 0.0]))
+    >>> settled_nodes(w, np.array([8, 8])).tolist()
+    [True, False]
+    """
+    n = len(weights.cap_out)
+    i, j = weights.edges_i, weights.edges_j
+    leaving = np.bincount(i, weights.cap_ij, n) + np.bincount(j, weights.cap_ji, n)
+    entering = np.bincount(i, weights.cap_ji, n) + np.bincount(j, weights.cap_ij, n)
+    net = weights.cap_out - weights.cap_in
+    decided = (net > SETTLED_MARGIN * leaving) | (-net > SETTLED_MARGIN * entering)
+    return decided & (np.asarray(counted) >= SETTLED_MIN_RAYS)
 
 
 def opening_undecided(
@@ -516,6 +561,7 @@ class _Sampling:
         self.rounds: list[dict] = []
         self.t_sample = self.t_cut = 0.0
         self.stop_reason = "single round"
+        self.left_out = 0  # rays the settled nodes did not cast (their next round's)
         self.graph = self.cut = self.labels = None
 
     def run(self, rays_per_node: int, rays_per_point: int, progressive: bool, tolerance: float) -> None:
@@ -560,7 +606,14 @@ class _Sampling:
                     f"converged after {len(self.rounds)} rounds (change {changed:.2e} <= {tolerance:g})"
                 )
                 break
-            active = self._undecided(prev_nodes) | near_threshold
+            active = self._undecided(prev_nodes)
+            # a sample point whose vote is decided with a margin casts no more rays of its own;
+            # a cluster's escape shares are also orient's evidence, and keep their rays
+            settled = active & settled_nodes(self.graph.weights, counted) & nodes.is_point & ~near_threshold
+            self.rounds[-1]["settled_left_out"] = int(settled.sum())
+            self.rounds[-1]["rays_left_out"] = int(np.minimum(cast, budget - cast)[settled].sum())
+            self.left_out += self.rounds[-1]["rays_left_out"]
+            active = (active & ~settled) | near_threshold
             give = np.where(active, np.minimum(cast, budget - cast), 0)
             # a node undecided against the opening threshold gets its whole remaining budget at
             # once: it is settled in one more round instead of one doubling per round
@@ -635,7 +688,8 @@ class _Sampling:
                 "sampling",
                 True,
                 self.t_sample,
-                f"{c.rays} rays + {c.reverse_rays} reverse; {self.stop_reason}",
+                f"{c.rays} rays + {c.reverse_rays} reverse; {self.stop_reason}"
+                + (f"; settled nodes left out {self.left_out} rays" if self.left_out else ""),
             ),
             Stage(
                 "cut",

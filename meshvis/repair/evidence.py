@@ -75,6 +75,11 @@ RARE_SHARE = 2.0
 RARE_MIN_BUDGET = 1 << 16
 #: :func:`until_settled` starts with this many more rays per face
 SETTLE_FIRST_RAYS = 1024
+#: ... and casts at most this many times the rays of the first round (or
+#: :data:`RARE_MIN_BUDGET`), largest faces first: the faces near the line are seen from both
+#: sides about equally, and on a city of real models twice the first round's rays went
+#: to them, a fifth of ``orient``'s rays
+SETTLE_SHARE = 0.5
 #: ... and goes on while a true ratio of :data:`DOMINANCE` has at least this chance
 SETTLE_LEVEL = 0.05
 #: ... or this chance, for a face whose counts already pass the line (about to leave the
@@ -455,7 +460,7 @@ def until_settled(
     which: np.ndarray,
     shown: np.ndarray,
     stream: RayStream,
-) -> None:
+) -> int:
     """Rounds of more rays for faces that lean to their other side near the :data:`DOMINANCE` line (in place).
 
     A face seen 7x as often through the side it does not show can escape 41 : 11 in 2,560
@@ -464,11 +469,17 @@ def until_settled(
     tell on which side of the line it is (:func:`near_the_line` at :data:`SETTLE_LEVEL`,
     or at :data:`LEAVING_LEVEL` where they pass it), gets :data:`SETTLE_FIRST_RAYS` more
     rays, then twice as many per round (up to :data:`RARE_MOST_RAYS`) while that still
-    holds, within the budget of :func:`until_decisive`, largest faces first.
+    holds, within :data:`SETTLE_SHARE` times the rays of the first round (``2 * FIRST_RAYS``
+    per face of ``faces``) or :data:`RARE_MIN_BUDGET` rays, largest faces first.
 
     Parameters
     ----------
     soup, caster, faces, escaped, cast, which, shown, stream : as :func:`until_decisive`
+
+    Returns
+    -------
+    int
+        Faces left out: a round was due to them, but the budget was spent on larger faces.
     """
     shown = np.asarray(shown, np.int64)
 
@@ -478,7 +489,9 @@ def until_settled(
         return (other > own) & near_the_line(escaped[rows], level=level)
 
     which = np.asarray(which, np.int64)
-    _rounds(soup, caster, faces, escaped, cast, which[keep(which)], keep, SETTLE_FIRST_RAYS, stream)
+    return _rounds(
+        soup, caster, faces, escaped, cast, which[keep(which)], keep, SETTLE_FIRST_RAYS, stream, SETTLE_SHARE
+    )
 
 
 def near_the_line(
@@ -542,16 +555,24 @@ def _other_own(escaped: np.ndarray, shown: np.ndarray, rows: np.ndarray) -> tupl
 
 def _rounds(
     soup, caster, faces, escaped, cast, which, keep, first: int, stream, share: float = RARE_SHARE
-) -> None:
-    """Doubling rounds of rays from ``faces[which]`` while ``keep(rows)`` holds (the budget of :func:`until_decisive`)."""
+) -> int:
+    """Doubling rounds of rays from ``faces[which]`` while ``keep(rows)`` holds (the budget of :func:`until_decisive`).
+
+    Returns the faces left out: due a round, but beyond the budget.
+    """
     which = np.asarray(which, np.int64)
     budget = max(int(share * 2 * FIRST_RAYS * len(faces)), RARE_MIN_BUDGET)
-    rays = first
+    rays, left_out = first, 0
     while len(which) and rays <= min(RARE_MOST_RAYS, budget):
+        asked = len(which)
         which = _cast_largest(soup, caster, faces, escaped, cast, which, rays, budget // rays, stream)
+        left_out += asked - len(which)
         budget -= rays * len(which)
         which = which[keep(which)]
         rays *= 2
+    if rays <= RARE_MOST_RAYS:  # the budget ended the rounds of the faces still kept
+        left_out += len(which)
+    return left_out
 
 
 def _cast_largest(soup, caster, faces, escaped, cast, which, rays: int, cap: int, stream) -> np.ndarray:

@@ -677,7 +677,9 @@ def _visible_sides(
     pooled = _pooled_patches(c, p, test, escaped, cast, outer, movable, clear, both)
     undecided = undecided & ~pooled
     # a face whose rays lean against its side near the 4x line gets rounds until they settle
-    evidence.until_settled(c.soup, caster, test, escaped, cast, np.arange(len(test)), shown(), stream)
+    left_out = evidence.until_settled(
+        c.soup, caster, test, escaped, cast, np.arange(len(test)), shown(), stream
+    )
     sure = evidence.decisive(escaped)
     sure |= crossing & evidence.significant(escaped, CROSSING_LEVEL)
     outer[test[sure]] = evidence.more_seen(escaped, shown())[sure]
@@ -687,6 +689,7 @@ def _visible_sides(
         "tested": len(test),
         "turned": int(turned.sum()),
         "rays": int(cast.sum()),
+        "settle_left_out": left_out,
         "pooled_patches": len(np.unique(p.clustering.cluster[pooled])),
     }
     return decided | pooled, report

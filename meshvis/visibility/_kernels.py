@@ -40,6 +40,49 @@ def far_origins(targets, directions, center, margin):  # pragma: no cover - comp
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
+def framed_targets(directions, u, v, center, half):  # pragma: no cover - compiled
+    """(n, 3) points of the box's orthographic frame across each direction (:meth:`Region.view_lines`).
+
+    Each direction ``d`` gets two unit axes across it, ``a = d x e / |d x e|`` (``e`` the x
+    axis, or the y axis where ``|d_x| >= 0.9``) and ``b = d x a``; the box of half sides
+    ``half`` projects to ``|a|.half`` and ``|b|.half`` along them, and ``u``, ``v`` (uniform
+    in [0, 1)) pick the point ``center + (2u - 1)|a|.half a + (2v - 1)|b|.half b``.
+    """
+    out = np.empty_like(directions)
+    for k in range(len(directions)):
+        d0, d1, d2 = directions[k, 0], directions[k, 1], directions[k, 2]
+        if abs(d0) < 0.9:  # d x (1, 0, 0)
+            a0, a1, a2 = 0.0, d2, -d1
+        else:  # d x (0, 1, 0)
+            a0, a1, a2 = -d2, 0.0, d0
+        n = norm3(a0, a1, a2)
+        a0, a1, a2 = a0 / n, a1 / n, a2 / n
+        b0, b1, b2 = d1 * a2 - d2 * a1, d2 * a0 - d0 * a2, d0 * a1 - d1 * a0
+        ru = (2.0 * u[k] - 1.0) * (abs(a0) * half[0] + abs(a1) * half[1] + abs(a2) * half[2])
+        rv = (2.0 * v[k] - 1.0) * (abs(b0) * half[0] + abs(b1) * half[1] + abs(b2) * half[2])
+        out[k, 0] = center[0] + ru * a0 + rv * b0
+        out[k, 1] = center[1] + ru * a1 + rv * b1
+        out[k, 2] = center[2] + ru * a2 + rv * b2
+    return out
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def tilt_into_planes(directions, axis, tilt):  # pragma: no cover - compiled
+    """Turn the first ``len(axis)`` directions into their coordinate plane ``axis``, tilted out by ``tilt`` (in place).
+
+    The component along ``axis`` is dropped, the rest scaled to ``cos(tilt)`` and the
+    component set to ``sin(tilt)`` (:func:`meshvis.visibility.regions.view_directions`).
+    """
+    for k in range(len(axis)):
+        directions[k, axis[k]] = 0.0
+        n = max(norm3(directions[k, 0], directions[k, 1], directions[k, 2]), 1e-300)
+        c = np.cos(tilt[k])
+        for j in range(3):
+            directions[k, j] = directions[k, j] / n * c
+        directions[k, axis[k]] = np.sin(tilt[k])
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
 def aimed_from(origins, targets):  # pragma: no cover - compiled
     """(n, 3) unit directions ``origins[k] -> targets[k]`` (``d / np.linalg.norm(d)``, no zero guard)."""
     out = np.empty_like(targets)

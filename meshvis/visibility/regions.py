@@ -127,15 +127,10 @@ class Region:
         if not self.at_infinity:
             return self.random_viewers(n, rng), view_directions(n, rng, plane_share)
         directions = -self._view_directions(n, rng, plane_share)
-        across = np.cross(directions, np.where(np.abs(directions[:, :1]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
-        across /= np.linalg.norm(across, axis=1, keepdims=True)
-        other = np.cross(directions, across)
-        # half extents of the box projected on the two axes across the direction
-        reach_a = np.abs(across) @ self.half
-        reach_b = np.abs(other) @ self.half
-        u = (2 * rng.random(n) - 1) * reach_a
-        v = (2 * rng.random(n) - 1) * reach_b
-        targets = self.center + u[:, None] * across + v[:, None] * other
+        u, v = rng.random(n), rng.random(n)
+        targets = _kernels.framed_targets(
+            directions, u, v, np.asarray(self.center, np.float64), np.asarray(self.half, np.float64)
+        )
         return self.far_origins(targets, directions), directions
 
     def random_viewers(self, n: int, rng: np.random.Generator) -> np.ndarray:
@@ -340,14 +335,8 @@ def view_directions(n: int, rng: np.random.Generator, plane_share: float = 0.0) 
     if k == 0:
         return d
     axis = rng.integers(0, 3, k)
-    rows = np.arange(k)
-    flat = d[:k].copy()
-    flat[rows, axis] = 0.0
-    flat /= np.maximum(np.linalg.norm(flat, axis=1, keepdims=True), 1e-300)
     tilt = np.radians(PLANE_TILT) * rng.standard_normal(k)
-    flat *= np.cos(tilt)[:, None]
-    flat[rows, axis] = np.sin(tilt)
-    d[:k] = flat
+    _kernels.tilt_into_planes(d, axis, tilt)
     return d
 
 

@@ -207,3 +207,47 @@ def test_crack_near_the_opening_threshold_gives_the_same_answer_for_every_seed()
         assert leaked.all() or not leaked.any()
         answers.add(bool(leaked.any()))
     assert len(answers) == 1
+
+
+def test_settled_nodes_need_their_terminal_link_to_outweigh_twice_their_edges():
+    from types import SimpleNamespace
+
+    from meshvis.graphcut.classify import settled_nodes
+
+    # node 0 -- node 1 -- node 2, edges of capacity 1 each way
+    w = SimpleNamespace(
+        edges_i=np.array([0, 1]),
+        edges_j=np.array([1, 2]),
+        cap_ij=np.ones(2),
+        cap_ji=np.ones(2),
+        cap_out=np.array([2.5, 4.5, 0.0]),
+        cap_in=np.array([0.0, 0.0, 1.0]),
+    )
+    # 0: 2.5 > 2 x 1; 1: 4.5 > 2 x 2 out; 2: 1 is not > 2 x 1 in
+    assert settled_nodes(w, np.full(3, 8)).tolist() == [True, True, False]
+    w.cap_in = np.array([0.0, 0.0, 2.5])
+    assert settled_nodes(w, np.full(3, 8)).tolist() == [True, True, True]
+    assert settled_nodes(w, np.array([8, 7, 8])).tolist() == [True, False, True]  # too few rays
+
+
+@pytest.mark.slow
+def test_settled_sample_points_cast_no_more_rays(monkeypatch):
+    """Two balls through each other: with every node taken as settled, the crossing
+    faces' sample points get no rays after the first round, and the rounds count the rays
+    left out; the clusters keep theirs (orient reads their escape shares)."""
+    import importlib
+
+    classify_module = importlib.import_module("meshvis.graphcut.classify")
+    a, b = trimesh.creation.icosphere(4), trimesh.creation.icosphere(4)
+    b.vertices += [0.8, 0.1, 0]
+    v, f = stack(a, b)
+    every = classify((v, f), seed=0)
+    monkeypatch.setattr(classify_module, "settled_nodes", lambda w, counted: np.ones(len(counted), bool))
+    c = classify((v, f), seed=0)
+    left_out = sum(r.get("rays_left_out", 0) for r in c.rounds)
+    assert left_out > 0 and sum(r.get("settled_left_out", 0) for r in c.rounds) > 0
+    assert f"settled nodes left out {left_out} rays" in next(s.note for s in c.stages if s.name == "sampling")
+    points = c.nodes.is_point
+    again = every.counts.cast[points] > c.counts.cast[points]  # more rays without the rule
+    assert again.any() and (c.counts.cast[points] <= every.counts.cast[points]).all()
+    assert c.counts.rays < every.counts.rays

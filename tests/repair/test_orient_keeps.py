@@ -297,6 +297,25 @@ def test_until_settled_casts_rounds_until_the_counts_tell_the_side_of_the_line()
     assert evidence.decisive(e[:1])[0] and e[0, 1] > e[0, 0]
 
 
+def test_until_settled_counts_the_faces_its_budget_leaves_out(monkeypatch):
+    """The leaning triangle of the test above gets its rounds within the budget, and is
+    counted as left out, with no ray cast, when the budget cannot pay for its first round."""
+    from meshvis.rays.caster import RayCaster
+
+    soup = two_holes(0.4, 0.15)
+    caster, faces = RayCaster(soup), np.arange(soup.n_faces)
+    rng = evidence.RayStream(8, soup.n_faces)
+    escaped, cast = np.zeros((soup.n_faces, 2), np.int64), np.zeros(soup.n_faces, np.int64)
+    escaped[:1] = evidence.escapes(soup, caster, faces[:1], 64, rng)
+    cast[0] = 64
+    shown = np.zeros(soup.n_faces, np.int64)
+    for budget, left_out in ((evidence.RARE_MIN_BUDGET, 0), (evidence.SETTLE_FIRST_RAYS - 1, 1)):
+        monkeypatch.setattr(evidence, "RARE_MIN_BUDGET", budget)
+        e, c = escaped.copy(), cast.copy()
+        assert evidence.until_settled(soup, caster, faces, e, c, [0], shown, rng) == left_out
+        assert (c[0] > 64) == (left_out == 0)
+
+
 def test_until_settled_gives_a_face_about_to_leave_its_side_rounds_at_one_percent():
     """0 : 14 escapes pass 4x and tell so at 5 % (0.8^14 = 0.044), but a face whose true
     ratio is 1.8x draws them now and then: a face about to leave the side it shows gets

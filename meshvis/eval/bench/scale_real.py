@@ -141,18 +141,22 @@ def peak_mb() -> float:
 
 
 def record(status: int, seconds: float, out: str) -> None:
-    """Write a finished command's exit status, seconds, peak memory and rays to ``out`` (JSON).
+    """Write a finished command's exit status, seconds, CPU seconds, peak memory and rays to ``out`` (JSON).
 
     Called in the child process that ran the command (:data:`STAGE`), so that the peak
     memory is the command's own and the rays those of its casters.
     """
+    import resource
+
     from meshvis.rays import caster
 
+    usage = resource.getrusage(resource.RUSAGE_SELF)
     with open(out, "w") as fh:
         json.dump(
             {
                 "status": status,
                 "seconds_in_process": seconds,
+                "cpu_seconds": usage.ru_utime + usage.ru_stime,
                 "peak_mb": peak_mb(),
                 "rays": caster.RAYS["rays"],
                 "embree_seconds": caster.RAYS["seconds"],
@@ -198,7 +202,7 @@ def run(sizes: list[int], commands: list[str], folder: str, seed: int = 0) -> li
     """Build each city, run each command on it in a fresh process, and measure the floor.
 
     Returns one dict per (city, command): ``faces``, ``command``, ``seconds`` (end to end),
-    ``peak_mb``, ``rays``, ``embree_seconds``, ``status``, ``floor_seconds`` (raw Embree's
+    ``cpu_seconds`` (user + system, all threads of the command's process), ``peak_mb``, ``rays``, ``embree_seconds``, ``status``, ``floor_seconds`` (raw Embree's
     build of the scene + ``embree_seconds``) and the machine's ``load_average`` at the end.
     """
     from meshvis.io import save
@@ -262,11 +266,11 @@ def growth(results: list[dict]) -> dict[tuple[str, int], float]:
 
 
 def format(results: list[dict], header: bool = True) -> str:
-    """A table: faces, command, seconds, growth per 4x faces, peak MB, rays, Embree seconds, floor."""
+    """A table: faces, command, seconds, CPU seconds, growth per 4x faces, peak MB, rays, Embree seconds, floor."""
     lines = []
     if header:
         lines.append(
-            f"{'faces':>10} {'command':<16} {'seconds':>8} {'x4':>5} {'peak MB':>8} {'rays':>11} "
+            f"{'faces':>10} {'command':<16} {'seconds':>8} {'cpu s':>7} {'x4':>5} {'peak MB':>8} {'rays':>11} "
             f"{'embree s':>8} {'floor s':>8} {'load':>5}"
         )
     grow = growth(results)
@@ -277,7 +281,8 @@ def format(results: list[dict], header: bool = True) -> str:
         g = grow.get((r["command"], r["faces"]))
         fl = r.get("floor_seconds")
         lines.append(
-            f"{r['faces']:>10} {r['command']:<16} {r['seconds']:>8.1f} {'' if g is None else f'{g:.2f}':>5} "
+            f"{r['faces']:>10} {r['command']:<16} {r['seconds']:>8.1f} {r.get('cpu_seconds', 0.0):>7.1f} "
+            f"{'' if g is None else f'{g:.2f}':>5} "
             f"{r['peak_mb']:>8.0f} {r['rays']:>11} {r['embree_seconds']:>8.1f} "
             f"{'' if fl is None else f'{fl:.1f}':>8} {r['load_average']:>5.1f}"
         )
