@@ -215,7 +215,8 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         type=int,
         default=d["check_rays"],
         metavar="N",
-        help="self-check: fresh random rays from every removed face, reported (0: no check)",
+        help="random rays from every face the search did not see (one sees a viewer: the face is kept; view "
+        "and both), then fresh ones from every removed face, reported (self-check; 0: neither)",
     )
     p.add_argument(
         "--level",
