@@ -6,7 +6,7 @@
   layers 1 .. k-1 are taken out of the scene (the search asks about the remaining faces
   only, and rays pass where the peeled faces were).  The faces no search sees form the last
   bucket, ``n_layers + 1``.  Each layer's search ends with the removal's rescue pass
-  (:data:`~meshvis.visibility.check.CHECK_RAYS` random rays from every face left that it did
+  (:data:`~meshvis.visibility.check.RESCUE_RAYS` random rays from every face left that it did
   not see; a face one of them sees from joins the layer), so layer 1 is the default
   removal's kept faces.
 * ``visibility="object"`` (the paper's "Layer Computation"): layer 1 is every face with an
@@ -33,7 +33,7 @@ from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.repair.remove_modes import DEFAULT_LAYER_VISIBILITY, DEFAULT_TRANSPARENT, LAYER_MODES
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, parse_region, visible_from
-from meshvis.visibility.check import CHECK_RAYS, RESCUE_STREAM, self_check
+from meshvis.visibility.check import RESCUE_RAYS, RESCUE_STREAM, self_check
 from meshvis.visibility.walls import walls
 
 
@@ -226,7 +226,7 @@ def _layers_by_sight(model, max_layers, region, budget, up, transparent, seed: i
         vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=asked, caster=caster)
         searches.append(vis)
         unseen = left & active & ~vis.seen
-        rescue = self_check(caster, bound, unseen, rays=CHECK_RAYS, seed=seed, stream=RESCUE_STREAM)
+        rescue = self_check(caster, bound, unseen, rays=RESCUE_RAYS, seed=seed, stream=RESCUE_STREAM)
         new = (vis.seen | rescue.seen) & left & active
         if not new.any():
             break

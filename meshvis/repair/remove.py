@@ -22,7 +22,7 @@ Sight passes the faces of see-through materials unless ``transparent="opaque"``
 (:mod:`meshvis.visibility.walls`): what shows through a windshield stays.  The cut does not
 look at materials.
 
-A removal by sight (``"view"``, ``"both"``) ends with a rescue pass: ``check_rays`` random
+A removal by sight (``"view"``, ``"both"``) ends with a rescue pass: ``rescue_rays`` random
 rays from every face it is about to remove, to random viewers of the region
 (:func:`meshvis.visibility.check.self_check` on the stream
 :data:`~meshvis.visibility.check.RESCUE_STREAM`); a face one of them sees from is kept.  The
@@ -58,6 +58,7 @@ from meshvis.repair.remove_modes import (
     DEFAULT_TRANSPARENT,
     DEFAULT_VISIBILITY,
     LEVELS,
+    RESCUE_RAYS,
     VISIBILITY_MODES,
     cut_rays_per_point,
     reuse_note,
@@ -110,7 +111,7 @@ class RemovalResult:
     see_through : int
         Faces that sight passed through (see-through materials)
     rescue : SelfCheck or None
-        The rescue pass (removal by sight; None otherwise or with ``check_rays=0``): its
+        The rescue pass (removal by sight; None otherwise or with ``rescue_rays=0``): its
         ``seen`` faces are kept.
     """
 
@@ -201,6 +202,7 @@ def remove_interior(
     transparent: str = DEFAULT_TRANSPARENT,
     check_rays: int = CHECK_RAYS,
     conservative: bool = False,
+    rescue_rays: int = RESCUE_RAYS,
     **classify_kw: Any,
 ) -> RemovalResult:
     """Remove the faces that cannot be seen from outside (or from ``region``).
@@ -236,13 +238,15 @@ def remove_interior(
         Whether faces of see-through materials let sight through
         (:mod:`meshvis.visibility.walls`), in the search and the self-check.
     check_rays : int
-        Random rays from every face in the rescue pass of a removal by sight, and fresh ones
-        from every removed face in the self-check (0: neither).
+        Fresh random rays from every removed face in the self-check (0: no check).
     conservative : bool
         Remove only the faces outside the conservative set from the viewpoints of
         ``region`` (``points:...`` or ``path:CAMERAS.json``;
         :func:`meshvis.visible_from` with ``conservative=True``): nothing visible from them
         is removed.  No cut; ``visibility`` is not used.
+    rescue_rays : int
+        Random rays from every face that a removal by sight (``"view"``, ``"both"``) is about
+        to remove; a face one of them sees from is kept (0: no rescue pass).
     **classify_kw
         Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
         in ``"both"`` an unset ``rays_per_point`` is ``rays_per_node // samples_per_face``
@@ -257,7 +261,7 @@ def remove_interior(
     ------
     ParameterError
         Unknown mode, level or ``transparent``, ``keep_border`` not an integer of at least 0,
-        a negative ``check_rays``, a budget below 1.
+        a negative ``check_rays`` or ``rescue_rays``, a budget below 1.
 
     Examples
     --------
@@ -281,6 +285,7 @@ def remove_interior(
         raise ParameterError(f"unknown level {level!r}; choose one of {', '.join(LEVELS)}")
     _validate.removal_args(keep_border, budget)
     check_rays = _validate.integer("check_rays", check_rays, 0)
+    rescue_rays = _validate.integer("rescue_rays", rescue_rays, 0)
     seed = int(classify_kw.get("seed", 0))
     progress = classify_kw.get("progress")  # of the cut, and of the search by sight
     c: Classification | None = None
@@ -318,14 +323,14 @@ def remove_interior(
             code = np.where(by_cut, _KEPT_CUT, np.where(vis.seen, _KEPT_RESCUED, _GONE_BOTH))
     code = code.astype(np.int8)
     check = rescue = None
-    by_rays = check_rays and not _is_cells(region)  # a PVS file's cells are judged by meshvis bench pvs
+    by_rays = (check_rays or rescue_rays) and not _is_cells(region)  # cells: judged by meshvis bench pvs
     bound = parse_region(region, up=up).bind(soup) if by_rays else None
-    if bound is not None and visibility in ("view", "both"):
-        rescue = self_check(caster, bound, ~keep, rays=check_rays, seed=seed, stream=RESCUE_STREAM)
+    if bound is not None and rescue_rays and visibility in ("view", "both"):
+        rescue = self_check(caster, bound, ~keep, rays=rescue_rays, seed=seed, stream=RESCUE_STREAM)
         code[rescue.seen] = _KEPT_RESCUE
         keep = keep | rescue.seen
     keep = _widen(soup, keep, code, level, int(keep_border))
-    if bound is not None:
+    if bound is not None and check_rays:
         check = self_check(caster, bound, ~keep, rays=check_rays, seed=seed)
     see_through = 0 if caster.walls is None else int((~caster.walls).sum())
     return RemovalResult(

@@ -9,9 +9,9 @@ they repeat nothing the search did.  A face one of them reaches was seen: it sho
 have been removed.  The check only reports; the removal stays what its method decided.
 The constants are read by the command line, which does not load the ray tracer for them.
 
-The same draw from another stream (:data:`RESCUE_STREAM`) is the removal's last pass by
-sight, the *rescue*: a face that is about to be removed and that one of its random rays
-reaches a viewer from is kept (:func:`meshvis.remove_interior`, :func:`meshvis.layers`).
+The same draw, :data:`RESCUE_RAYS` per face from another stream (:data:`RESCUE_STREAM`), is
+the removal's last pass by sight, the *rescue*: a face that is about to be removed and that
+one of its random rays reaches a viewer from is kept (:func:`meshvis.remove_interior`, :func:`meshvis.layers`).
 The check that is reported afterwards draws its own stream again, so it judges the removal
 with rays that the removal did not see.
 
@@ -36,6 +36,10 @@ CHECK_RAYS = 64
 #: the check's random stream: ``numpy.random.default_rng([seed, CHECK_STREAM])``, apart from
 #: the search's ``default_rng(seed)``
 CHECK_STREAM = 0x5E1FC4EC
+#: random rays from each face in the rescue pass: on a car of 3.9 k faces whose search left
+#: a face seen in 752 pixels per million of one view, 64 rays kept 1 face and the view stayed
+#: at 752, 256 kept 2 and brought it to 139, at 2-7 % of the removal's time
+RESCUE_RAYS = 256
 #: the rescue pass's random stream: ``numpy.random.default_rng([seed, RESCUE_STREAM])``
 RESCUE_STREAM = 0x2E5C0E
 #: rays traced per batch (bounded memory, about 200 bytes a ray)

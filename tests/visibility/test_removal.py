@@ -83,6 +83,8 @@ def test_bad_removal_arguments(scenes):
         remove_interior(cube, transparent="glass")
     with pytest.raises(ParameterError, match="check_rays"):
         remove_interior(cube, check_rays=-1)
+    with pytest.raises(ParameterError, match="rescue_rays"):
+        remove_interior(cube, rescue_rays=-1)
 
 
 def test_cli_flags_of_remove_interior_and_visible(scenes, tmp_path, capsys):

@@ -284,12 +284,13 @@ def test_the_rescue_pass_keeps_what_the_search_missed(scenes):
     r = remove_interior(cube, view=vis, seed=0)
     assert r.keep.all() and r.rescue.seen.tolist() == [i == 3 for i in range(12)]
     assert r.reason[3] == "kept: a ray of the rescue pass saw it"
-    assert r.check.faces == 0 and any("found a view of 1 of them (kept)" in line for line in r.summary())
+    assert r.check.faces == 0 and r.rescue.rays_per_face == 256
+    assert any("found a view of 1 of them (kept)" in line for line in r.summary())
     assert r.report(per_face=False)["rescue"]["faces_seen"] == 1
-    assert not remove_interior(cube, view=vis, seed=0, check_rays=0).keep[3]  # no rescue: removed
+    assert not remove_interior(cube, view=vis, seed=0, rescue_rays=0).keep[3]  # no rescue: removed
     # a search cut short by its budget misses faces in view; the rescue sees each of them
     soup, _, truth = scenes.slot_box()
-    short = remove_interior(soup, seed=0, budget=200, check_rays=0)
+    short = remove_interior(soup, seed=0, budget=200, rescue_rays=0)
     assert short.visibility.stopped == "budget" and short.keep.sum() < soup.n_faces
     r = remove_interior(soup, seed=0, budget=200)
     assert r.keep.all() and r.rescue.seen.sum() == soup.n_faces - short.keep.sum()
