@@ -191,7 +191,7 @@ def removal_options(p: argparse.ArgumentParser) -> None:
     """Add the options of inside removal by sight to the ``remove-interior`` parser.
 
     The options are ``--visibility``, ``--from``, ``--budget``, ``--transparent``,
-    ``--check-rays``, ``--level``, ``--keep-border`` and ``--conservative``, with the defaults of
+    ``--check-rays``, ``--rescue-rays``, ``--level``, ``--keep-border`` and ``--conservative``, with the defaults of
     :func:`meshvis.remove_interior`.
 
     Parameters
@@ -216,6 +216,14 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         default=d["check_rays"],
         metavar="N",
         help="self-check: fresh random rays from every removed face, reported (0: no check)",
+    )
+    p.add_argument(
+        "--rescue-rays",
+        type=int,
+        default=d["rescue_rays"],
+        metavar="N",
+        help="rescue pass (view and both): random rays from every face the search did not see; a face one "
+        "of them sees from is kept (0: no rescue)",
     )
     p.add_argument(
         "--level",

@@ -5,7 +5,10 @@
   :func:`meshvis.remove_interior` keeps); layer *k* is every face such a search sees once
   layers 1 .. k-1 are taken out of the scene (the search asks about the remaining faces
   only, and rays pass where the peeled faces were).  The faces no search sees form the last
-  bucket, ``n_layers + 1``.
+  bucket, ``n_layers + 1``.  Each layer's search ends with the removal's rescue pass
+  (:data:`~meshvis.visibility.check.RESCUE_RAYS` random rays from every face left that it did
+  not see; a face one of them sees from joins the layer), so layer 1 is the default
+  removal's kept faces.
 * ``visibility="object"`` (the paper's "Layer Computation"): layer 1 is every face with an
   outside side after the first cut.  Then the nodes of the layer-1 faces (in particular
   their inside nodes) are tied to the source and the graph is cut again: what becomes
@@ -29,7 +32,8 @@ from meshvis.io import as_soup
 from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.repair.remove_modes import DEFAULT_LAYER_VISIBILITY, DEFAULT_TRANSPARENT, LAYER_MODES
 from meshvis.soup import Soup
-from meshvis.visibility import Visibility, visible_from
+from meshvis.visibility import Visibility, parse_region, visible_from
+from meshvis.visibility.check import RESCUE_RAYS, RESCUE_STREAM, self_check
 from meshvis.visibility.walls import walls
 
 
@@ -211,6 +215,7 @@ def _layers_by_sight(model, max_layers, region, budget, up, transparent, seed: i
     layer = np.zeros(m, np.int64)
     outer_side = np.full(m, -1, np.int8)
     active = soup.areas > 0  # a face of zero area is never seen
+    bound = parse_region(region, up=up).bind(soup)
     searches: list[Visibility] = []
     k = 0
     while (layer[active] == 0).any() and (max_layers is None or k < max_layers):
@@ -220,12 +225,14 @@ def _layers_by_sight(model, max_layers, region, budget, up, transparent, seed: i
         asked = None if k == 0 else left & active
         vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=asked, caster=caster)
         searches.append(vis)
-        new = vis.seen & left & active
+        unseen = left & active & ~vis.seen
+        rescue = self_check(caster, bound, unseen, rays=RESCUE_RAYS, seed=seed, stream=RESCUE_STREAM)
+        new = (vis.seen | rescue.seen) & left & active
         if not new.any():
             break
         k += 1
         layer[new] = k
-        seen = vis.seen_side[new]
+        seen = (vis.seen_side | rescue.seen_side)[new]
         outer_side[new] = np.where(seen.all(axis=1), 2, np.argmax(seen, axis=1))
         if progress is not None:
             progress(k, int((layer > 0).sum()), m)

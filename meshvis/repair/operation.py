@@ -61,6 +61,7 @@ OPERATION_OPTIONS: dict[str, dict[str, tuple[str, str]]] = {
         "up": (REMOVE, "up"),
         "transparent": (REMOVE, "transparent"),
         "check_rays": (REMOVE, "check_rays"),
+        "rescue_rays": (REMOVE, "rescue_rays"),
         "conservative": (REMOVE, "conservative"),
     },
     "layers": {
@@ -437,6 +438,7 @@ def removal_kwargs(options: Mapping[str, Any] | Any, soup) -> dict[str, Any]:
         seed=int(o["seed"]),
         transparent=o["transparent"],
         check_rays=int(o["check_rays"]),
+        rescue_rays=int(o["rescue_rays"]),
         conservative=bool(o["conservative"]),
     )
 

@@ -22,9 +22,15 @@ Sight passes the faces of see-through materials unless ``transparent="opaque"``
 (:mod:`meshvis.visibility.walls`): what shows through a windshield stays.  The cut does not
 look at materials.
 
-Every removal ends with a self-check (:func:`meshvis.visibility.check.self_check`):
-``check_rays`` fresh random rays from every removed face; the report says how many removed
-faces and how much of their area one of them saw.
+A removal by sight (``"view"``, ``"both"``) ends with a rescue pass: ``rescue_rays`` random
+rays from every face it is about to remove, to random viewers of the region
+(:func:`meshvis.visibility.check.self_check` on the stream
+:data:`~meshvis.visibility.check.RESCUE_STREAM`); a face one of them sees from is kept.  The
+search stops once new views have become rare, and a small face seen through a narrow gap
+can be one it never aimed at often enough; the rescue gives every such face the same number
+of rays of its own.  Every removal then ends with a self-check: ``check_rays`` fresh random
+rays from every removed face, from another stream than the rescue's; the report says how
+many removed faces and how much of their area one of them saw.
 
 ``level="patch"`` or ``"part"`` removes a connected patch (faces sharing edges) or a named
 part only when all its faces are hidden; ``keep_border=N`` keeps N rings of hidden faces
@@ -52,13 +58,14 @@ from meshvis.repair.remove_modes import (
     DEFAULT_TRANSPARENT,
     DEFAULT_VISIBILITY,
     LEVELS,
+    RESCUE_RAYS,
     VISIBILITY_MODES,
     cut_rays_per_point,
     reuse_note,
 )
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, parse_region, visible_from
-from meshvis.visibility.check import SelfCheck, self_check
+from meshvis.visibility.check import RESCUE_STREAM, SelfCheck, self_check
 from meshvis.visibility.walls import walls
 
 #: reason of each face, by code
@@ -73,9 +80,10 @@ REASONS = (
     "removed: hidden by the cut and no view of it was found",
     "kept: may be seen from the region (conservative set)",
     "removed: surely hidden from the region (outside the conservative set)",
+    "kept: a ray of the rescue pass saw it",
 )
 _KEPT_CUT, _KEPT_SEEN, _KEPT_RESCUED, _KEPT_GROUP, _KEPT_BORDER, _GONE_CUT, _GONE_VIEW, _GONE_BOTH = range(8)
-_KEPT_MAY, _GONE_SURELY = 8, 9
+_KEPT_MAY, _GONE_SURELY, _KEPT_RESCUE = 8, 9, 10
 
 
 @dataclass
@@ -102,6 +110,9 @@ class RemovalResult:
         The self-check of the removed faces (None with ``check_rays=0``)
     see_through : int
         Faces that sight passed through (see-through materials)
+    rescue : SelfCheck or None
+        The rescue pass (removal by sight; None otherwise or with ``rescue_rays=0``): its
+        ``seen`` faces are kept.
     """
 
     kept: Soup
@@ -114,6 +125,7 @@ class RemovalResult:
     soup: Soup
     check: SelfCheck | None = None
     see_through: int = 0
+    rescue: SelfCheck | None = None
 
     @property
     def reason(self) -> list[str]:
@@ -132,6 +144,8 @@ class RemovalResult:
             "reasons": {REASONS[c]: int(n) for c, n in zip(*np.unique(self.reason_code, return_counts=True))},
             "see_through_faces": self.see_through,
         }
+        if self.rescue is not None:
+            d["rescue"] = self.rescue.report()
         if self.check is not None:
             d["self_check"] = self.check.report()
         if self.classification is not None:
@@ -164,6 +178,11 @@ class RemovalResult:
                 f"the search for views stopped at its ray budget ({self.visibility.rays['total']} rays) "
                 "before its stop rule: some removed faces may be visible (raise --budget)"
             )
+        if self.rescue is not None:
+            lines.append(
+                f"rescue: {self.rescue.rays_per_face} random rays from each of {self.rescue.faces} faces the "
+                f"search did not see found a view of {int(self.rescue.seen.sum())} of them (kept)"
+            )
         if self.check is not None:
             lines.append(self.check.summary())
         return lines
@@ -183,6 +202,7 @@ def remove_interior(
     transparent: str = DEFAULT_TRANSPARENT,
     check_rays: int = CHECK_RAYS,
     conservative: bool = False,
+    rescue_rays: int = RESCUE_RAYS,
     **classify_kw: Any,
 ) -> RemovalResult:
     """Remove the faces that cannot be seen from outside (or from ``region``).
@@ -224,6 +244,9 @@ def remove_interior(
         ``region`` (``points:...`` or ``path:CAMERAS.json``;
         :func:`meshvis.visible_from` with ``conservative=True``): nothing visible from them
         is removed.  No cut; ``visibility`` is not used.
+    rescue_rays : int
+        Random rays from every face that a removal by sight (``"view"``, ``"both"``) is about
+        to remove; a face one of them sees from is kept (0: no rescue pass).
     **classify_kw
         Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
         in ``"both"`` an unset ``rays_per_point`` is ``rays_per_node // samples_per_face``
@@ -238,7 +261,7 @@ def remove_interior(
     ------
     ParameterError
         Unknown mode, level or ``transparent``, ``keep_border`` not an integer of at least 0,
-        a negative ``check_rays``, a budget below 1.
+        a negative ``check_rays`` or ``rescue_rays``, a budget below 1.
 
     Examples
     --------
@@ -262,6 +285,7 @@ def remove_interior(
         raise ParameterError(f"unknown level {level!r}; choose one of {', '.join(LEVELS)}")
     _validate.removal_args(keep_border, budget)
     check_rays = _validate.integer("check_rays", check_rays, 0)
+    rescue_rays = _validate.integer("rescue_rays", rescue_rays, 0)
     seed = int(classify_kw.get("seed", 0))
     progress = classify_kw.get("progress")  # of the cut, and of the search by sight
     c: Classification | None = None
@@ -298,14 +322,29 @@ def remove_interior(
             keep = by_cut | vis.seen
             code = np.where(by_cut, _KEPT_CUT, np.where(vis.seen, _KEPT_RESCUED, _GONE_BOTH))
     code = code.astype(np.int8)
+    check = rescue = None
+    by_rays = (check_rays or rescue_rays) and not _is_cells(region)  # cells: judged by meshvis bench pvs
+    bound = parse_region(region, up=up).bind(soup) if by_rays else None
+    if bound is not None and rescue_rays and visibility in ("view", "both"):
+        rescue = self_check(caster, bound, ~keep, rays=rescue_rays, seed=seed, stream=RESCUE_STREAM)
+        code[rescue.seen] = _KEPT_RESCUE
+        keep = keep | rescue.seen
     keep = _widen(soup, keep, code, level, int(keep_border))
-    check = None
-    if check_rays and not _is_cells(region):  # a PVS file's cells are judged by meshvis bench pvs
-        bound = parse_region(region, up=up).bind(soup)
+    if bound is not None and check_rays:
         check = self_check(caster, bound, ~keep, rays=check_rays, seed=seed)
     see_through = 0 if caster.walls is None else int((~caster.walls).sum())
     return RemovalResult(
-        soup.subset(keep), soup.subset(~keep), keep, c, vis, code, visibility, soup, check, see_through
+        soup.subset(keep),
+        soup.subset(~keep),
+        keep,
+        c,
+        vis,
+        code,
+        visibility,
+        soup,
+        check,
+        see_through,
+        rescue,
     )
 
 

@@ -12,7 +12,7 @@ engine block open at one end, which no viewer sees; ``both`` removes only what t
 
 from __future__ import annotations
 
-from meshvis.visibility.check import CHECK_RAYS
+from meshvis.visibility.check import CHECK_RAYS, RESCUE_RAYS
 from meshvis.visibility.walls import DEFAULT_TRANSPARENT, TRANSPARENT_MODES
 
 #: what decides that a face is hidden: the graph cut, lines of sight, or both together
@@ -34,6 +34,7 @@ __all__ = [
     "DEFAULT_VISIBILITY",
     "LAYER_MODES",
     "LEVELS",
+    "RESCUE_RAYS",
     "TRANSPARENT_MODES",
     "VISIBILITY_MODES",
     "cut_rays_per_point",

@@ -78,11 +78,13 @@ def test_bad_removal_arguments(scenes):
     for kw in ({"visibility": "sight"}, {"level": "object"}, {"keep_border": -1}):
         with pytest.raises(ParameterError):
             remove_interior(cube, **kw)
-    assert len(REASONS) == 10
+    assert len(REASONS) == 11
     with pytest.raises(ParameterError, match="transparent"):
         remove_interior(cube, transparent="glass")
     with pytest.raises(ParameterError, match="check_rays"):
         remove_interior(cube, check_rays=-1)
+    with pytest.raises(ParameterError, match="rescue_rays"):
+        remove_interior(cube, rescue_rays=-1)
 
 
 def test_cli_flags_of_remove_interior_and_visible(scenes, tmp_path, capsys):

@@ -12,10 +12,12 @@ import trimesh
 
 from meshvis.cli.main import main
 from meshvis.io import load, save
+from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
 from meshvis.repair.layers import layers
 from meshvis.repair.remove import remove_interior
 from meshvis.soup import Material, Soup
-from meshvis.visibility import visible_from
+from meshvis.visibility import parse_region, visible_from
+from meshvis.visibility.check import self_check
 
 from .conftest import box_faces, quad
 
@@ -257,22 +259,48 @@ def test_the_layers_command_peels_by_sight_or_by_the_cut(tmp_path):
 
 def test_the_self_check_catches_a_planted_visible_face(scenes):
     cube, names = scenes.unit_cube()
-    vis = visible_from(cube, seed=0)
-    assert vis.seen.all()
-    vis.seen_side[3] = False  # plant: the search "missed" a face every viewer sees
-    r = remove_interior(cube, view=vis, seed=0)
-    assert not r.keep[3] and r.keep.sum() == 11
-    assert r.check.seen.tolist() == [i == 3 for i in range(12)]
-    assert r.check.seen_area_fraction == 1.0 and r.check.rays == 64
-    assert "saw 1 of them (100 % of the removed area)" in r.summary()[-1]
+    removed = np.zeros(12, bool)
+    removed[3] = True  # plant: a removal that took away a face every viewer sees
+    caster = RayCaster(cube, offset=VISIBILITY_OFFSET)
+    check = self_check(caster, parse_region("outside").bind(cube), removed, seed=0)
+    assert check.seen.tolist() == [i == 3 for i in range(12)]
+    assert check.seen_area_fraction == 1.0 and check.rays == 64 and check.faces == 1
+    assert "saw 1 of them (100 % of the removed area)" in check.summary()
     # an honest removal: the check sees none of the removed faces
     soup, bottom, truth = scenes.sealed_pocket()
     honest = remove_interior(soup, seed=0)
     assert honest.check.faces == 2 and not honest.check.seen.any()
     assert remove_interior(soup, seed=0, check_rays=0).check is None
     # the check draws its own random stream: the same seed gives the same check
-    again = remove_interior(cube, view=vis, seed=0)
-    np.testing.assert_array_equal(again.check.seen, r.check.seen)
+    again = self_check(caster, parse_region("outside").bind(cube), removed, seed=0)
+    np.testing.assert_array_equal(again.seen, check.seen)
+
+
+def test_the_rescue_pass_keeps_what_the_search_missed(scenes):
+    cube, names = scenes.unit_cube()
+    vis = visible_from(cube, seed=0)
+    assert vis.seen.all()
+    vis.seen_side[3] = False  # plant: the search "missed" a face every viewer sees
+    r = remove_interior(cube, view=vis, seed=0)
+    assert r.keep.all() and r.rescue.seen.tolist() == [i == 3 for i in range(12)]
+    assert r.reason[3] == "kept: a ray of the rescue pass saw it"
+    assert r.check.faces == 0 and r.rescue.rays_per_face == 256
+    assert any("found a view of 1 of them (kept)" in line for line in r.summary())
+    assert r.report(per_face=False)["rescue"]["faces_seen"] == 1
+    assert not remove_interior(cube, view=vis, seed=0, rescue_rays=0).keep[3]  # no rescue: removed
+    # a search cut short by its budget misses faces in view; the rescue sees each of them
+    soup, _, truth = scenes.slot_box()
+    short = remove_interior(soup, seed=0, budget=200, rescue_rays=0)
+    assert short.visibility.stopped == "budget" and short.keep.sum() < soup.n_faces
+    r = remove_interior(soup, seed=0, budget=200)
+    assert r.keep.all() and r.rescue.seen.sum() == soup.n_faces - short.keep.sum()
+    assert not r.check.seen.any()
+    # layers by sight end every layer with the same pass: layer 1 is the removal's kept faces
+    assert (layers(soup, seed=0, budget=200).layer == 1).all()
+    # "both": the cut proposes, the search and then the rescue may keep
+    both = remove_interior(soup, visibility="both", seed=0, budget=200)
+    assert both.keep.all() and both.rescue is not None
+    assert remove_interior(soup, visibility="object", seed=0).rescue is None  # the cut alone: no rescue
 
 
 def test_every_mode_runs_the_self_check(scenes):

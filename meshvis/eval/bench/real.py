@@ -6,7 +6,7 @@ their stop rules off saw: :func:`meshvis.eval.reference.hidden`), both cached; t
 
 * the default removal (:func:`meshvis.remove_interior`, by sight) at every seed of
   ``--seeds``: removed area, share of the hidden area removed (also once the faces that any
-  seed's search saw, which are visible, are taken out of the estimate), false pixels per million
+  seed's search or rescue pass saw, which are visible, are taken out of the estimate), false pixels per million
   (mean and worst of the views, and for scenes on the ground the views from above), the
   self-check, rays, time and why the search stopped;
 * at the first seed: the cut (``object``), ``both``, random sampling with the rays of the
@@ -328,22 +328,24 @@ def run_model(
         t = time.perf_counter()
         r = remove_interior(soup, seed=s)
         seconds = time.perf_counter() - t
-        vis, check = r.visibility, r.check
+        vis, check, rescue = r.visibility, r.check, r.rescue
         default_rows.append(
             judge(
                 f"default (view), seed {s}",
                 r.keep,
-                vis.rays["total"] + check.rays,
+                vis.rays["total"] + rescue.rays + check.rays,
                 seconds,
                 seed=s,
                 stopped=vis.stopped,
+                rescued_faces=int(rescue.seen.sum()),
                 check_faces_seen=int(check.seen.sum()),
                 check_area=check.seen_area_fraction,
                 check_share_of_time=check.seconds / max(seconds, 1e-9),
+                rescue_share_of_time=rescue.seconds / max(seconds, 1e-9),
             )
         )
         keeps.append(r.keep)
-        seen_any |= vis.seen
+        seen_any |= vis.seen | rescue.seen
         if first is None:
             first = (r, seconds)
     r0, t_default = first
@@ -619,7 +621,8 @@ def format_model(r: dict) -> str:
         lines.append(
             _row(x, x["method"])
             + f"  {x['stopped']}; {100 * x.get('hidden_removed_all_searches', np.nan):.1f} % against every seed's"
-            f" search; check saw {x['check_faces_seen']} faces ({100 * x['check_area']:.2g} %),"
+            f" search; rescue kept {x.get('rescued_faces', 0)} faces ({100 * x.get('rescue_share_of_time', 0):.0f} %"
+            f" of the time); check saw {x['check_faces_seen']} faces ({100 * x['check_area']:.2g} %),"
             f" {100 * x['check_share_of_time']:.0f} % of the time"
         )
     if "layers" in r:
