@@ -136,6 +136,7 @@ def place_boxes(
         directions,
         centres,
         lines,
+        leaders,
     )
     endpoints_in = ctx.endpoints.copy()
     for side in (WEST, EAST):

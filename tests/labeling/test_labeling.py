@@ -914,6 +914,56 @@ def test_coherence_test_fails_when_the_previous_frame_is_ignored(assembly_soup, 
         test_coherence_halves_label_motion_along_an_orbit(assembly_soup)
 
 
+def _side_change_frames(assembly_soup) -> list[int]:
+    """Labels changing side in each transition of 12 steps of 5 degrees (left-right, 256 px)."""
+    cams = orbit(assembly_soup, 72, up=(0, 1, 0))[:13]
+    res = layout_frames(assembly_soup, cams, layout="left-right", size=(256, 256))
+    out = []
+    for a, b in zip(res[:-1], res[1:]):
+        pa, pb = a.by_part(), b.by_part()
+        out.append(sum(pa[p].side != pb[p].side for p in set(pa) & set(pb)))
+    return out
+
+
+@pytest.mark.slow
+def test_side_changes_come_in_one_frame(assembly_soup, monkeypatch):
+    """Labels nearer their other side change with the one that has to: one jumpy frame, not several.
+
+    With batching off (SIDE_BATCH = SIDE_KEEP) the same orbit changes sides in two frames.
+    """
+    from meshvis.labeling import pipeline
+
+    batched = _side_change_frames(assembly_soup)
+    assert sum(n > 0 for n in batched) == 1 and max(batched) >= 2
+    monkeypatch.setattr(pipeline, "SIDE_BATCH", pipeline.SIDE_KEEP)
+    alone = _side_change_frames(assembly_soup)
+    assert sum(n > 0 for n in alone) > sum(n > 0 for n in batched)
+
+
+def test_flag_boxes_keep_their_direction_while_the_port_crosses_the_centre():
+    """A row's flags split left/right where the fewest turn against last frame (centre rule without one)."""
+    from types import SimpleNamespace
+
+    from meshvis.labeling.boxes.stacking import _flag_split
+
+    ports = np.array([80.0, 95.0, 105.0, 120.0, 160.0])
+    idx = np.arange(5)
+    fresh = SimpleNamespace(
+        center=np.array([100.0, 50.0]), leaders=[None] * 5, centres=np.full((5, 2), np.nan)
+    )
+    assert _flag_split(fresh, idx, ports).tolist() == [True, True, False, False, False]
+    # last frame: the first four flags pointed left of their ports, the last one right
+    before = SimpleNamespace(
+        center=np.array([100.0, 50.0]),
+        leaders=[np.array([[x, 10.0]]) for x in ports],
+        centres=np.column_stack([ports + np.array([-30.0, -30.0, -30.0, -30.0, 30.0]), np.full(5, 5.0)]),
+    )
+    assert _flag_split(before, idx, ports).tolist() == [True, True, True, True, False]
+    # flags point apart (no left one right of a right one): the split turning one flag wins
+    before.centres[1, 0] = ports[1] + 30.0
+    assert _flag_split(before, idx, ports).tolist() == [True, True, True, True, False]
+
+
 def test_orbit_coherence_counts_jumps_and_side_changes(buffers):
     from meshvis.labeling.metrics import orbit_coherence
 
