@@ -32,7 +32,7 @@ from meshvis.soup import Soup
 
 from .boxes import Spacing, place_boxes
 from .candidates import LAYOUTS, SIDE_NAMES, check_layout, is_horizontal, leader_candidates
-from .greedy import greedy_layout
+from .greedy import greedy_layout, stable_order
 from .idbuffer import IdBuffer, id_buffer
 from .inputs import label_texts, load_models
 from .internal_area import internal_area
@@ -341,7 +341,7 @@ def _pixels(idbuf: IdBuffer, cand, dist_sil: np.ndarray, labelled: np.ndarray, n
     pix = np.flatnonzero(ids_flat >= 0)
     pix = pix[slot[ids_flat[pix]] >= 0]
     area_of = slot[ids_flat[pix]]
-    order = np.argsort(area_of, kind="stable")
+    order = stable_order(area_of)
     pix, area_of = pix[order], area_of[order]
     row, col = np.divmod(pix, w)
     return _Pixels(
