@@ -964,6 +964,27 @@ def test_flag_boxes_keep_their_direction_while_the_port_crosses_the_centre():
     assert _flag_split(before, idx, ports).tolist() == [True, True, True, True, False]
 
 
+def test_silhouette_leaders_leave_where_they_left_last_frame():
+    """An anchor near the middle keeps last frame's side of the boundary while within RADIAL_KEEP."""
+    from types import SimpleNamespace
+
+    from meshvis.labeling.boxes.place import RADIAL_KEEP, _keep_radial_endpoints
+
+    t = np.linspace(0.0, 100.0, 51)
+    pts = np.concatenate(
+        [np.column_stack([np.zeros_like(t), t]), np.column_stack([np.full_like(t, 100.0), t])]
+    )
+    anchors = np.array([[45.0, 50.0], [10.0, 50.0]])  # the nearest boundary is the left side for both
+    ctx = SimpleNamespace(
+        boundary=(pts, None), anchors=anchors, endpoints=np.array([[0.0, 50.0], [0.0, 50.0]]), _rays=0
+    )
+    # last frame both left on the right side (moved with the anchor: a point near it)
+    _keep_radial_endpoints(ctx, np.array([0, 1]), [np.array([[101.0, 52.0]]), np.array([[99.0, 50.0]])])
+    assert ctx.endpoints[0].tolist() == [100.0, 52.0]  # 55 px against 45: kept
+    assert ctx.endpoints[1].tolist() == [0.0, 50.0]  # 90 px against 10: more than RADIAL_KEEP times
+    assert 55 / 45 <= RADIAL_KEEP < 90 / 10 and ctx._rays is None
+
+
 def test_orbit_coherence_counts_jumps_and_side_changes(buffers):
     from meshvis.labeling.metrics import orbit_coherence
 
