@@ -893,7 +893,7 @@ def test_coherence_halves_label_motion_along_an_orbit(assembly_soup):
     """Coherent frames move their labels less than half as much, and change side less often.
 
     Switched off (frames laid out alone), both numbers are those of the free run, so the
-    test fails; on this orbit coherence gives motion 2.9x the surface's, free frames 7.6x.
+    test fails; on this orbit coherence gives motion 2.9x the surface's, free frames 7.3x.
     """
     on = _orbit_coherence(assembly_soup, True)
     off = _orbit_coherence(assembly_soup, False)
