@@ -14,13 +14,10 @@ Routes (all on 127.0.0.1 only):
                       "height", "format", "camera": {"position", "target", "up", "fov"}}``, body =
                       the ID buffer, ``"rgba"`` bytes (:func:`meshvis.labeling.live.ids_from_rgba`)
                       or ``"u16"`` (:func:`meshvis.labeling.live.ids_from_u16`);
-                      answers :func:`meshvis.labeling.live.frame_json`, or ``{"seq", "stale":
-                      true}`` without a layout when the viewer's newer frame came first
+                      answers :func:`meshvis.labeling.live.frame_json`
 
-Layouts are made one at a time (one lock around the layout).  A page keeps up to two
-frames in flight, so the server lays out the next frame while the page reads and draws
-the answer to the previous one; a frame older than one already laid out for its viewer
-is answered as stale (its layout would be out of date, and coherence runs forward only).
+Requests are answered one at a time (one lock around the layout): a frame takes a few
+milliseconds and a page waits for its answer before it sends the next one.
 """
 
 from __future__ import annotations
@@ -30,7 +27,6 @@ import json
 import os
 import threading
 import time
-from collections import OrderedDict
 from http.server import BaseHTTPRequestHandler, ThreadingHTTPServer
 from pathlib import Path
 from typing import Any
@@ -40,7 +36,7 @@ import numpy as np
 from meshvis.errors import MeshvisError, ParameterError
 from meshvis.rays.camera import Camera
 
-from .live import MAX_SIDE, MAX_VIEWERS, LiveLabeler, frame_json, ids_from_rgba, ids_from_u16
+from .live import MAX_SIDE, LiveLabeler, frame_json, ids_from_rgba, ids_from_u16
 
 #: the page and its scripts, inside the installed package
 WEB = Path(__file__).resolve().parent / "web"
@@ -149,9 +145,6 @@ class ViewServer:
         }
         self._lock = threading.Lock()
         self.frames = 0
-        self.stale = 0
-        # the newest frame number laid out per viewer (frames older than it are stale)
-        self._newest: OrderedDict[str, int] = OrderedDict()
         self.httpd = ThreadingHTTPServer((HOST, int(port)), self._handler())
         self.httpd.daemon_threads = True
         self._thread: threading.Thread | None = None
@@ -187,18 +180,10 @@ class ViewServer:
             raise ParameterError(f"unknown ID buffer format {fmt!r}")
         ids = (ids_from_u16 if fmt == "u16" else ids_from_rgba)(body, width, height)
         camera = _camera(header.get("camera"))
-        viewer, seq = str(header.get("viewer", ""))[:64], int(header.get("seq", 0))
         with self._lock:
-            if seq <= self._newest.get(viewer, -1):
-                self.stale += 1
-                return {"seq": seq, "stale": True}
-            self._newest[viewer] = seq
-            self._newest.move_to_end(viewer)
-            while len(self._newest) > MAX_VIEWERS:
-                self._newest.popitem(last=False)
-            result = self.live.frame(ids, camera, viewer)
+            result = self.live.frame(ids, camera, str(header.get("viewer", ""))[:64])
             self.frames += 1
-        answer = frame_json(result, seq)
+        answer = frame_json(result, int(header.get("seq", 0)))
         answer["serverMs"] = round(1000.0 * (time.perf_counter() - t0), 3)
         return answer
 

@@ -108,10 +108,7 @@ function resize() {
 }
 
 // ------------------------------------------------------------------ frames to the server
-// up to two frames in flight: the server lays out the next one while the page takes in
-// the answer to the previous one; answers older than the newest one taken are dropped
-const MAX_IN_FLIGHT = 2;
-let dirty = true, inFlight = 0, resized = true, seq = 0, newest = 0, lastSent = null;
+let dirty = true, inFlight = false, resized = true, seq = 0;
 const state = { labels: new Map(), scale: 1, fontSize: 11, boxHeight: 16, layoutMs: 0 };
 const stats = { received: [], answers: [], sent: 0, errors: 0, timing: [] };
 controls.addEventListener('change', () => { dirty = true; });
@@ -134,7 +131,7 @@ function renderIds() {
 
 async function requestLayout() {
   dirty = false;
-  inFlight++;
+  inFlight = true;
   const t0 = performance.now();
   const [iw, ih] = renderIds();
   const t1 = performance.now();
@@ -145,7 +142,7 @@ async function requestLayout() {
       up: camera.up.toArray(), fov: camera.fov,
     },
   };
-  lastSent = camera.matrixWorld.clone();
+  const sentCamera = camera.matrixWorld.clone();
   stats.sent++;
   try {
     const res = await fetch('layout', {
@@ -153,8 +150,6 @@ async function requestLayout() {
     });
     const answer = await res.json();
     if (!res.ok) throw new Error(answer.error);
-    if (answer.stale || answer.seq <= newest) return;
-    newest = answer.seq;
     accept(answer, iw);
     stats.timing.push({ ids: t1 - t0, answer: performance.now() - t1, layout: answer.layoutMs, server: answer.serverMs });
     if (stats.timing.length > 200) stats.timing.shift();
@@ -162,8 +157,8 @@ async function requestLayout() {
     stats.errors++;
     status.textContent = `error: ${err.message}`;
   } finally {
-    inFlight--;
-    if (!camera.matrixWorld.equals(lastSent)) dirty = true;
+    inFlight = false;
+    if (!camera.matrixWorld.equals(sentCamera)) dirty = true;
   }
 }
 
@@ -266,7 +261,7 @@ function animate() {
     drawn = camera.matrixWorld.clone();
     resized = false;
   }
-  if (dirty && inFlight < MAX_IN_FLIGHT) requestLayout();
+  if (dirty && !inFlight) requestLayout();
   drawLabels();
   showStatus();
   requestAnimationFrame(animate);
@@ -283,5 +278,5 @@ function turn(degrees) {
 window.addEventListener('resize', resize);
 resize();
 fitCamera();
-window.meshvisView = { stats, turn, idle: () => !dirty && inFlight === 0, labels: () => state.labels.size };
+window.meshvisView = { stats, turn, idle: () => !dirty && !inFlight, labels: () => state.labels.size };
 animate();
