@@ -194,6 +194,13 @@ def _shortest(
 
     def offer(code: int, length: np.ndarray, bx: np.ndarray, by: np.ndarray, k: np.ndarray) -> None:
         offers.append((code, length, bx, by, k))
+        if len(sides) == 1:  # one direction: its candidate is every inside pixel's (NaN / -1 outside)
+            best[...] = np.where(mask, length, np.inf)
+            ex[...] = np.where(mask, bx, np.nan)
+            ey[...] = np.where(mask, by, np.nan)
+            key[...] = np.where(mask, k, -1)
+            side[...] = np.where(mask, code, -1)
+            return
         # strictly shorter wins, so the first direction listed wins ties
         better = mask & (length < best)
         best[better] = length[better]

@@ -44,6 +44,19 @@ from ._kernels import lower_f4_near
 from .membership import dist_threshold
 
 
+def stable_order(keys: np.ndarray) -> np.ndarray:
+    """``np.argsort(keys, kind="stable")`` of small non-negative integers, faster.
+
+    Keys below 2**15 are sorted as int16, for which numpy's stable sort is a radix sort
+    (about 4x faster on the pixels of a frame than the merge sort of int64 keys); the
+    order is the same.
+    """
+    keys = np.asarray(keys)
+    if len(keys) and keys.min() >= 0 and keys.max() < np.iinfo(np.int16).max:
+        keys = keys.astype(np.int16)
+    return np.argsort(keys, kind="stable")
+
+
 class _Buckets:
     """Indices of points grouped by grid cell, for "points within d of p" queries.
 
@@ -59,7 +72,7 @@ class _Buckets:
         self.nx = int(self.cx.max()) - self.x0 + 1
         self.ny = int(self.cy.max()) - self.y0 + 1
         key = (self.cy - self.y0) * self.nx + (self.cx - self.x0)
-        self.order = np.argsort(key, kind="stable")
+        self.order = stable_order(key)
         self.start = np.searchsorted(key[self.order], np.arange(self.nx * self.ny + 1))
         self.grid = np.array([self.cell, self.x0, self.y0, self.nx, self.ny], np.float64)
 

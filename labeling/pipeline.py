@@ -32,7 +32,7 @@ from meshvis.soup import Soup
 
 from .boxes import Spacing, place_boxes
 from .candidates import LAYOUTS, SIDE_NAMES, check_layout, is_horizontal, leader_candidates
-from .greedy import greedy_layout
+from .greedy import greedy_layout, stable_order
 from .idbuffer import IdBuffer, id_buffer
 from .inputs import label_texts, load_models
 from .internal_area import internal_area
@@ -116,7 +116,11 @@ def _fit_font(
 #: surface) unless a candidate is more than ANCHOR_KEEP times as feasible, and keeps its
 #: side unless the other side's leader is shorter by more than the factor SIDE_KEEP
 ANCHOR_KEEP = 4.0
-SIDE_KEEP = 3.0
+SIDE_KEEP = 5.0
+#: side changes come together: in a frame where some label changes side, every label
+#: whose other side is shorter by more than this factor changes too.  A viewer sees one
+#: rearrangement instead of one label after another over the next frames
+SIDE_BATCH = 1.5
 #: how far an anchor may slide over its part from one frame to the next, as a fraction of
 #: ``d_S`` (and at least ANCHOR_DRIFT_PX): it creeps towards better places instead of jumping
 ANCHOR_DRIFT = 0.01
@@ -337,7 +341,7 @@ def _pixels(idbuf: IdBuffer, cand, dist_sil: np.ndarray, labelled: np.ndarray, n
     pix = np.flatnonzero(ids_flat >= 0)
     pix = pix[slot[ids_flat[pix]] >= 0]
     area_of = slot[ids_flat[pix]]
-    order = np.argsort(area_of, kind="stable")
+    order = stable_order(area_of)
     pix, area_of = pix[order], area_of[order]
     row, col = np.divmod(pix, w)
     return _Pixels(
@@ -400,6 +404,13 @@ def _fuzzy_picks(
     )
     t = clock.tick("greedy", t)
     return (g.area_order, g.pick, g.feasibility, g.priority), t
+
+
+def _changes_side(px: _Pixels, order: tuple[np.ndarray, ...], prev: _Previous) -> bool:
+    """True when a picked candidate leaves on another side than its label did last frame."""
+    areas, picks = order[0], order[1]
+    before = prev.side[areas]
+    return bool(np.any((before >= 0) & (px.side[picks] != before)))
 
 
 def _two_step_picks(px: _Pixels, n: int, clock: _Stopwatch, t: float) -> tuple[tuple[np.ndarray, ...], float]:
@@ -731,6 +742,12 @@ def solve(
     da_px = d_a * d_s
     if method == "fuzzy":
         order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t)
+        if prev is not None and len(LAYOUTS[layout]) > 1 and _changes_side(px, order, prev):
+            # batch the side changes: the other labels that are nearer their other side go too
+            cand = leader_candidates(ia, layout, prefer, SIDE_BATCH)
+            t = clock.tick("candidates", t)
+            px = _pixels(idbuf, cand, dist_sil, labelled, len(names))
+            order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t)
     else:
         order, t = _two_step_picks(px, len(labelled), clock, t)
     label_texts_ = [texts[p] for p in labelled]

@@ -15,22 +15,26 @@ COLLINEAR = 1e-9
 
 
 def _placed_arrays(ctx: Context, exclude: int) -> tuple[np.ndarray, np.ndarray]:
-    """Boxes (P, 4) and leader segments (Q, 2, 2) of every placed label except ``exclude``."""
-    key = (exclude, tuple(id(p) for p in ctx.placed))
-    if ctx._cache is not None and ctx._cache[0] == key:
-        return ctx._cache[1]
-    boxes, segs = [], []
-    for i, p in enumerate(ctx.placed):
-        if p is None or i == exclude:
-            continue
-        boxes.append(p.box)
-        segs.append(p.segments)
-    out = (
-        np.array(boxes, np.float64).reshape(-1, 4),
-        np.concatenate(segs).reshape(-1, 2, 2) if segs else np.zeros((0, 2, 2)),
-    )
-    ctx._cache = (key, out)
-    return out
+    """Boxes (P, 4) and leader segments (Q, 2, 2) of every placed label except ``exclude``.
+
+    The arrays of all placed labels are built once per change of the placements (the
+    searches of one label ask several times, with the label itself left out).
+    """
+    key = tuple(id(p) for p in ctx.placed)
+    if ctx._cache is None or ctx._cache[0] != key:
+        ids = [i for i, p in enumerate(ctx.placed) if p is not None]
+        segs = [ctx.placed[i].segments for i in ids]
+        ctx._cache = (
+            key,
+            np.array([ctx.placed[i].box for i in ids], np.float64).reshape(-1, 4),
+            np.array(ids, np.int64),
+            np.concatenate(segs).reshape(-1, 2, 2) if segs else np.zeros((0, 2, 2)),
+            np.repeat(np.array(ids, np.int64), [len(s) for s in segs]),
+        )
+    _, boxes, box_of, segs, seg_of = ctx._cache
+    if ctx.placed[exclude] is None:
+        return boxes, segs
+    return boxes[box_of != exclude], segs[seg_of != exclude]
 
 
 def _valid(ctx: Context, k: int, boxes: np.ndarray, leaders: np.ndarray) -> np.ndarray:

@@ -58,6 +58,7 @@ class Context:
         directions=None,
         centres=None,
         lines=None,
+        leaders=None,
     ):
         self.anchors = np.asarray(anchors, np.float64).reshape(-1, 2)
         # per label: its box centre along each side in the previous frame (NaN: elsewhere)
@@ -92,6 +93,11 @@ class Context:
             SOUTH: _sticky(float(np.nanmax(area.bottom)) + spacing.clearance, before[SOUTH], 1.0, slack),
         }
         self.center = area.centroid
+        # per label: the previous frame's leader moved with its anchor (None: none), and
+        # the direction of its flag box in a row (1 left of the port, -1 right, 0: by the
+        # side of the centre the port is on), set by the row stacking
+        self.leaders = [None] * len(self.anchors) if leaders is None else leaders
+        self.flags = np.zeros(len(self.anchors), np.int8)
         self.stats = BoxStats()
         self._boundary = None
         self._rays = None
@@ -110,10 +116,10 @@ class Context:
         """Flag box of label k whose leader port is at ``x``, in ``tier``."""
         w, h, sp = self.widths[k], self.height, self.sp
         if np.ndim(x) == 0 and np.ndim(tier) == 0:  # one box: plain floats cost far less than arrays
-            return np.array(self._one_row_box(float(w), side, float(x), float(tier)))
+            return np.array(self._one_row_box(float(w), side, float(x), float(tier), int(self.flags[k])))
         x = np.asarray(x, np.float64)
         tier = np.asarray(tier, np.float64)
-        left_flag = x < self.center[0]
+        left_flag = x < self.center[0] if self.flags[k] == 0 else np.full(x.shape, self.flags[k] > 0)
         x0 = np.where(left_flag, x + sp.inset - w, x - sp.inset)
         step = h + sp.gap
         if side == NORTH:
@@ -125,10 +131,13 @@ class Context:
         x0, y0, y1 = np.broadcast_arrays(x0, y0, y1)
         return np.stack([x0, y0, x0 + w, y1], axis=-1)
 
-    def _one_row_box(self, w: float, side: int, x: float, tier: float) -> tuple[float, float, float, float]:
+    def _one_row_box(
+        self, w: float, side: int, x: float, tier: float, flag: int = 0
+    ) -> tuple[float, float, float, float]:
         """:meth:`row_box` of one label of width ``w`` (the same arithmetic on floats)."""
         h, sp = self.height, self.sp
-        x0 = x + sp.inset - w if x < self.center[0] else x - sp.inset
+        left = x < self.center[0] if flag == 0 else flag > 0
+        x0 = x + sp.inset - w if left else x - sp.inset
         step = h + sp.gap
         if side == NORTH:
             y1 = self.row_y[NORTH] - tier * step

@@ -53,7 +53,8 @@ def _place_radial(ctx: Context, ring: np.ndarray, endpoints_in: np.ndarray, lead
     """Silhouette boxes: keep last frame's valid boxes (hysteresis), search places for the others.
 
     When that leaves a label without room, every box of the ring is searched for afresh
-    (the search still prefers the places the boxes had, :data:`~.costs.COHERENCE_COST`).
+    from this frame's own endpoints (the search still prefers the places the boxes had,
+    :data:`~.costs.COHERENCE_COST`).
     """
     state = (ctx.stats.shifted, ctx.stats.swaps, len(ctx.stats.unplaced))
     kept = _keep_previous(ctx, ring, leaders)
@@ -66,6 +67,34 @@ def _place_radial(ctx: Context, ring: np.ndarray, endpoints_in: np.ndarray, lead
         ctx.endpoints[ring] = endpoints_in[ring]
         ctx._rays = None
         _place_ring(ctx, ring)
+
+
+#: a silhouette label keeps last frame's endpoint (moved with its anchor, onto the boundary
+#: of ``A_I``) while that leader is at most this many times as long as the nearest one
+RADIAL_KEEP = 3.0
+
+
+def _keep_radial_endpoints(ctx: Context, ring: np.ndarray, leaders: list | None) -> None:
+    """Hysteresis of the silhouette endpoints: a leader leaves where it left last frame.
+
+    The nearest boundary point of an anchor near the middle of a long part can jump to the
+    far side of ``A_I`` between two frames, and the box with it; the point of the boundary
+    nearest to last frame's endpoint (moved with the anchor) is kept instead while its
+    leader is at most :data:`RADIAL_KEEP` times as long.
+    """
+    known = [k for k in ring if leaders is not None and leaders[k] is not None and len(leaders[k])]
+    if not known:
+        return
+    pts, _ = ctx.boundary
+    for k in known:
+        before = np.asarray(leaders[k][0], np.float64)
+        if not np.all(np.isfinite(before)):
+            continue
+        q = pts[int(np.argmin(((pts - before) ** 2).sum(axis=1)))]
+        nearest = np.hypot(*(ctx.endpoints[k] - ctx.anchors[k]))
+        if np.hypot(*(q - ctx.anchors[k])) <= RADIAL_KEEP * nearest:
+            ctx.endpoints[k] = q
+    ctx._rays = None
 
 
 def place_boxes(
@@ -136,8 +165,10 @@ def place_boxes(
         directions,
         centres,
         lines,
+        leaders,
     )
-    endpoints_in = ctx.endpoints.copy()
+    endpoints_in = ctx.endpoints.copy()  # a ring placed afresh starts from these
+    _keep_radial_endpoints(ctx, np.flatnonzero(ctx.sides == RADIAL), leaders)
     for side in (WEST, EAST):
         _place_column(ctx, np.flatnonzero(ctx.sides == side), side)
     for side in (NORTH, SOUTH):

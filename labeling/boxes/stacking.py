@@ -124,6 +124,35 @@ def _place_column(ctx: Context, idx: np.ndarray, side: int) -> None:
         )
 
 
+def _flag_split(ctx: Context, idx: np.ndarray, port_x: np.ndarray) -> np.ndarray:
+    """Which flag boxes of a row point left (True) or right of their ports.
+
+    The ports left of some split point get left flags, the others right ones, so the two
+    groups stack apart.  Without a previous frame the split is the centre of ``A_I``;
+    along a camera path it is the split that turns the fewest flags against last frame's
+    (ties: the fewest against the centre rule), so a box does not swing across its
+    leader each time its port crosses the centre.
+    """
+    natural = port_x < ctx.center[0]
+    before = np.zeros(len(idx), np.int64)  # 1: left last frame, -1: right, 0: unknown
+    for j, k in enumerate(idx):
+        lead = ctx.leaders[k]
+        if lead is not None and len(lead) and np.all(np.isfinite(ctx.centres[k])):
+            before[j] = 1 if ctx.centres[k][0] < lead[0][0] else -1
+    if not before.any():
+        return natural
+    order = np.argsort(port_x, kind="stable")
+    b, nat = before[order], natural[order]
+    # split s: the first s ports (left to right) point left; count the flags each s turns
+    left_cost = np.concatenate([[0], np.cumsum(b == -1)])  # right before, left now
+    right_cost = np.concatenate([np.cumsum((b == 1)[::-1])[::-1], [0]])  # left before, right now
+    nat_cost = np.concatenate([[0], np.cumsum(~nat)]) + np.concatenate([np.cumsum(nat[::-1])[::-1], [0]])
+    s = int(np.lexsort((nat_cost, left_cost + right_cost))[0])
+    left = np.zeros(len(idx), bool)
+    left[order[:s]] = True
+    return left
+
+
 def _place_row(ctx: Context, idx: np.ndarray, side: int) -> None:
     """Spread the ports of one north/south side (shift, swap), then stack flag boxes in tiers."""
     if len(idx) == 0:
@@ -141,7 +170,8 @@ def _place_row(ctx: Context, idx: np.ndarray, side: int) -> None:
     assign, swaps = uncross(ctx.anchors[idx], ports)
     ctx.stats.swaps += swaps
     port_x = xs[assign]
-    left = port_x < ctx.center[0]
+    left = _flag_split(ctx, idx, port_x)
+    ctx.flags[idx] = np.where(left, 1, -1)
     g = ctx.sp.gap
     # left group: outermost (leftmost) first; a box may sit in tier r only if it starts
     # right of every box already in tier r or above (those leaders pass through tier r)
