@@ -60,6 +60,7 @@ def pvs(
     Parameters
     ----------
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model.
     cells : str or ViewCells
         ``"auto"`` or ``"auto:N"``: N cells (default 64) built by render cost (002);
         ``"grid:NX,NY,NZ"``: a uniform grid over the view space's box; a path to a JSON

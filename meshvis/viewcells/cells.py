@@ -58,9 +58,13 @@ class ViewCells:
     Attributes
     ----------
     n_cells : int
-    cell_lo, cell_hi : (k, 3) float64, the cells' boxes
-    volume : (k,) float64, each cell's share of the view space's volume (P(cell) of 002 §3.3)
-    parent : (n,) int32, each node's parent (-1 for the root)
+        Number of cells ``k``.
+    cell_lo, cell_hi : (k, 3) float64
+        The cells' boxes.
+    volume : (k,) float64
+        Each cell's share of the view space's volume (P(cell) of 002 §3.3).
+    parent : (n,) int32
+        Each node's parent (-1 for the root).
     """
 
     view_space: ViewSpace
@@ -148,6 +152,7 @@ class ViewCells:
         Parameters
         ----------
         view_space : ViewSpace
+            The space the grid covers (its box).
         shape : 3 ints
             Cells along x, y and z.
 
@@ -188,6 +193,7 @@ class ViewCells:
         Parameters
         ----------
         view_space : ViewSpace
+            The space the boxes partition.
         boxes : (k, 6) float
             ``x0, y0, z0, x1, y1, z1`` of each cell; clipped to the view space's box (a box
             outside it is left out).  Boxes must not overlap.
@@ -498,6 +504,7 @@ def parse_cells(text, view_space: ViewSpace) -> ViewCells | tuple[str, int]:
         ``grid:NX,NY,NZ``; ``auto`` or ``auto:N`` (built by render cost, returned as
         ``("auto", N)`` for the caller to build); a path to a JSON file of boxes.
     view_space : ViewSpace
+        The space the cells partition.
 
     Returns
     -------

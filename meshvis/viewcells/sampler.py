@@ -49,11 +49,17 @@ class BatchResult:
     Attributes
     ----------
     samples : int
-    rays : int, rays traced (both ways, and discovery rays)
-    contribution : int, new PVS entries (AGVS Eq. 2 summed)
-    own_rays : int, rays (2 per sample) that found a face new to the cell holding their start
-    own_contributing : int, of those, the ones that did
+        Samples cast.
+    rays : int
+        Rays traced (both ways, and discovery rays).
+    contribution : int
+        New PVS entries (AGVS Eq. 2 summed).
+    own_rays : int
+        Rays (2 per sample) that started in a cell.
+    own_contributing : int
+        Of those, the ones that found a face new to the cell holding their start.
     seconds : float
+        Time of the batch.
     """
 
     samples: int
@@ -70,16 +76,22 @@ class GlobalSampler:
     Parameters
     ----------
     cells : ViewCells
+        The view cells.
     caster : RayCaster
         The model's caster.
     buffer : MutationBuffer, optional
+        Where the successful segments are kept for mutation (a new one by default).
 
     Attributes
     ----------
-    bits : (k, w) uint64, the PVS of each cell as a bit set
-    sides : (m,) uint8, bit 0: the front of the face was hit, bit 1: the back
-    cell_segments : (k,) int64, segments that pierced each cell
-    face_hits : (m,) int64, segment ends on each face
+    bits : (k, w) uint64
+        The PVS of each cell as a bit set.
+    sides : (m,) uint8
+        Bit 0: the front of the face was hit, bit 1: the back.
+    cell_segments : (k,) int64
+        Segments that pierced each cell.
+    face_hits : (m,) int64
+        Segment ends on each face.
     """
 
     def __init__(self, cells, caster, buffer: MutationBuffer | None = None):

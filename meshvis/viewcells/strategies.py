@@ -138,7 +138,9 @@ class MutationBuffer:
     Parameters
     ----------
     fields : tuple of str
+        Names of the arrays each candidate carries.
     capacity : int
+        Most candidates kept.
     """
 
     def __init__(self, fields=("s_o", "s_t", "face", "r_o", "r_t"), capacity: int = BUFFER_SIZE):
