@@ -194,6 +194,7 @@ def pvs(
                 available = dict.fromkeys(st.STRATEGIES, True)
                 available["mutation"] = available["silhouette"] = len(sampler.buffer) > 0
                 available["border"] = len(sampler.border) > 0
+                available["adjacent"] = len(sampler.spread) > 0 and vc.n_cells > 1
                 p = mixture.probabilities(available)
                 parts = []
                 for name in st.STRATEGIES:
@@ -344,6 +345,12 @@ def _draw(name: str, k: int, vs, surface, sampler: GlobalSampler, rng, caster, p
         return st.two_point_mutation(sampler.buffer, k, rng)
     if name == "silhouette":
         return st.silhouette_mutation(sampler.buffer, k, rng, caster, push)
+    if name == "adjacent":
+        if sampler.adjacent is None:
+            sampler.adjacent = sampler.cells.adjacent()
+        return st.adjacent_cell(
+            sampler.spread, k, rng, sampler.bits, sampler.adjacent, sampler.cells, surface
+        )
     if sampler.neighbours is None:
         sampler.neighbours = st.face_neighbours(caster.soup)
     return st.border_mutation(sampler.border, k, rng, sampler.bits, sampler.neighbours, surface)

@@ -283,6 +283,26 @@ class ViewCells:
         """(k,) half the diagonal of each cell's box."""
         return 0.5 * np.linalg.norm(self.cell_hi - self.cell_lo, axis=1)
 
+    def adjacent(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR ``(ptr, nbr)`` of the cells whose box shares a piece of wall with each cell's box.
+
+        Cell ``c``'s neighbours are ``nbr[ptr[c]:ptr[c + 1]]``: boxes that touch along one
+        axis (within a relative 1e-9 of the view space's diagonal) and overlap, with a
+        positive extent, along the other two.
+        """
+        lo, hi = self.cell_lo, self.cell_hi
+        eps = 1e-9 * self.view_space.diagonal
+        overlap = np.minimum(hi[:, None], hi[None]) - np.maximum(lo[:, None], lo[None])  # (k, k, 3)
+        touch = (np.abs(hi[:, None] - lo[None]) <= eps) | (np.abs(lo[:, None] - hi[None]) <= eps)
+        wide = overlap > eps
+        # touching along one axis, overlapping along both others
+        pair = (touch & (wide.sum(axis=2, keepdims=True) - wide == 2)).any(axis=2)
+        np.fill_diagonal(pair, False)
+        rows, nbr = np.nonzero(pair)
+        ptr = np.zeros(self.n_cells + 1, np.int64)
+        np.add.at(ptr, rows + 1, 1)
+        return np.cumsum(ptr), nbr.astype(np.int64)
+
     def describe(self) -> dict:
         """The cells as a JSON-ready dict (the boxes of every cell)."""
         return {

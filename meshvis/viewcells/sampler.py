@@ -106,6 +106,10 @@ class GlobalSampler:
         self.buffer = buffer or MutationBuffer()
         #: new PVS entries with a point of the cell that saw the face (border mutations)
         self.border = MutationBuffer(("x", "face", "cell"))
+        #: new PVS entries, for the cells next to theirs (adjacent-cell mutations)
+        self.spread = MutationBuffer(("face", "cell"))
+        #: cells sharing a wall with each cell, CSR (made on first use)
+        self.adjacent: tuple[np.ndarray, np.ndarray] | None = None
         #: faces sharing a vertex with each face, CSR (made on first use)
         self.neighbours: tuple[np.ndarray, np.ndarray] | None = None
         self._log_cell = np.empty(LOG_START, np.int32)
@@ -251,7 +255,7 @@ class GlobalSampler:
         return out
 
     def _keep_border(self, o, d, found, rng) -> None:
-        """Store every new entry with a random point of its segment inside the cell."""
+        """Store every new entry with a random point of its segment inside the cell, and for its neighbours."""
         for log_start, sample, t0, t1 in found:
             if len(sample) == 0:
                 continue
@@ -261,6 +265,7 @@ class GlobalSampler:
             self.border.add(
                 x=o[sample] + t[:, None] * d[sample], face=face.astype(np.int64), cell=cell.copy()
             )
+            self.spread.add(face=face.astype(np.int64), cell=cell.astype(np.int64))
 
     def _keep(self, o, d, t_back, t_fwd, face_back, face_fwd, clip, useful, origin_cell) -> None:
         """Store the segments with a new entry as mutation candidates: one per end that found one."""
