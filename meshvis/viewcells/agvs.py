@@ -107,6 +107,7 @@ def pvs(
     (2, 12)
     """
     t_start = time.perf_counter()
+    cpu_start = time.process_time()
     seed = _validate.seed(seed)
     if budget is not None:
         budget = _validate.integer("budget", budget, 0)
@@ -139,12 +140,13 @@ def pvs(
     stats = {n: {"samples": 0, "rays": 0, "contribution": 0, "seconds": 0.0} for n in st.STRATEGIES}
     history: dict[str, list] = {
         "seconds": [],
+        "cpu_seconds": [],
         "rays": [],
         "mean_pvs": [],
         "estimate_per_million": [],
         "probabilities": [],
     }
-    batches: dict[str, list] = {"seconds": [], "rays": []}
+    batches: dict[str, list] = {"seconds": [], "cpu_seconds": [], "rays": []}
     sizes = np.zeros(vc.n_cells, np.int64)
     rays = 0
 
@@ -165,12 +167,15 @@ def pvs(
         fresh = when == sampler.batch
         np.add.at(sizes, cell[fresh], 1) if fresh.any() else None
         now = time.perf_counter() - t_start
+        cpu = time.process_time() - cpu_start
         history["seconds"].append(now)
+        history["cpu_seconds"].append(cpu)
         history["rays"].append(rays)
         history["mean_pvs"].append(float(sizes.mean()))
         history["estimate_per_million"].append(estimate.per_million)
         history["probabilities"].append({k: round(v, 4) for k, v in p.items()})
         batches["seconds"].append(now)
+        batches["cpu_seconds"].append(cpu)
         batches["rays"].append(rays)
         sampler.batch += 1
 

@@ -67,7 +67,8 @@ class PVS:
     log : tuple of (cell, face, batch) arrays, optional
         Every sampled entry with the batch that found it (runs only, not files).
     batches : dict, optional
-        ``seconds`` and ``rays`` at the end of each batch (runs only).
+        ``seconds``, ``cpu_seconds`` (of the whole process) and ``rays`` at the end of each
+        batch (runs only).
     """
 
     cells: ViewCells
