@@ -143,8 +143,9 @@ def test_remove_interior_removes_what_no_cell_sees(levels, tmp_path, capsys):
 @pytest.mark.slow
 def test_bench_pvs_reports_cpu_seconds_and_reuses_its_cached_run(tmp_path, capsys):
     model = os.path.join(os.path.dirname(__file__), "..", "..", "models", "house.obj")
-    argv = ["bench", "pvs", model, "--rays", "300000", "--cells", "grid:2,1,2", "--points", "8", "--path", "4"]
-    argv += ["--size", "8", "--parts", "agvs,converged", "--gvs-cells", "1", "--cache", str(tmp_path)]
+    argv = ["bench", "pvs", model, "--rays", "300000", "--cells", "grid:2,1,2", "--points", "8"]
+    argv += ["--path", "4", "--size", "8", "--parts", "agvs,converged", "--gvs-cells", "1"]
+    argv += ["--cache", str(tmp_path)]
     assert main([*argv, "--json", str(tmp_path / "a.json")]) == 0
     first = json.loads((tmp_path / "a.json").read_text())["results"][0]
     curve = [p["cpu_seconds"] for p in first["agvs_curve"]]
@@ -157,3 +158,10 @@ def test_bench_pvs_reports_cpu_seconds_and_reuses_its_cached_run(tmp_path, capsy
     assert main([*argv, "--json", str(tmp_path / "b.json")]) == 0
     second = json.loads((tmp_path / "b.json").read_text())["results"][0]
     assert second["agvs_curve"] == first["agvs_curve"] and second["rays"] == first["rays"]
+    # with the filter: judged with and without the faces it added (a superset: never more wrong pixels)
+    assert main([*argv, "--parts", "agvs", "--filter", "--json", str(tmp_path / "c.json")]) == 0
+    fl = json.loads((tmp_path / "c.json").read_text())["results"][0]
+    assert fl["filter"]["added"] > 0
+    assert fl["mean_pvs"] == pytest.approx(fl["filter"]["mean_pvs_sampled"] + fl["filter"]["mean_added"])
+    assert fl["final"]["mean"] <= fl["filter"]["sampled"]["mean"]
+    assert fl["filter"]["mean_pvs_sampled"] == pytest.approx(first["mean_pvs"])

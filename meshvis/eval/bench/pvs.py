@@ -67,6 +67,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--time", type=float, default=SECONDS, help="AGVS's time cap in seconds")
     p.add_argument("--rays", type=int, help="AGVS's ray budget (instead of the stop rule and the time)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--filter",
+        action="store_true",
+        help="run AGVS with the visibility filter and judge its PVS with and without the filter's faces",
+    )
     p.add_argument("--points", type=int, default=judge.VIEWPOINTS, help="random viewpoints (six views each)")
     p.add_argument("--path", type=int, default=judge.PATH_POINTS, help="walkthrough points (one view each)")
     p.add_argument("--size", type=int, default=judge.SIZE, help="pixels along each side of a view")
@@ -161,6 +166,14 @@ def run_level(path: str, args: argparse.Namespace) -> dict:
     table = _views(soup, cells.view_space, args, caster)
     out["views"] = int(table.n_views)
     out["final"] = judge.summary(judge.pixel_errors(table, cells, result.bits), table)
+    if "filter" in result.summary:
+        # the log holds the sampled entries only: its last state is the PVS before the filter
+        sampled = result.bits_at(len(result.batches["seconds"]) - 1)
+        out["filter"] = {
+            **result.summary["filter"],
+            "mean_pvs_sampled": float(_sizes(sampled).mean()),
+            "sampled": judge.summary(judge.pixel_errors(table, cells, sampled), table),
+        }
     out["agvs_curve"] = _agvs_curve(result, table)
     out["estimate_vs_measured"] = [
         {"seconds": p["seconds"], "estimate": p["estimate"], "measured": p["mean"]}
@@ -196,6 +209,7 @@ def _agvs_run(soup, args, caster):
     key = hashlib.sha256(
         repr(
             (model_key(soup), args.cells, args.rays, None if args.rays else args.time, args.seed, RUN_VERSION)
+            + (("filter",) if args.filter else ())
         ).encode()
     ).hexdigest()[:20]
     path = os.path.join(args.cache, f"pvs-run-{key}.npz")
@@ -214,7 +228,7 @@ def _agvs_run(soup, args, caster):
     load = _load()
     start = _clock()
     run_args = {"budget": args.rays, "target_error": 0.0} if args.rays else {"seconds": args.time}
-    result = pvs(soup, args.cells, seed=args.seed, caster=caster, **run_args)
+    result = pvs(soup, args.cells, seed=args.seed, caster=caster, visibility_filter=args.filter, **run_args)
     wall, cpu = _since(start)
     run = {
         "seconds": wall,
@@ -503,6 +517,13 @@ def format_level(r: dict) -> str:
                 if t is not None
                 else f"-- (it ended at {g['agvs_mean_pvs_final_same_cells']:.0f})"
             )
+        )
+    fl = r.get("filter")
+    if fl:
+        lines.append(
+            f"visibility filter: {fl['added']} entries added ({fl['mean_added']:.0f} per cell), mean PVS "
+            f"{fl['mean_pvs_sampled']:.0f} -> {r['mean_pvs']:.0f}; error mean {fl['sampled']['mean']:.2f} -> "
+            f"{r['final']['mean']:.2f}, worst {fl['sampled']['worst']:.0f} -> {r['final']['worst']:.0f} per million"
         )
     if r["estimate_vs_measured"]:
         ratios = [
