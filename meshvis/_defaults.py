@@ -136,7 +136,29 @@ def _value(module: str, node: ast.expr, hops: int) -> Any:
         target = _imported_module(module, node.value.id)
         if target is not None:
             return _constant(target, node.attr, hops - 1)
+    if isinstance(node, (ast.Tuple, ast.List, ast.Dict)):
+        return _container(module, node, hops)
     return UNRESOLVED
+
+
+def _container(module: str, node: ast.Tuple | ast.List | ast.Dict, hops: int) -> Any:
+    """A tuple, list or dictionary written with names, such as ``{"left": (WEST,)}``."""
+    if isinstance(node, ast.Dict):
+        keys = [k for k in node.keys if k is not None]
+        if len(keys) < len(node.keys):  # a ``**mapping`` entry
+            return UNRESOLVED
+        items = [_value(module, e, hops - 1) for e in [*keys, *node.values]]
+    else:
+        items = [_value(module, e, hops - 1) for e in node.elts]
+    if any(item is UNRESOLVED for item in items):
+        return UNRESOLVED
+    if isinstance(node, ast.Dict):
+        half = len(node.keys)
+        try:
+            return dict(zip(items[:half], items[half:]))
+        except TypeError:  # a key that cannot be one
+            return UNRESOLVED
+    return tuple(items) if isinstance(node, ast.Tuple) else items
 
 
 def _constant(module: str, name: str, hops: int) -> Any:
@@ -149,6 +171,13 @@ def _constant(module: str, name: str, hops: int) -> Any:
             target = node.targets[0]
             if isinstance(target, ast.Name) and target.id == name:
                 return _value(module, node.value, hops)
+            if isinstance(target, ast.Tuple) and isinstance(node.value, ast.Tuple):
+                # ``A, B = 0, 1``: the value at the name's place
+                names = [t.id if isinstance(t, ast.Name) else None for t in target.elts]
+                if name in names and len(names) == len(node.value.elts):
+                    return _value(module, node.value.elts[names.index(name)], hops)
+                if name in names:
+                    return UNRESOLVED
         elif isinstance(node, ast.AnnAssign) and isinstance(node.target, ast.Name) and node.target.id == name:
             return UNRESOLVED if node.value is None else _value(module, node.value, hops)
         elif isinstance(node, ast.ImportFrom):
