@@ -16,15 +16,15 @@ import numba
 import numpy as np
 
 from meshvis._threads import in_threads
-
-#: relative slack of every reporting comparison (far above float64 reordering error)
-SLACK = 1e-12
-#: angular slack of the wedge test at a shared corner (as in the vectorised version)
-WEDGE_SLACK = 1e-9
-#: widening of each face's projection interval on its own axes (unit-diagonal coordinates):
-#: above the rounding of a 3-term dot product in any order (a few 1e-16), so gaps can only
-#: shrink and an evaluation order never hides a pair (more reports, never fewer)
-PROJ_SLACK = 1e-15
+from meshvis.geometry._kernel_constants import (  # shared with the numpy formulations
+    COPLANAR,
+    INTERSECTS,
+    NEAR_CELL_FLOOR,
+    PROJ_SLACK,
+    SLACK,
+    TOO_CLOSE,
+    WEDGE_SLACK,
+)
 
 # The kernels are serial and release the GIL; the large ones (the narrow phase, the face
 # axes, the corner gather) run on slices in threads (meshvis._threads.in_threads), and
@@ -225,10 +225,6 @@ def narrow_phase(
             cos_angle,
             cos_fold,
         )
-
-
-#: bits of the codes of :func:`broad_narrow`
-INTERSECTS, COPLANAR, TOO_CLOSE = 1, 2, 4
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -710,9 +706,6 @@ def _labels(parent):
 
 #: constants of the cell hash of :func:`near_labels` (odd multipliers of the splitmix64 family)
 _CELL_MIX = (np.uint64(0x9E3779B97F4A7C15), np.uint64(0xBF58476D1CE4E5B9), np.uint64(0x94D049BB133111EB))
-#: smallest cell of :func:`near_labels`, as a fraction of the points' largest extent: cell
-#: coordinates stay below 2**40, far inside int64, whatever the radius
-NEAR_CELL_FLOOR = 2.0**-40
 
 
 @numba.njit(cache=True, nogil=True, inline="always")

@@ -14,6 +14,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from meshvis.geometry._vectorised import kernels
+
 #: default weld tolerance, as a fraction of the bounding-box diagonal
 WELD_TOL = 1e-7
 
@@ -37,10 +39,8 @@ def used_vertices(faces: np.ndarray, n_vertices: int) -> np.ndarray:
 
 
 def _bounds(vertices: np.ndarray, faces: np.ndarray) -> np.ndarray:
-    """(2, 3) bounding box of the used vertices (a numba pass over the corners)."""
-    from meshvis.geometry._kernels import corner_bounds
-
-    return corner_bounds(np.asarray(vertices, np.float64), np.asarray(faces))
+    """(2, 3) bounding box of the used vertices (one pass over the corners)."""
+    return kernels(len(faces)).corner_bounds(np.asarray(vertices, np.float64), np.asarray(faces))
 
 
 def _diagonal(vertices: np.ndarray, faces: np.ndarray) -> float:
@@ -90,7 +90,8 @@ def group_vertices(vertices: np.ndarray, faces: np.ndarray) -> VertexGroups:
     """Group the used vertices whose float64 coordinates are identical bit for bit.
 
     Equal rows are found through a hash table on a 64-bit hash of their bits (a numba
-    kernel, rows compared in full, so a collision costs a probe, never a wrong group).
+    kernel, rows compared in full, so a collision costs a probe, never a wrong group), or
+    on a small model by sorting the rows (:mod:`meshvis.geometry._vectorised`).
 
     Parameters
     ----------
@@ -111,12 +112,10 @@ def group_vertices(vertices: np.ndarray, faces: np.ndarray) -> VertexGroups:
     >>> g.group.tolist(), g.first.tolist()
     ([0, 1, 2, 1], [0, 1, 2])
     """
-    from meshvis.geometry._kernels import exact_groups
-
     vertices = np.asarray(vertices, np.float64)
     used = used_vertices(faces, len(vertices))
     bits = np.ascontiguousarray(vertices[used]).view(np.uint64)
-    group, first_row = exact_groups(bits, _hash_rows(bits))
+    group, first_row = kernels(len(faces)).exact_groups(bits, _hash_rows(bits))
     return VertexGroups(used, group, used[first_row])
 
 
@@ -128,29 +127,29 @@ def _lex_rank(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     return pts[lex], rank
 
 
-def _exact_groups(pts: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _exact_groups(pts: np.ndarray, n_faces: int) -> tuple[np.ndarray, np.ndarray]:
     """Distinct rows of ``pts`` in lexicographic order, and the row of each input point.
 
     The same answer as ``np.unique(pts, axis=0, return_inverse=True)``, about 10x faster:
     equal points are grouped by the hash table of :func:`group_vertices`, and only the
     distinct points are sorted lexicographically.  The points must not hold ``-0.0`` (add
-    ``0.0`` first) or NaN.
+    ``0.0`` first) or NaN.  ``n_faces``, the model's faces, chooses the kernels.
     """
-    from meshvis.geometry._kernels import exact_groups
-
     bits = np.ascontiguousarray(pts, np.float64).view(np.uint64)
-    group, first_row = exact_groups(bits, _hash_rows(bits))
+    group, first_row = kernels(n_faces).exact_groups(bits, _hash_rows(bits))
     uniq, rank = _lex_rank(pts[first_row])
     return uniq, rank[group]
 
 
-def _distinct_points(vertices: np.ndarray, groups: VertexGroups) -> tuple[np.ndarray, np.ndarray]:
+def _distinct_points(
+    vertices: np.ndarray, groups: VertexGroups, n_faces: int
+) -> tuple[np.ndarray, np.ndarray]:
     """Distinct used points up to the sign of zero, lexicographic, and the one of each group."""
     # + 0.0 turns -0.0 into 0.0 so that both weld exactly
     firsts = vertices[groups.first]
     pts = firsts + 0.0
     if np.signbit(firsts[pts == 0]).any():
-        return _exact_groups(pts)  # some groups differ only in the sign of a zero: merge them
+        return _exact_groups(pts, n_faces)  # some groups differ only in the sign of a zero: merge them
     return _lex_rank(pts)  # the groups are the distinct points already
 
 
@@ -200,13 +199,11 @@ def weld(
     if len(faces) == 0:
         return index, faces.copy()
     groups = vertex_groups if vertex_groups is not None else group_vertices(vertices, faces)
-    uniq, of_group = _distinct_points(vertices, groups)
+    uniq, of_group = _distinct_points(vertices, groups, len(faces))
     label = np.arange(len(uniq))
     radius = tol * _diagonal(vertices, faces)
     if radius > 0 and len(uniq) > 1:
-        from meshvis.geometry._kernels import near_labels
-
-        label = near_labels(uniq, radius)
+        label = kernels(len(faces)).near_labels(uniq, radius)
     index[groups.used] = label[of_group][groups.group]
     return index, index[faces]
 
@@ -384,10 +381,10 @@ def components(n_faces: int, pairs: np.ndarray) -> tuple[int, np.ndarray]:
     label : (n_faces,) int64 array
         Component of each face (numbered by smallest face index).
     """
-    from meshvis.geometry._kernels import component_labels
-
     pairs = np.asarray(pairs, np.int64).reshape(-1, 2)
-    label = component_labels(n_faces, np.ascontiguousarray(pairs[:, 0]), np.ascontiguousarray(pairs[:, 1]))
+    label = kernels(n_faces).component_labels(
+        n_faces, np.ascontiguousarray(pairs[:, 0]), np.ascontiguousarray(pairs[:, 1])
+    )
     return int(label.max()) + 1 if n_faces else 0, label
 
 
@@ -429,10 +426,8 @@ def degenerate_faces(
     f = np.asarray(faces, np.int64).reshape(-1, 3)
     if len(f) == 0:
         return np.zeros(0, bool)
-    from meshvis.geometry._kernels import flat_faces
-
     lo, hi = _bounds(v, f)  # corners shifted by lo: small magnitudes before the cross product
-    flat, zero = flat_faces(v, f, lo, tol * float(np.linalg.norm(hi - lo)))
+    flat, zero = kernels(len(f)).flat_faces(v, f, lo, tol * float(np.linalg.norm(hi - lo)))
     out = flat | zero if zero_area else flat
     if faces_welded is not None:
         out |= collapsed(faces_welded)

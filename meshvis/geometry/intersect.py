@@ -89,6 +89,9 @@ import numpy as np
 
 from meshvis._threads import default_threads, in_threads, pool
 from meshvis.errors import ModelError, ParameterError
+from meshvis.geometry import _vectorised
+from meshvis.geometry._kernel_constants import COPLANAR, INTERSECTS, TOO_CLOSE
+from meshvis.geometry._vectorised import compiled, kernels
 from meshvis.geometry.adjacency import WELD_TOL, weld
 
 #: default distance tolerance, as a fraction of the bounding-box diagonal
@@ -323,7 +326,8 @@ def classify_pairs(
 ) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     """Narrow phase on candidate pairs of *normalised* triangles (unit diagonal).
 
-    Per pair (a numba kernel, :func:`meshvis.geometry._kernels.narrow_phase`): stage 1 uses
+    Per pair (a numba kernel, :func:`meshvis.geometry._kernels.narrow_phase`, or its numpy
+    formulation on a small model, :mod:`meshvis.geometry._vectorised`): stage 1 uses
     the 8 face axes (two unit normals, six in-plane edge normals, precomputed per face); it
     also decides coplanarity.  Stage 2 adds the 9 edge x edge axes for the non-adjacent pairs
     stage 1 could not separate by more than ``max(eps, near)``.  The gap along a unit axis
@@ -365,9 +369,8 @@ def classify_pairs(
     too_close : (p,) bool
         A non-adjacent pair closer than ``near``.
     """
-    from meshvis.geometry._kernels import narrow_phase
-
-    kernel: Callable[..., None] = narrow_phase  # numba's dispatcher, called with the faces' arguments
+    # numba's dispatcher or the numpy formulation, called with the faces' arguments
+    kernel: Callable[..., None] = kernels(len(triangles)).narrow_phase
     test = _Narrow(triangles, faces_welded, eps, near, angle_eps, fold_angle, order)
     out = np.zeros((3, len(pairs)), bool)
     for s in range(0, len(pairs), NARROW_CHUNK):
@@ -395,8 +398,6 @@ class _Narrow:
     """
 
     def __init__(self, triangles, faces_welded, eps, near, angle_eps, fold_angle, order=None):
-        from meshvis.geometry._kernels import face_axes
-
         # cross products of factors at an angle below tau are skipped: their round-off
         # (~ machine eps / tau, relative to unit coordinates) must stay far below eps
         tau = min(1e-3, 100 * np.finfo(np.float64).eps / min(eps, near))
@@ -404,6 +405,7 @@ class _Narrow:
         m = len(tri)
         axes, valid, has_normal = np.zeros((m, 4, 3)), np.zeros((m, 4), bool), np.zeros(m, bool)
         low, high = np.empty((m, 4)), np.empty((m, 4))
+        face_axes = kernels(m).face_axes
         in_threads(
             lambda a, b: face_axes(
                 tri[a:b], float(tau), axes[a:b], valid[a:b], has_normal[a:b], low[a:b], high[a:b]
@@ -473,14 +475,13 @@ def _normalised(vertices: np.ndarray, faces: np.ndarray, rows: np.ndarray) -> tu
 
     The corners are centred on the bounding box of every face and scaled to unit diagonal.
     """
-    from meshvis.geometry._kernels import corner_bounds, gather_normalised
-
     v = np.ascontiguousarray(vertices, np.float64)
     faces = np.ascontiguousarray(faces)
-    lo, hi = corner_bounds(v, faces) if len(faces) else np.zeros((2, 3))
+    k = kernels(len(faces))
+    lo, hi = k.corner_bounds(v, faces) if len(faces) else np.zeros((2, 3))
     diag = float(np.linalg.norm(hi - lo))
     scale = 1.0 / diag if diag > 0 else 1.0
-    return gather_normalised(v, np.ascontiguousarray(faces[rows]), 0.5 * (lo + hi), scale), diag
+    return k.gather_normalised(v, np.ascontiguousarray(faces[rows]), 0.5 * (lo + hi), scale), diag
 
 
 def intersection_flags(
@@ -556,7 +557,6 @@ def intersection_flags(
     >>> d["coplanar"].tolist(), d["coplanar_pairs"].tolist()
     ([True, True, True], [[0, 1], [0, 2]])
     """
-    from meshvis.geometry._kernels import COPLANAR, INTERSECTS, TOO_CLOSE
     from meshvis.geometry.adjacency import duplicate_faces
 
     eps = EPS if eps is None else float(eps)
@@ -633,19 +633,29 @@ def _flagged_pairs(
     """Broad and narrow phase in one pass over the rows ``tri`` (the first rows of ``test``).
 
     Returns the (k, 2) row pairs with a flag, their codes (bits of
-    :data:`meshvis.geometry._kernels.INTERSECTS`, ...) and the candidates looked at.  Memory
-    follows the flagged pairs: the candidates are tested in chunks as the grid meets them.
+    :data:`meshvis.geometry._vectorised.INTERSECTS`, ...) and the candidates looked at.
+    Memory follows the flagged pairs: the candidates are tested in chunks as the grid meets
+    them.  On a small model (:func:`meshvis.geometry._vectorised.compiled`) the numpy
+    formulation tests the same pairs, every pair of overlapping boxes, found by a sweep
+    (its candidates are the pairs the sweep meets).
     """
     from meshvis import limits
-    from meshvis.geometry._kernels import broad_narrow
 
     n = len(tri)
     if n < 2:
         return np.zeros((0, 2), np.int64), np.zeros(0, np.uint8), 0
     lower = tri.min(axis=1) - pad
     upper = tri.max(axis=1) + pad
-    broad = _BroadPhase(lower, upper, overwrite=True)
-    candidates = broad.candidates
+    small = not compiled(len(test.faces[1]))
+    if small:
+        # the boxes shifted as the grid shifts them, so that the overlap tests round alike
+        origin = lower.min(axis=0)
+        lo, hi = lower - origin, upper - origin
+        swept = _vectorised.sweep(lo, hi)
+        candidates = int(swept[1].sum())
+    else:
+        broad = _BroadPhase(lower, upper, overwrite=True)
+        candidates = broad.candidates
     cap = max(limits.MAX_FACE_PAIRS_PER_FACE * n, limits.MIN_FACE_PAIRS)
     if candidates > cap:
         raise ModelError(
@@ -653,6 +663,11 @@ def _flagged_pairs(
             f"{candidates // n} per face, more than the cap MAX_FACE_PAIRS_PER_FACE of meshvis.limits "
             f"({limits.MAX_FACE_PAIRS_PER_FACE}): many different faces are stacked in one place"
         )
+    if small:
+        keys, codes = _vectorised.flagged_pairs(lo, hi, swept, test.faces, test.tolerances)
+        return _split_keys(keys, n).astype(np.int64), codes, candidates
+    from meshvis.geometry._kernels import broad_narrow
+
     report(0.1)
     work = [(job, sl) for job in broad.jobs for sl in _chunks(job.counts)]
     bounds = broad.bounds

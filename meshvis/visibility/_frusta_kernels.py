@@ -743,9 +743,13 @@ def _hidden_in_cut(
     if _sees_plane(T, delta) == 0:
         return False
     # t only touching the frustum (along a line or at a point) is seen through it by no
-    # set of rays of positive measure
+    # set of rays of positive measure; but a sliver as thin as that everywhere is seen by
+    # some (a ray aimed at it hits it), and only a blocker proves it hidden
     n0 = _clip_triangle(T, planes, FRUSTUM_PLANES, axis, np.inf, TOUCH_SLACK * mu, clip_a, clip_b)
-    if n0 == 0 or _cone_of(clip_a, n0, cut, probe, TOUCH_WIDTH * TOUCH_SLACK * mu)[1] == 0:
+    if n0 == 0:
+        return True
+    touch = TOUCH_WIDTH * TOUCH_SLACK * mu
+    if _cone_of(clip_a, n0, cut, probe, touch)[1] == 0 and _cone_of(T, 3, cut, probe, touch)[1] > 0:
         return True
     n_cut, n_probes = _cone_of(poly, n_poly, cut, probe, 0.0)
     if n_probes == 0:
@@ -985,3 +989,25 @@ def trace_frusta(
                 OPEN, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
                 planes, axis, far, delta, eta, mu, keep, blocks, starts, 0, seeds[i], sc, stack,
             )  # fmt: skip
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def first_hits(v, d, tri, lo, hi, first, count, order, out):  # pragma: no cover - compiled
+    """The triangle each ray ``v + s d[i]`` (``s > 0``) meets first, traced in float64; -1 if none.
+
+    Parameters
+    ----------
+    v : (3,) float64
+        Where the rays start.
+    d : (n, 3) float64
+        Their directions.
+    tri : (m, 3, 3) float64
+        The triangles.
+    lo, hi, first, count, order :
+        The :class:`~meshvis.geometry.bvh.Bvh` of ``tri``.
+    out : (n,) int64, out
+        The first triangle of each ray.
+    """
+    stack = np.empty(STACK, np.int64)
+    for i in range(len(d)):
+        out[i] = _first_hit(v, d[i], np.inf, -1, tri, lo, hi, first, count, order, stack)

@@ -18,7 +18,7 @@ by level (FastV §3.4), down to ``max_level``; there, it keeps every triangle it
 which no blocker is found among the rays that reach that triangle.
 
 A face is kept with the side that faces the point (both when the point lies within the
-margin of its plane).  Every test takes margins of ``tolerance`` times the scene's size
+margin of its plane, or the face's corners lie on one line, :func:`fillers`).  Every test takes margins of ``tolerance`` times the scene's size
 seen from the point (:func:`margins`), so that rounding -- ours, or the float32 scene that
 Embree traces -- can only keep more.  Two consequences a user sees: a face that only
 touches a visible one along the edge of an outline (the side of a box seen from above
@@ -36,7 +36,7 @@ through it, however thin.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 import numpy as np
 
@@ -69,6 +69,8 @@ LEVEL_CAP = 24
 FILLER_WIDTH = 1e-7
 #: rays per batch of :func:`sample_views`
 SAMPLE_BATCH = 1 << 20
+#: rays traced again in float64 per side that aimed rays hit (:func:`confirm_hits`)
+CONFIRM = 4
 #: rays in all of a camera path's views when cameras look into views and no budget is given
 VIEW_RAYS = 1 << 22
 
@@ -102,6 +104,11 @@ class ConservativeSet:
         ``base_level``, ``max_level``, ``tolerance``.
     seconds : float
         Time taken.
+    open_frusta : list of tuple
+        Per viewpoint, its frusta at the limit without a blocker, where the set keeps what
+        it cannot prove hidden: ``(roots, root, box)``, the viewpoint's (r, 3, 3) roots
+        (``axis``, ``right``, ``up``), and each frustum's (k,) root and (k, 4) box
+        ``u0, u1, w0, w1`` (its directions are ``axis + u right + w up``).
     """
 
     visible_side: np.ndarray
@@ -113,6 +120,7 @@ class ConservativeSet:
     parameters: dict
     seconds: float
     at_limit: np.ndarray
+    open_frusta: list = field(default_factory=list)
 
     @property
     def visible(self) -> np.ndarray:
@@ -352,17 +360,19 @@ def conservative_from(
     m = soup.n_faces
     visible_side = np.zeros((m, 2), bool)
     at_limit, in_front = np.zeros(m, bool), np.zeros(m, bool)
-    point_faces, point_sides, per_point = [], [], []
+    point_faces, point_sides, per_point, open_frusta = [], [], [], []
     totals = dict.fromkeys(("traced", "blocked", "split", "open", "empty"), 0)
     for view in views:
         t0 = time.perf_counter()
-        keep, counts = _trace_viewpoint(scene, view, base_level, max_level, tolerance)
+        keep, counts, leaves = _trace_viewpoint(scene, view, base_level, max_level, tolerance)
+        open_frusta.append((np.asarray(view.roots, np.float64), *leaves))
         faces = np.flatnonzero(keep)
         at_limit |= keep == fk.OPEN
         in_front |= keep == fk.BLOCKED
         sides = facing_sides(
             scene.triangles[faces], view.position, margins(scene, view.position, tolerance)[0]
         )
+        sides[scene.filler[faces] >= 0] = 2  # corners on one line: no side to tell
         visible_side[faces, 0] |= sides != 1
         visible_side[faces, 1] |= sides != 0
         point_faces.append(faces)
@@ -380,6 +390,7 @@ def conservative_from(
         parameters={"base_level": base_level, "max_level": max_level, "tolerance": tolerance},
         seconds=time.perf_counter() - start,
         at_limit=at_limit & ~in_front,
+        open_frusta=open_frusta,
     )
 
 
@@ -447,15 +458,16 @@ def _seed_rays(roots: np.ndarray, root: np.ndarray, box: np.ndarray) -> np.ndarr
 
 def _trace_viewpoint(
     scene: FrustumScene, view: Viewpoint, base_level: int, max_level: int, tolerance: float
-) -> tuple[np.ndarray, dict]:
-    """Trace one viewpoint's frusta level by level; the kept faces (m,) uint8 and the counts."""
+) -> tuple[np.ndarray, dict, tuple[np.ndarray, np.ndarray]]:
+    """Trace one viewpoint's frusta level by level: the kept faces (m,) uint8, the counts, and the open frusta's ``(root, box)``."""
     from meshvis._threads import in_threads
 
     m = scene.soup.n_faces
     keep = np.zeros(m, np.uint8)
     counts = dict.fromkeys(("traced", "blocked", "split", "open", "empty"), 0)
+    open_root, open_box = [np.zeros(0, np.int64)], [np.zeros((0, 4))]
     if m == 0:
-        return keep, counts
+        return keep, counts, (open_root[0], open_box[0])
     v = np.asarray(view.position, np.float64)
     delta, eta, mu = margins(scene, v, tolerance)
     roots = np.ascontiguousarray(view.roots, np.float64)
@@ -485,12 +497,14 @@ def _trace_viewpoint(
         counts["traced"] += len(root)
         counts["blocked"] += int((status == fk.BLOCKED).sum())
         counts["open"] += int((status == fk.OPEN).sum())
+        open_root.append(root[status == fk.OPEN])
+        open_box.append(box[status == fk.OPEN])
         counts["empty"] += int((status == fk.EMPTY).sum())
         split = status == fk.SPLIT
         counts["split"] += int(split.sum())
         root, box = split_frusta(root[split], box[split])
         level += 1
-    return keep, counts
+    return keep, counts, (np.concatenate(open_root).astype(np.int64), np.concatenate(open_box))
 
 
 def sample_views(
@@ -535,6 +549,123 @@ def sample_views(
             ok = hits.face >= 0
             seen[hits.face[ok], hits.side[ok]] = True
     return seen
+
+
+def sample_frusta(
+    scene: FrustumScene,
+    position: np.ndarray,
+    frusta: tuple[np.ndarray, np.ndarray, np.ndarray],
+    per_side: int,
+    rng: np.random.Generator,
+) -> np.ndarray:
+    """(m, 2) bool: the sides that a jittered grid of rays through each of ``frusta`` hits first.
+
+    Each frustum's box is cut into ``per_side`` x ``per_side`` cells and one ray leaves
+    ``position`` through a uniformly random point of each cell.  Aimed at the frusta that
+    :func:`conservative_from` keeps open at its limit (``open_frusta``), these rays find
+    faces seen only through narrow gaps, which uniformly random rays rarely reach.  Every
+    side counted was hit first by a ray, in the float32 Embree scene and again in float64
+    (:func:`confirm_hits`): a sampled lower bound, like :func:`sample_views`.
+
+    Parameters
+    ----------
+    scene : FrustumScene
+        The prepared model.
+    position : (3,) float64
+        The viewpoint.
+    frusta : tuple
+        ``(roots, root, box)``: (r, 3, 3) roots, (k,) root and (k, 4) box of each frustum
+        (:attr:`ConservativeSet.open_frusta`).
+    per_side : int
+        Rays along each side of a frustum's box (``per_side**2`` rays per frustum).
+    rng : numpy.random.Generator
+        The random generator of the jitter.
+
+    Returns
+    -------
+    (m, 2) bool
+
+    Examples
+    --------
+    >>> import trimesh
+    >>> scene = FrustumScene.build(trimesh.creation.box())
+    >>> roots = np.array([[[0, 0, 1], [1, 0, 0], [0, 1, 0]]], float)  # looking up +z
+    >>> frusta = (roots, np.zeros(1, np.int64), np.array([[-0.1, 0.1, -0.1, 0.1]]))
+    >>> seen = sample_frusta(scene, np.zeros(3), frusta, 4, np.random.default_rng(0))
+    >>> seen.sum(axis=0).tolist()  # the top's inner side: one or both of its triangles
+    [0, 2]
+    """
+    seen = np.zeros((scene.soup.n_faces, 2), bool)
+    roots, root, box = frusta
+    per_side = _validate.integer("per_side", per_side, 1, 1 << 10)
+    cells = per_side * per_side
+    step = max(1, SAMPLE_BATCH // cells)
+    grid = (np.arange(cells) % per_side, np.arange(cells) // per_side)
+    for a in range(0, len(root), step):
+        r, b = root[a : a + step], box[a : a + step]
+        s = (grid[0] + rng.random((len(r), cells))) / per_side  # (k, cells) in [0, 1)
+        t = (grid[1] + rng.random((len(r), cells))) / per_side
+        u = b[:, 0, None] + s * (b[:, 1] - b[:, 0])[:, None]
+        w = b[:, 2, None] + t * (b[:, 3] - b[:, 2])[:, None]
+        axis, right, up = roots[r, 0], roots[r, 1], roots[r, 2]
+        d = axis[:, None] + u[..., None] * right[:, None] + w[..., None] * up[:, None]
+        d = d.reshape(-1, 3)
+        d /= np.linalg.norm(d, axis=1, keepdims=True)
+        hits = scene.caster.intersect(np.broadcast_to(position, d.shape), d)
+        confirm_hits(scene, position, d, hits.face, hits.side, seen)
+    return seen
+
+
+def confirm_hits(
+    scene: FrustumScene,
+    position: np.ndarray,
+    directions: np.ndarray,
+    face: np.ndarray,
+    side: np.ndarray,
+    seen: np.ndarray,
+    per_side: int = CONFIRM,
+) -> None:
+    """Mark in ``seen`` the sides that rays hit first, each confirmed by a float64 trace of the ray.
+
+    Rays aimed at narrow gaps and thin faces are where the float32 Embree scene can pass
+    between two faces that share an edge, and report a face behind them.  For each side
+    not yet in ``seen`` that some rays hit (``face``, ``side``: -1 for a miss), up to
+    ``per_side`` of those rays are traced again in float64 (:func:`._frusta_kernels.first_hits`);
+    the side is marked when one of them meets the same face first.
+
+    Parameters
+    ----------
+    scene : FrustumScene
+        The prepared model.
+    position : (3,) float64
+        Where the rays start.
+    directions : (n, 3) float64
+        Their directions.
+    face, side : (n,) int
+        What Embree hit first along each (face -1: nothing).
+    seen : (m, 2) bool
+        The sides seen so far; the confirmed sides are added to it.
+    per_side : int
+        Rays traced again per side.
+    """
+    idx = np.flatnonzero(face >= 0)
+    idx = idx[~seen[face[idx], side[idx]]]
+    if len(idx) == 0:
+        return
+    key = face[idx].astype(np.int64) * 2 + side[idx]
+    order = np.argsort(key, kind="stable")
+    key = key[order]
+    start = np.flatnonzero(np.r_[True, key[1:] != key[:-1]])
+    rank = np.arange(len(key)) - np.repeat(start, np.diff(np.r_[start, len(key)]))
+    pick = idx[order[rank < per_side]]
+    got = np.empty(len(pick), np.int64)
+    bvh = scene.bvh
+    fk.first_hits(
+        np.asarray(position, np.float64), np.ascontiguousarray(directions[pick], np.float64),
+        scene.triangles, bvh.lo, bvh.hi, bvh.first, bvh.count, bvh.order, got,
+    )  # fmt: skip
+    good = got == face[pick]
+    seen[face[pick][good], side[pick][good]] = True
 
 
 def bracket(model, region, *, search, max_level: int = DEFAULT_MAX_LEVEL, **search_kw):

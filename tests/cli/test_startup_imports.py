@@ -1,8 +1,10 @@
 """What a command imports before it works: the start-up cost of ``meshvis`` kept down.
 
-``meshvis info`` on an STL needs numpy and the compiled kernels (numba), not scipy's sparse
-graphs or k-d tree, trimesh or Embree; a command's parser needs no numerical module beyond
-numpy.  Each check runs in a fresh interpreter, as the command does.
+``meshvis info`` on a small STL needs numpy alone: not numba (its numpy kernels stand in for
+the compiled ones below ``SMALL_MODEL_FACES`` faces), scipy, trimesh or Embree; on a larger
+model it loads numba's compiled kernels and still no scipy module of its own.  A command's
+parser needs no numerical module beyond numpy.  Each check runs in a fresh interpreter, as
+the command does.
 """
 
 from __future__ import annotations
@@ -17,8 +19,8 @@ from helpers import real_model
 from meshvis._defaults import UNRESOLVED, module_constant, signature_default, source_default
 from meshvis.repair import operation
 
-#: modules ``meshvis info`` on an STL does without (numba imports scipy itself, and scipy's
-#: BLAS wrappers for its linear algebra, so those two are not listed)
+#: modules ``meshvis info`` on an STL does without, whatever its size (numba, when a larger
+#: model loads it, imports scipy itself, and scipy's BLAS wrappers, so those are not listed)
 NOT_FOR_INFO = (
     "scipy.sparse",
     "scipy.spatial",
@@ -54,13 +56,23 @@ def imported_after(code: str, names: tuple[str, ...]) -> set[str]:
     return set(out.split())
 
 
-def test_info_on_an_stl_imports_no_heavy_module():
+def info_imports(model: str, small_model_faces: int | None = None) -> set[str]:
+    """The heavy modules ``meshvis info MODEL`` imports, with the small-model threshold set."""
+    code = "import contextlib, io\nfrom meshvis.cli.main import main\n"
+    if small_model_faces is not None:
+        code += f"import meshvis.geometry._vectorised as v\nv.SMALL_MODEL_FACES = {small_model_faces}\n"
+    code += f"with contextlib.redirect_stdout(io.StringIO()):\n    assert main(['info', {model!r}]) == 0"
+    return imported_after(code, (*NOT_FOR_INFO, "numba", "scipy"))
+
+
+def test_info_on_a_small_stl_imports_neither_numba_nor_scipy():
     model = real_model("soup.stl")
-    code = (
-        "import contextlib, io\nfrom meshvis.cli.main import main\n"
-        f"with contextlib.redirect_stdout(io.StringIO()):\n    assert main(['info', {model!r}]) == 0"
-    )
-    assert imported_after(code, (*NOT_FOR_INFO, "numba")) == {"numba"}  # the kernels ran
+    assert info_imports(model) == set()
+
+
+def test_info_on_a_larger_model_loads_the_compiled_kernels_and_nothing_else_heavy():
+    # soup.stl (100 faces) made "larger" by a threshold of 10 faces
+    assert info_imports(real_model("soup.stl"), small_model_faces=10) == {"numba", "scipy"}
 
 
 @pytest.mark.parametrize("command", LIGHT_PARSERS)

@@ -72,3 +72,23 @@ def test_the_viewpoints_are_inside_the_box_and_around_the_scene():
     assert ((inside >= lo) & (inside <= hi)).all()
     radius = np.linalg.norm(outside - 0.5 * (lo + hi), axis=1)
     np.testing.assert_allclose(radius, bench.OUTSIDE_RADIUS * 0.5 * soup.diagonal)
+
+
+def test_rays_are_not_aimed_at_faces_whose_corners_lie_on_one_line():
+    from meshvis.geometry.adjacency import components, edges, face_adjacency
+    from meshvis.visibility.conservative import FrustumScene
+
+    soup = scene()
+    flat = np.array([[0.0, 0.0, 5.0], [1.0, 0.0, 5.0], [2.0, 0.0, 5.0]])  # a line above the scene
+    soup = meshvis.Soup(
+        np.r_[soup.vertices, flat], np.r_[soup.faces, [[len(soup.vertices) + k for k in range(3)]]]
+    )
+    fs = FrustumScene.build(soup)
+    part = components(soup.n_faces, face_adjacency(edges(fs.welded), manifold_only=False))[1]
+    point = np.array([0.0, 0.0, 10.0])
+    last = soup.n_faces - 1
+    seen, parts = bench.aimed_seen(fs, point, np.array([0, last]), 16, np.random.default_rng(0), part)
+    assert parts[1] == 0 and not seen[last].any()
+    # the same rays twice: the same answer
+    again = bench.aimed_seen(fs, point, np.array([0, last]), 16, np.random.default_rng(0), part)
+    assert (again[0] == seen).all() and (again[1] == parts).all()

@@ -27,3 +27,15 @@ def test_markdown_reads_the_error_on_confirmed_faces_only_when_recounted():
     both = markdown(_runs(True), machine, "cmd", 1.0)
     assert "0.100 % (1.000 s)" in plain and " % / " not in plain
     assert "0.100 % / 0.020 % (1.000 s)" in both and "recount confirms" in both
+
+
+def test_the_soup_input_keeps_the_models_up_axis():
+    import numpy as np
+
+    from meshvis.eval.bench.orientation import FLIP, soup_of
+    from meshvis.soup import Soup
+
+    model = Soup(np.eye(3), np.array([[0, 1, 2]] * 10), up=(0.0, 1.0, 0.0))
+    soup, turned = soup_of(model, seed=1)
+    assert soup.up == (0.0, 1.0, 0.0)
+    assert turned.sum() == round(FLIP * 10) and soup.n_vertices == 30

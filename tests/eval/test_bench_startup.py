@@ -37,3 +37,7 @@ def test_bench_startup_runs(tmp_path, capsys):
     assert "meshvis info MODEL" in text and "numba, first compiled kernel called" in text
     r = json.loads(out.read_text())
     assert r["median"]["meshvis info MODEL"] > r["median"]["python -c pass"] > 0
+    assert main(["bench", "startup", "--kernels", model, "--repeat", "1", "--json", str(out)]) == 0
+    assert "numba wall s" in capsys.readouterr().out
+    row = json.loads(out.read_text())["rows"][0]
+    assert row["faces"] == 100 and row["numba"]["cpu"] > 0 and row["numpy"]["cpu"] > 0

@@ -14,7 +14,7 @@ import pytest
 import meshvis
 from meshvis.cli.main import main
 from meshvis.errors import ModelError, ParameterError
-from meshvis.visibility.conservative import FrustumScene, conservative_from, sample_views
+from meshvis.visibility.conservative import FrustumScene, conservative_from, sample_frusta, sample_views
 from meshvis.visibility.viewpoints import parse_viewpoints
 
 # the faces of these scenes are large: a few levels of frusta are enough, and fast
@@ -211,3 +211,49 @@ def test_cameras_with_views_bracket_rays_in_their_views(tmp_path, scenes):
     np.testing.assert_array_equal(vis.seen, names == "+x")  # both +x triangles, nothing else
     assert vis.report(per_face=False)["conservative"]["outside"] == 0
     np.testing.assert_array_equal(vis.conservative.visible, names == "+x")
+
+
+def test_a_sliver_thinner_than_the_margin_that_a_ray_hits_stays_in_the_set():
+    # a sliver 1e-9 wide (far below the tests' margin of about 1e-5) facing the point, in front
+    # of a back wall: a ray aimed at it hits it first, so it may be seen
+    sliver = [[(-0.5, 0.0, 1.0), (0.5, 0.0, 1.0), (0.0, 1e-9, 1.0)]]
+    soup = soup_from(sliver + quad_x(-5, 5, -5, 5, 3))
+    scene = FrustumScene.build(soup)
+    d = np.array([[0.0, 0.5e-9, 1.0]])
+    assert int(scene.caster.intersect(np.zeros((1, 3)), d / np.linalg.norm(d)).face[0]) == 0
+    c = conservative_from(soup, "points:0,0,0", max_level=LEVEL, scene=scene)
+    assert c.visible_side[0, 1]  # its back side faces the point (its corners lie on one line: both)
+    assert c.visible_side[1:, 1].all() and not c.visible_side[1:, 0].any()  # the wall around it
+
+
+def test_rays_through_the_open_frusta_see_only_what_the_set_holds_and_repeat_with_the_seed():
+    # a wall with a slit 0.02 wide: frusta along the slit's edges stay open at the limit
+    wall = quad_x(-5, -0.01, -5, 5, 1) + quad_x(0.01, 5, -5, 5, 1)
+    edges = np.arange(-5.0, 5.0 + 1e-9, 0.4)
+    soup = soup_from(wall + [t for x0, x1 in zip(edges[:-1], edges[1:]) for t in quad_x(x0, x1, -5, 5, 3)])
+    scene = FrustumScene.build(soup)
+    c = conservative_from(soup, "points:0,0,0", max_level=LEVEL, scene=scene)
+    roots, root, box = c.open_frusta[0]
+    assert len(root) == c.frusta["open"] > 0 and box.shape == (len(root), 4)
+    seen = [
+        sample_frusta(scene, np.zeros(3), c.open_frusta[0], 4, np.random.default_rng(3)) for _ in range(2)
+    ]
+    assert (seen[0] == seen[1]).all()
+    assert seen[0][len(wall) :].any()  # through the slit, the back wall
+    assert not (seen[0] & ~c.visible_side).any()
+
+
+def test_hits_are_counted_only_when_a_float64_trace_meets_the_same_face_first():
+    from meshvis.visibility.conservative import confirm_hits
+
+    # a near wall (faces 0, 1) in front of a far wall (faces 2, 3), seen from below
+    soup = soup_from(quad_x(-1, 1, -1, 1, 1) + quad_x(-2, 2, -2, 2, 3))
+    scene = FrustumScene.build(soup)
+    d = np.array([[0.1, 0.2, 1.0], [0.3, -0.1, 1.0]])
+    d /= np.linalg.norm(d, axis=1, keepdims=True)
+    face = scene.caster.intersect(np.zeros((2, 3)), d).face
+    assert set(face.tolist()) <= {0, 1}
+    seen = np.zeros((4, 2), bool)
+    # the true hits, and the same rays claimed to reach the far wall (as a leak would)
+    confirm_hits(scene, np.zeros(3), np.r_[d, d], np.r_[face, [2, 3]], np.ones(4, np.int64), seen)
+    assert seen[:, 1].tolist() == [f in face for f in range(4)] and not seen[:, 0].any()

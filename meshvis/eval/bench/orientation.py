@@ -109,7 +109,7 @@ def model_paths(names: str | None, quick: bool, models_dir: str | os.PathLike = 
 
 
 def soup_of(soup, seed: int = 0):
-    """The soup input: unwelded, ``round(FLIP m)`` random faces turned over.
+    """The soup input: unwelded, ``round(FLIP m)`` random faces turned over, the model's up axis kept.
 
     Returns
     -------
@@ -125,7 +125,7 @@ def soup_of(soup, seed: int = 0):
     turned[rng.choice(m, int(round(FLIP * m)), replace=False)] = True
     corners = soup.vertices[soup.faces].reshape(-1, 3)
     faces = np.arange(3 * m, dtype=np.int64).reshape(m, 3)
-    return Soup(corners, faces).flipped(turned), turned
+    return Soup(corners, faces, up=soup.up).flipped(turned), turned
 
 
 def _meshvis(soup, rays_per_node: int | None, seed: int):
