@@ -60,6 +60,7 @@ def pvs(
     Parameters
     ----------
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model.
     cells : str or ViewCells
         ``"auto"`` or ``"auto:N"``: N cells (default 64) built by render cost (002);
         ``"grid:NX,NY,NZ"``: a uniform grid over the view space's box; a path to a JSON
@@ -106,6 +107,7 @@ def pvs(
     (2, 12)
     """
     t_start = time.perf_counter()
+    cpu_start = time.process_time()
     seed = _validate.seed(seed)
     if budget is not None:
         budget = _validate.integer("budget", budget, 0)
@@ -138,12 +140,13 @@ def pvs(
     stats = {n: {"samples": 0, "rays": 0, "contribution": 0, "seconds": 0.0} for n in st.STRATEGIES}
     history: dict[str, list] = {
         "seconds": [],
+        "cpu_seconds": [],
         "rays": [],
         "mean_pvs": [],
         "estimate_per_million": [],
         "probabilities": [],
     }
-    batches: dict[str, list] = {"seconds": [], "rays": []}
+    batches: dict[str, list] = {"seconds": [], "cpu_seconds": [], "rays": []}
     sizes = np.zeros(vc.n_cells, np.int64)
     rays = 0
 
@@ -164,12 +167,15 @@ def pvs(
         fresh = when == sampler.batch
         np.add.at(sizes, cell[fresh], 1) if fresh.any() else None
         now = time.perf_counter() - t_start
+        cpu = time.process_time() - cpu_start
         history["seconds"].append(now)
+        history["cpu_seconds"].append(cpu)
         history["rays"].append(rays)
         history["mean_pvs"].append(float(sizes.mean()))
         history["estimate_per_million"].append(estimate.per_million)
         history["probabilities"].append({k: round(v, 4) for k, v in p.items()})
         batches["seconds"].append(now)
+        batches["cpu_seconds"].append(cpu)
         batches["rays"].append(rays)
         sampler.batch += 1
 
@@ -193,6 +199,7 @@ def pvs(
                 available = dict.fromkeys(st.STRATEGIES, True)
                 available["mutation"] = available["silhouette"] = len(sampler.buffer) > 0
                 available["border"] = len(sampler.border) > 0
+                available["adjacent"] = len(sampler.spread) > 0 and vc.n_cells > 1
                 p = mixture.probabilities(available)
                 parts = []
                 for name in st.STRATEGIES:
@@ -343,6 +350,12 @@ def _draw(name: str, k: int, vs, surface, sampler: GlobalSampler, rng, caster, p
         return st.two_point_mutation(sampler.buffer, k, rng)
     if name == "silhouette":
         return st.silhouette_mutation(sampler.buffer, k, rng, caster, push)
+    if name == "adjacent":
+        if sampler.adjacent is None:
+            sampler.adjacent = sampler.cells.adjacent()
+        return st.adjacent_cell(
+            sampler.spread, k, rng, sampler.bits, sampler.adjacent, sampler.cells, surface
+        )
     if sampler.neighbours is None:
         sampler.neighbours = st.face_neighbours(caster.soup)
     return st.border_mutation(sampler.border, k, rng, sampler.bits, sampler.neighbours, surface)

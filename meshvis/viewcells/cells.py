@@ -58,9 +58,13 @@ class ViewCells:
     Attributes
     ----------
     n_cells : int
-    cell_lo, cell_hi : (k, 3) float64, the cells' boxes
-    volume : (k,) float64, each cell's share of the view space's volume (P(cell) of 002 §3.3)
-    parent : (n,) int32, each node's parent (-1 for the root)
+        Number of cells ``k``.
+    cell_lo, cell_hi : (k, 3) float64
+        The cells' boxes.
+    volume : (k,) float64
+        Each cell's share of the view space's volume (P(cell) of 002 §3.3).
+    parent : (n,) int32
+        Each node's parent (-1 for the root).
     """
 
     view_space: ViewSpace
@@ -148,6 +152,7 @@ class ViewCells:
         Parameters
         ----------
         view_space : ViewSpace
+            The space the grid covers (its box).
         shape : 3 ints
             Cells along x, y and z.
 
@@ -188,6 +193,7 @@ class ViewCells:
         Parameters
         ----------
         view_space : ViewSpace
+            The space the boxes partition.
         boxes : (k, 6) float
             ``x0, y0, z0, x1, y1, z1`` of each cell; clipped to the view space's box (a box
             outside it is left out).  Boxes must not overlap.
@@ -276,6 +282,26 @@ class ViewCells:
     def radius(self) -> np.ndarray:
         """(k,) half the diagonal of each cell's box."""
         return 0.5 * np.linalg.norm(self.cell_hi - self.cell_lo, axis=1)
+
+    def adjacent(self) -> tuple[np.ndarray, np.ndarray]:
+        """CSR ``(ptr, nbr)`` of the cells whose box shares a piece of wall with each cell's box.
+
+        Cell ``c``'s neighbours are ``nbr[ptr[c]:ptr[c + 1]]``: boxes that touch along one
+        axis (within a relative 1e-9 of the view space's diagonal) and overlap, with a
+        positive extent, along the other two.
+        """
+        lo, hi = self.cell_lo, self.cell_hi
+        eps = 1e-9 * self.view_space.diagonal
+        overlap = np.minimum(hi[:, None], hi[None]) - np.maximum(lo[:, None], lo[None])  # (k, k, 3)
+        touch = (np.abs(hi[:, None] - lo[None]) <= eps) | (np.abs(lo[:, None] - hi[None]) <= eps)
+        wide = overlap > eps
+        # touching along one axis, overlapping along both others
+        pair = (touch & (wide.sum(axis=2, keepdims=True) - wide == 2)).any(axis=2)
+        np.fill_diagonal(pair, False)
+        rows, nbr = np.nonzero(pair)
+        ptr = np.zeros(self.n_cells + 1, np.int64)
+        np.add.at(ptr, rows + 1, 1)
+        return np.cumsum(ptr), nbr.astype(np.int64)
 
     def describe(self) -> dict:
         """The cells as a JSON-ready dict (the boxes of every cell)."""
@@ -498,6 +524,7 @@ def parse_cells(text, view_space: ViewSpace) -> ViewCells | tuple[str, int]:
         ``grid:NX,NY,NZ``; ``auto`` or ``auto:N`` (built by render cost, returned as
         ``("auto", N)`` for the caller to build); a path to a JSON file of boxes.
     view_space : ViewSpace
+        The space the cells partition.
 
     Returns
     -------

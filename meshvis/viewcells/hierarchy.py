@@ -94,6 +94,7 @@ def auto_cells(
     Parameters
     ----------
     view_space : ViewSpace
+        The space the cells partition.
     segments : Segments
         The coarse pass's visibility segments, clipped to the view space's box.
     points : (p, 3) float

@@ -136,6 +136,7 @@ def render_views(
     Parameters
     ----------
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model the PVS was made for.
     view_space : ViewSpace
         Where the viewpoints are drawn (uniformly) and the walkthrough goes.
     points, path : int
@@ -145,6 +146,7 @@ def render_views(
     seed : int
         Seed of the viewpoints and the path.
     caster : RayCaster, optional
+        A caster of the model to reuse.
 
     Returns
     -------

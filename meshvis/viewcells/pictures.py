@@ -42,6 +42,7 @@ def top_view(result, model, *, height: float | None = None) -> np.ndarray:
     Parameters
     ----------
     result : PVS
+        The PVS of every cell.
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
         The model the PVS was made for.
     height : float, optional
@@ -114,9 +115,13 @@ def cell_view(
     Parameters
     ----------
     result : PVS
+        The PVS of every cell.
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model the PVS was made for.
     cell : int
-    size : (width, height)
+        The cell whose PVS is drawn.
+    size : (int, int)
+        Width and height of the picture in pixels.
     azimuth, elevation : float
         Degrees of the fitted camera (:meth:`meshvis.rays.camera.Camera.fit`).
 

@@ -45,11 +45,16 @@ class PVS:
     Attributes
     ----------
     cells : ViewCells
+        The view cells (the leaves of a kD-tree over the view space).
     bits : (k, w) uint64
         The PVS of each cell as a bit set over face ids (face ``f`` is bit ``f % 64`` of
         word ``f // 64``).
     n_faces : int
-    part_id : (m,) int64 or None, part_names : list of str
+        Faces of the model.
+    part_id : (m,) int64 or None
+        The named part of each face (None when the model has none or the file was read
+        without its model).
+    part_names : list of str
         The model's named parts (a file read without its model knows only the parts each
         cell sees, :attr:`cell_parts`).
     sides : (m,) uint8
@@ -62,7 +67,8 @@ class PVS:
     log : tuple of (cell, face, batch) arrays, optional
         Every sampled entry with the batch that found it (runs only, not files).
     batches : dict, optional
-        ``seconds`` and ``rays`` at the end of each batch (runs only).
+        ``seconds``, ``cpu_seconds`` (of the whole process) and ``rays`` at the end of each
+        batch (runs only).
     """
 
     cells: ViewCells

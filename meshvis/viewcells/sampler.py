@@ -49,11 +49,17 @@ class BatchResult:
     Attributes
     ----------
     samples : int
-    rays : int, rays traced (both ways, and discovery rays)
-    contribution : int, new PVS entries (AGVS Eq. 2 summed)
-    own_rays : int, rays (2 per sample) that found a face new to the cell holding their start
-    own_contributing : int, of those, the ones that did
+        Samples cast.
+    rays : int
+        Rays traced (both ways, and discovery rays).
+    contribution : int
+        New PVS entries (AGVS Eq. 2 summed).
+    own_rays : int
+        Rays (2 per sample) that started in a cell.
+    own_contributing : int
+        Of those, the ones that found a face new to the cell holding their start.
     seconds : float
+        Time of the batch.
     """
 
     samples: int
@@ -70,16 +76,22 @@ class GlobalSampler:
     Parameters
     ----------
     cells : ViewCells
+        The view cells.
     caster : RayCaster
         The model's caster.
     buffer : MutationBuffer, optional
+        Where the successful segments are kept for mutation (a new one by default).
 
     Attributes
     ----------
-    bits : (k, w) uint64, the PVS of each cell as a bit set
-    sides : (m,) uint8, bit 0: the front of the face was hit, bit 1: the back
-    cell_segments : (k,) int64, segments that pierced each cell
-    face_hits : (m,) int64, segment ends on each face
+    bits : (k, w) uint64
+        The PVS of each cell as a bit set.
+    sides : (m,) uint8
+        Bit 0: the front of the face was hit, bit 1: the back.
+    cell_segments : (k,) int64
+        Segments that pierced each cell.
+    face_hits : (m,) int64
+        Segment ends on each face.
     """
 
     def __init__(self, cells, caster, buffer: MutationBuffer | None = None):
@@ -94,6 +106,10 @@ class GlobalSampler:
         self.buffer = buffer or MutationBuffer()
         #: new PVS entries with a point of the cell that saw the face (border mutations)
         self.border = MutationBuffer(("x", "face", "cell"))
+        #: new PVS entries, for the cells next to theirs (adjacent-cell mutations)
+        self.spread = MutationBuffer(("face", "cell"))
+        #: cells sharing a wall with each cell, CSR (made on first use)
+        self.adjacent: tuple[np.ndarray, np.ndarray] | None = None
         #: faces sharing a vertex with each face, CSR (made on first use)
         self.neighbours: tuple[np.ndarray, np.ndarray] | None = None
         self._log_cell = np.empty(LOG_START, np.int32)
@@ -239,7 +255,7 @@ class GlobalSampler:
         return out
 
     def _keep_border(self, o, d, found, rng) -> None:
-        """Store every new entry with a random point of its segment inside the cell."""
+        """Store every new entry with a random point of its segment inside the cell, and for its neighbours."""
         for log_start, sample, t0, t1 in found:
             if len(sample) == 0:
                 continue
@@ -249,6 +265,7 @@ class GlobalSampler:
             self.border.add(
                 x=o[sample] + t[:, None] * d[sample], face=face.astype(np.int64), cell=cell.copy()
             )
+            self.spread.add(face=face.astype(np.int64), cell=cell.astype(np.int64))
 
     def _keep(self, o, d, t_back, t_fwd, face_back, face_fwd, clip, useful, origin_cell) -> None:
         """Store the segments with a new entry as mutation candidates: one per end that found one."""

@@ -18,6 +18,13 @@ view cell it pierces (:mod:`.sampler`).
   discovery rays towards points beside the face it hit, along a random direction across
   the segment, in two rounds of four (a quaternary search): the nearest one that misses
   the face passes its edge, and the new sample follows it past the edge.
+* **border** (border mutation, after GVS's adaptive border sampling): from the point of the
+  cell that saw a face new to it, a ray towards a neighbour of that face (sharing a
+  vertex) the cell has not seen yet.
+* **adjacent** (adjacent-cell mutation): a face new to a cell is aimed at from a random
+  point of a cell next to it (sharing a piece of wall) that has not seen the face yet.  The
+  faces a cell misses are mostly small faces that its neighbours see: a viewer near the
+  wall between two cells sees nearly what the other side sees.
 
 Mutation candidates are kept in :class:`MutationBuffer`, the least mutated first.
 """
@@ -31,7 +38,7 @@ import numpy as np
 from meshvis.rays.samples import tangent_frames, uniform_sphere
 
 #: the distributions, in the order of the mixture
-STRATEGIES = ("uniform", "object", "two-point", "mutation", "silhouette", "border")
+STRATEGIES = ("uniform", "object", "two-point", "mutation", "silhouette", "border", "adjacent")
 #: discovery rays per round of the silhouette search, and rounds
 SILHOUETTE_RAYS = 4
 SILHOUETTE_ROUNDS = 2
@@ -43,6 +50,7 @@ RAYS_PER_SAMPLE = {
     "mutation": 2,
     "silhouette": 2 + SILHOUETTE_RAYS * SILHOUETTE_ROUNDS,
     "border": 2,
+    "adjacent": 2,
 }
 #: candidates the mutation buffer holds (AGVS §7 uses 2 M)
 BUFFER_SIZE = 1 << 20
@@ -138,7 +146,9 @@ class MutationBuffer:
     Parameters
     ----------
     fields : tuple of str
+        Names of the arrays each candidate carries.
     capacity : int
+        Most candidates kept.
     """
 
     def __init__(self, fields=("s_o", "s_t", "face", "r_o", "r_t"), capacity: int = BUFFER_SIZE):
@@ -304,3 +314,33 @@ def border_mutation(
     d = q - x
     ok = np.linalg.norm(d, axis=1) > 0
     return Samples(x[ok], _unit(d[ok]))
+
+
+def adjacent_cell(
+    buf: MutationBuffer, k: int, rng: np.random.Generator, bits, adjacent, cells, surface
+) -> Samples:
+    """Adjacent-cell mutations of ``k`` new PVS entries (least mutated first).
+
+    For an entry (cell, face): a random cell sharing a wall with the cell, and when that
+    cell has not seen the face, a ray from a random point of it (in the view space) towards
+    a random point of the face.
+    """
+    ptr, nbr = adjacent
+    c = buf.take(k)
+    if c is None or len(nbr) == 0:
+        return Samples(np.zeros((0, 3)), np.zeros((0, 3)))
+    count = ptr[c["cell"] + 1] - ptr[c["cell"]]
+    has = count > 0
+    cell, face, count = c["cell"][has], c["face"][has], count[has]
+    other = nbr[ptr[cell] + np.minimum((rng.random(len(cell)) * count).astype(np.int64), count - 1)]
+    word = bits[other, face >> 6]
+    unseen = ((word >> (face & 63).astype(np.uint64)) & np.uint64(1)) == 0
+    other, face = other[unseen], face[unseen]
+    lo, hi = cells.cell_lo[other], cells.cell_hi[other]
+    x = lo + rng.random((len(other), 3)) * (hi - lo)
+    r1, r2 = rng.random(len(face)), rng.random(len(face))
+    s = np.sqrt(r1)
+    w = np.stack([1 - s, s * (1 - r2), s * r2], axis=1)
+    q = np.einsum("ki,kij->kj", w, surface.triangles[face])
+    ok = cells.view_space.contains(x) & (np.linalg.norm(q - x, axis=1) > 0)
+    return Samples(x[ok], _unit((q - x)[ok]))

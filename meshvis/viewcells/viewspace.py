@@ -214,6 +214,7 @@ def default_view_space(
     Parameters
     ----------
     model : Soup or anything :func:`meshvis.io.as_soup` accepts
+        The model.
     view_space : str, ViewSpace or None
         ``"auto"`` (or None): the bounding box, above the ground when the scene stands on
         one; ``"box"``: the bounding box; ``"box:x0,y0,z0,x1,y1,z1"``: that box.  A

@@ -155,3 +155,22 @@ def test_the_walk_visits_exactly_the_cells_each_segment_pierces():
     # the point of each segment inside the space lies in the cell the walk gave it
     inside = vc.locate(origin)
     assert np.array_equal(out[0][inside >= 0], inside[inside >= 0])
+
+
+def test_adjacent_cells_share_a_piece_of_wall():
+    vc = ViewCells.grid(UNIT, (4, 3, 2))
+    ptr, nbr = vc.adjacent()
+    lo = vc.cell_lo
+    for c in range(vc.n_cells):
+        got = set(nbr[ptr[c] : ptr[c + 1]].tolist())
+        # in a grid of unit cubes the neighbours are the cells one step away along one axis
+        want = {d for d in range(vc.n_cells) if np.abs(lo[d] - lo[c]).sum() == 1.0}
+        assert got == want
+    # boxes of different sizes: [0,1]x[0,3] touches [1,4]x[0,1]; [3,4]x[1,3] touches [1,4]x[0,1]
+    # only along an edge at y = 1 for x in [3, 4] (z overlaps 0..1): a piece of wall
+    boxes = ViewCells.from_boxes(UNIT, [[0, 0, 0, 1, 3, 2], [1, 0, 0, 4, 1, 2], [3, 1, 0, 4, 3, 1]])
+    ptr, nbr = boxes.adjacent()
+    pairs = {(c, int(d)) for c in range(boxes.n_cells) for d in nbr[ptr[c] : ptr[c + 1]]}
+    box = {tuple(np.r_[boxes.cell_lo[c], boxes.cell_hi[c]].tolist()): c for c in range(boxes.n_cells)}
+    a, b, c = box[(0, 0, 0, 1, 3, 2)], box[(1, 0, 0, 4, 1, 2)], box[(3, 1, 0, 4, 3, 1)]
+    assert pairs == {(a, b), (b, a), (b, c), (c, b)}

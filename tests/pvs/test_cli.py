@@ -138,3 +138,30 @@ def test_remove_interior_removes_what_no_cell_sees(levels, tmp_path, capsys):
         capsys, ["remove-interior", "missing.obj", "-o", kept, "--force", "--from", "cells:none.npz"]
     )
     assert "PVS file not found" in err
+
+
+@pytest.mark.slow
+def test_bench_pvs_reports_cpu_seconds_and_reuses_its_cached_run(tmp_path, capsys):
+    model = os.path.join(os.path.dirname(__file__), "..", "..", "models", "house.obj")
+    argv = ["bench", "pvs", model, "--rays", "300000", "--cells", "grid:2,1,2", "--points", "8"]
+    argv += ["--path", "4", "--size", "8", "--parts", "agvs,converged", "--gvs-cells", "1"]
+    argv += ["--cache", str(tmp_path)]
+    assert main([*argv, "--json", str(tmp_path / "a.json")]) == 0
+    first = json.loads((tmp_path / "a.json").read_text())["results"][0]
+    curve = [p["cpu_seconds"] for p in first["agvs_curve"]]
+    assert curve == sorted(curve) and 0 < curve[-1] <= first["cpu_seconds"]
+    g = first["gvs_converged"]
+    assert g["extrapolated_cpu_seconds"] == pytest.approx(4 * g["cpu_seconds_per_cell"])
+    assert (g["cpu_ratio"] is None) == (g["agvs_cpu_seconds_to_same_mean_pvs"] is None)
+    assert "s CPU) for all cells" in capsys.readouterr().out
+    # the second run reads the cached run: the same numbers
+    assert main([*argv, "--json", str(tmp_path / "b.json")]) == 0
+    second = json.loads((tmp_path / "b.json").read_text())["results"][0]
+    assert second["agvs_curve"] == first["agvs_curve"] and second["rays"] == first["rays"]
+    # with the filter: judged with and without the faces it added (a superset: never more wrong pixels)
+    assert main([*argv, "--parts", "agvs", "--filter", "--json", str(tmp_path / "c.json")]) == 0
+    fl = json.loads((tmp_path / "c.json").read_text())["results"][0]
+    assert fl["filter"]["added"] > 0
+    assert fl["mean_pvs"] == pytest.approx(fl["filter"]["mean_pvs_sampled"] + fl["filter"]["mean_added"])
+    assert fl["final"]["mean"] <= fl["filter"]["sampled"]["mean"]
+    assert fl["filter"]["mean_pvs_sampled"] == pytest.approx(first["mean_pvs"])

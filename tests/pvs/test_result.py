@@ -110,3 +110,32 @@ def test_the_buffer_hands_out_the_least_mutated_newest_first():
     assert len(buf) == 5
     assert sorted(buf.take(5)["x"].tolist()) == [0, 10, 11, 12, 13]
     assert buf.take(0) is None
+
+
+def test_adjacent_cell_mutations_aim_from_a_neighbour_at_the_face_it_has_not_seen():
+    from meshvis.soup import Soup
+    from meshvis.viewcells.cells import ViewCells
+    from meshvis.viewcells.strategies import SurfacePoints, adjacent_cell
+    from meshvis.viewcells.viewspace import ViewSpace
+
+    soup = Soup(np.array([[5.0, 0, 0], [5, 1, 0], [5, 0, 1]]), np.array([[0, 1, 2]]))
+    vc = ViewCells.grid(ViewSpace(np.zeros(3), np.array([3.0, 1, 1])), (3, 1, 1))
+    bits = np.zeros((3, 1), np.uint64)
+    bits[[0, 2], 0] = 1  # cells 0 and 2 see the face, cell 1 does not
+    buf = MutationBuffer(("face", "cell"))
+    buf.add(face=np.zeros(200, np.int64), cell=np.r_[np.zeros(100, np.int64), np.full(100, 2)])
+    s = adjacent_cell(buf, 200, np.random.default_rng(0), bits, vc.adjacent(), vc, SurfacePoints(soup))
+    # every entry's only unseeing neighbour is cell 1: all samples start there, aimed at the face
+    assert len(s.origin) == 200
+    assert vc.locate(s.origin).tolist() == [1] * 200
+    t = (5.0 - s.origin[:, 0]) / s.direction[:, 0]
+    hit = s.origin + t[:, None] * s.direction
+    assert (
+        np.all(hit[:, 1] >= -1e-9)
+        and np.all(hit[:, 2] >= -1e-9)
+        and np.all(hit[:, 1] + hit[:, 2] <= 1 + 1e-9)
+    )
+    bits[1, 0] = 1  # now every cell has it: nothing to aim at
+    buf.add(face=np.zeros(10, np.int64), cell=np.ones(10, np.int64))
+    again = adjacent_cell(buf, 10, np.random.default_rng(0), bits, vc.adjacent(), vc, SurfacePoints(soup))
+    assert len(again.origin) == 0

@@ -49,7 +49,7 @@ SNAPSHOTS = 10
 #: the estimate is compared with the measured error below this (wrong pixels per million)
 COMPARE_BELOW = 100.0
 #: bump when the sampler changes, so that cached runs are not reused
-RUN_VERSION = 1
+RUN_VERSION = 3
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -67,6 +67,11 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--time", type=float, default=SECONDS, help="AGVS's time cap in seconds")
     p.add_argument("--rays", type=int, help="AGVS's ray budget (instead of the stop rule and the time)")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument(
+        "--filter",
+        action="store_true",
+        help="run AGVS with the visibility filter and judge its PVS with and without the filter's faces",
+    )
     p.add_argument("--points", type=int, default=judge.VIEWPOINTS, help="random viewpoints (six views each)")
     p.add_argument("--path", type=int, default=judge.PATH_POINTS, help="walkthrough points (one view each)")
     p.add_argument("--size", type=int, default=judge.SIZE, help="pixels along each side of a view")
@@ -161,6 +166,14 @@ def run_level(path: str, args: argparse.Namespace) -> dict:
     table = _views(soup, cells.view_space, args, caster)
     out["views"] = int(table.n_views)
     out["final"] = judge.summary(judge.pixel_errors(table, cells, result.bits), table)
+    if "filter" in result.summary:
+        # the log holds the sampled entries only: its last state is the PVS before the filter
+        sampled = result.bits_at(len(result.batches["seconds"]) - 1)
+        out["filter"] = {
+            **result.summary["filter"],
+            "mean_pvs_sampled": float(_sizes(sampled).mean()),
+            "sampled": judge.summary(judge.pixel_errors(table, cells, sampled), table),
+        }
     out["agvs_curve"] = _agvs_curve(result, table)
     out["estimate_vs_measured"] = [
         {"seconds": p["seconds"], "estimate": p["estimate"], "measured": p["mean"]}
@@ -196,6 +209,7 @@ def _agvs_run(soup, args, caster):
     key = hashlib.sha256(
         repr(
             (model_key(soup), args.cells, args.rays, None if args.rays else args.time, args.seed, RUN_VERSION)
+            + (("filter",) if args.filter else ())
         ).encode()
     ).hexdigest()[:20]
     path = os.path.join(args.cache, f"pvs-run-{key}.npz")
@@ -204,13 +218,17 @@ def _agvs_run(soup, args, caster):
         result = PVS.load(path, soup)
         with np.load(log_path) as d:
             result.log = (d["cell"], d["face"], d["batch"])
-            result.batches = {"seconds": d["seconds"].tolist(), "rays": d["rays"].tolist()}
+            result.batches = {
+                "seconds": d["seconds"].tolist(),
+                "cpu_seconds": d["cpu_seconds"].tolist(),
+                "rays": d["rays"].tolist(),
+            }
             run = json.loads(str(d["run"]))
         return result, run
     load = _load()
     start = _clock()
     run_args = {"budget": args.rays, "target_error": 0.0} if args.rays else {"seconds": args.time}
-    result = pvs(soup, args.cells, seed=args.seed, caster=caster, **run_args)
+    result = pvs(soup, args.cells, seed=args.seed, caster=caster, visibility_filter=args.filter, **run_args)
     wall, cpu = _since(start)
     run = {
         "seconds": wall,
@@ -229,6 +247,7 @@ def _agvs_run(soup, args, caster):
             face=result.log[1],
             batch=result.log[2],
             seconds=np.asarray(result.batches["seconds"]),
+            cpu_seconds=np.asarray(result.batches["cpu_seconds"]),
             rays=np.asarray(result.batches["rays"]),
             run=np.array(json.dumps(run)),
         )
@@ -300,6 +319,7 @@ def _agvs_curve(result, table) -> list[dict]:
             {
                 "batch": int(b),
                 "seconds": float(result.batches["seconds"][b]),
+                "cpu_seconds": float(result.batches["cpu_seconds"][b]),
                 "rays": int(result.batches["rays"][b]),
                 "estimate": float(h["estimate_per_million"][b]),
                 "mean_pvs": float(sizes.mean()),
@@ -404,16 +424,21 @@ def _gvs_converged(soup, result, caster, k: int, seed: int) -> dict:
     per_batch = np.bincount(when[mine], minlength=len(result.batches["seconds"])).cumsum() / len(pick)
     reached = np.flatnonzero(per_batch >= target)
     agvs_time = float(result.batches["seconds"][reached[0]]) if len(reached) else None
+    agvs_cpu = float(result.batches["cpu_seconds"][reached[0]]) if len(reached) else None
     total = float(np.mean(walls)) * cells.n_cells
+    total_cpu = float(np.mean(cpus)) * cells.n_cells
     return {
         "cells": pick.tolist(),
         "mean_pvs": target,
         "seconds_per_cell": float(np.mean(walls)),
         "cpu_seconds_per_cell": float(np.mean(cpus)),
         "extrapolated_seconds": total,
+        "extrapolated_cpu_seconds": total_cpu,
         "agvs_seconds_to_same_mean_pvs": agvs_time,
+        "agvs_cpu_seconds_to_same_mean_pvs": agvs_cpu,
         "agvs_mean_pvs_final_same_cells": float(per_batch[-1]),
         "ratio": (agvs_time / total) if agvs_time is not None else None,
+        "cpu_ratio": (agvs_cpu / total_cpu) if agvs_cpu is not None else None,
     }
 
 
@@ -465,7 +490,7 @@ def format_level(r: dict) -> str:
     ]
     for p in r["agvs_curve"]:
         lines.append(
-            f"{'AGVS':<22} {p['seconds']:>8.1f} {'':>8} {p['rays']:>12} {p['mean_pvs']:>9.0f} {p['mean']:>9.2f} "
+            f"{'AGVS':<22} {p['seconds']:>8.1f} {p['cpu_seconds']:>8.1f} {p['rays']:>12} {p['mean_pvs']:>9.0f} {p['mean']:>9.2f} "
             f"{p['worst']:>8.0f} {p['estimate']:>9.2f}"
         )
     for p in r.get("random_curve", []):
@@ -483,13 +508,22 @@ def format_level(r: dict) -> str:
         t = g["agvs_seconds_to_same_mean_pvs"]
         lines.append(
             f"per-cell guided to its stop rule on {len(g['cells'])} cells: {g['seconds_per_cell']:.1f} s per cell "
-            f"({g['cpu_seconds_per_cell']:.1f} s CPU), {g['extrapolated_seconds']:.0f} s for all cells; mean PVS "
+            f"({g['cpu_seconds_per_cell']:.1f} s CPU), {g['extrapolated_seconds']:.0f} s "
+            f"({g['extrapolated_cpu_seconds']:.0f} s CPU) for all cells; mean PVS "
             f"{g['mean_pvs']:.0f}; AGVS reached it on those cells after "
             + (
-                f"{t:.1f} s (ratio {g['ratio']:.3f})"
+                f"{t:.1f} s, {g['agvs_cpu_seconds_to_same_mean_pvs']:.1f} s CPU (ratio {g['ratio']:.3f}, "
+                f"CPU ratio {g['cpu_ratio']:.3f})"
                 if t is not None
                 else f"-- (it ended at {g['agvs_mean_pvs_final_same_cells']:.0f})"
             )
+        )
+    fl = r.get("filter")
+    if fl:
+        lines.append(
+            f"visibility filter: {fl['added']} entries added ({fl['mean_added']:.0f} per cell), mean PVS "
+            f"{fl['mean_pvs_sampled']:.0f} -> {r['mean_pvs']:.0f}; error mean {fl['sampled']['mean']:.2f} -> "
+            f"{r['final']['mean']:.2f}, worst {fl['sampled']['worst']:.0f} -> {r['final']['worst']:.0f} per million"
         )
     if r["estimate_vs_measured"]:
         ratios = [
