@@ -56,11 +56,23 @@ def _effective(task: FileTask, options: dict) -> dict:
 
 
 def _rays(report: dict) -> int | None:
+    """Every ray the operation's report counts (None when it counts none).
+
+    The cut's, the search by sight's, the rescue pass's and the self-check's.
+    """
+    counts: list[int] = []
     c = report.get("classification", report)
-    try:
-        return int(c["rays"]) + int(c.get("reverse_rays", 0)) + int(c.get("hint_rays", 0))
-    except (KeyError, TypeError, ValueError):
-        return None
+    if isinstance(c, dict) and isinstance(c.get("rays"), (int, float)):
+        counts += [int(c["rays"]), int(c.get("reverse_rays", 0)), int(c.get("hint_rays", 0))]
+    searches = [report.get("view"), *report.get("searches", [])]
+    counts += [
+        int(v["rays"]["total"]) for v in searches if isinstance(v, dict) and isinstance(v.get("rays"), dict)
+    ]
+    checks = [report.get("rescue"), report.get("self_check")]
+    counts += [
+        int(v["rays"]) for v in checks if isinstance(v, dict) and isinstance(v.get("rays"), (int, float))
+    ]
+    return sum(counts) if counts else None
 
 
 def _faces_out(report: dict, faces_in: int) -> int:

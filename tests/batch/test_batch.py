@@ -186,6 +186,16 @@ def test_run_file_matches_the_single_file_command(tmp_path, capsys):
     assert open(single, "rb").read() == open(task.output, "rb").read()
 
 
+def test_the_rows_rays_are_every_ray_of_a_removal_by_sight(tmp_path):
+    src = _sphere(tmp_path / "ball.ply")
+    task = mb.plan([src], "remove-interior", str(tmp_path / "out"))[0]
+    row = mb.run_file(task)
+    report = json.load(open(task.report))
+    assert "classification" not in report  # by sight: no cut
+    searched = report["view"]["rays"]["total"]
+    assert searched > 0 and row["rays"] == searched + report["rescue"]["rays"] + report["self_check"]["rays"]
+
+
 def test_run_file_reports_a_bad_file(tmp_path):
     out = tmp_path / "out"
     task = mb.plan([_noise(tmp_path / "noise.ply")], "remove-interior", str(out))[0]
