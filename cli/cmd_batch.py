@@ -13,7 +13,7 @@ import os
 import sys
 import time
 
-from .common import positive_int
+from .common import positive_int, positive_seconds
 
 EPILOG = """\
 outputs: DIR/<input path without extension>.<op>.<ext> and DIR/<...>.<op>.report.json,
@@ -23,16 +23,6 @@ plus DIR/summary.csv and DIR/summary.json.  Existing outputs are overwritten unl
 exit status: 0 every file ok (or skipped by --resume), 1 some file failed
 (error, time limit, crashed worker), 2 usage error, 130 interrupted (Ctrl-C).
 """
-
-
-def _positive_float(text: str) -> float:
-    try:
-        v = float(text)
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
-    if not v > 0 or v == float("inf"):
-        raise argparse.ArgumentTypeError("must be a positive number of seconds")
-    return v
 
 
 def _dests(add_options) -> list[str]:
@@ -88,7 +78,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--time-limit",
-        type=_positive_float,
+        type=positive_seconds,
         metavar="SECONDS",
         help="stop a file after this many seconds and report it as 'timeout'",
     )

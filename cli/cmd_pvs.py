@@ -8,7 +8,9 @@ from .common import (
     check_output,
     detail,
     library_default,
+    non_negative_float,
     positive_int,
+    positive_seconds,
     say,
     up_option,
     verbosity_options,
@@ -17,21 +19,6 @@ from .common import (
 
 #: the library function whose keywords the options are, and whose defaults they take
 PVS = "meshvis.viewcells.agvs:pvs"
-
-
-def _seconds(text: str) -> float:
-    """Parse a positive number of seconds (an argparse ``type``)."""
-    v = float(text)
-    if not v > 0:
-        raise argparse.ArgumentTypeError("must be a positive number of seconds")
-    return v
-
-
-def _non_negative(text: str) -> float:
-    v = float(text)
-    if not v >= 0:
-        raise argparse.ArgumentTypeError("must be at least 0")
-    return v
 
 
 def add_parser(sub) -> None:
@@ -64,7 +51,7 @@ def add_parser(sub) -> None:
     )
     stop = p.add_mutually_exclusive_group()
     stop.add_argument(
-        "--time", type=_seconds, default=d("seconds"), metavar="SECONDS", help="stop after this time"
+        "--time", type=positive_seconds, default=d("seconds"), metavar="SECONDS", help="stop after this time"
     )
     stop.add_argument(
         "--rays",
@@ -74,7 +61,7 @@ def add_parser(sub) -> None:
     )
     p.add_argument(
         "--target",
-        type=_non_negative,
+        type=non_negative_float,
         default=d("target_error"),
         help="stop when the estimated error is at most this many wrong pixels per million (0: never)",
     )

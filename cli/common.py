@@ -188,6 +188,39 @@ def positive_int(text: str) -> int:
     return v
 
 
+def non_negative_float(text: str) -> float:
+    """Parse a number of at least 0 (an argparse ``type``).
+
+    Raises
+    ------
+    ValueError
+        ``text`` is not a number (argparse reports it as an invalid value).
+    argparse.ArgumentTypeError
+        The number is below 0 (or NaN).
+    """
+    v = float(text)
+    if not v >= 0:
+        raise argparse.ArgumentTypeError("must be at least 0")
+    return v
+
+
+def positive_seconds(text: str) -> float:
+    """Parse a finite number of seconds above 0 (an argparse ``type``).
+
+    Raises
+    ------
+    argparse.ArgumentTypeError
+        ``text`` is not a number, or the number is not finite and above 0.
+    """
+    try:
+        v = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"expected a number of seconds, got {text!r}") from None
+    if not v > 0 or v == float("inf"):
+        raise argparse.ArgumentTypeError("must be a positive number of seconds")
+    return v
+
+
 def stderr(*text: Any) -> None:
     """Print to standard error.
 
