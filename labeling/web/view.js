@@ -113,7 +113,7 @@ const state = { labels: new Map(), scale: 1, fontSize: 11, boxHeight: 16, layout
 const stats = { received: [], answers: [], sent: 0, errors: 0, timing: [] };
 controls.addEventListener('change', () => { dirty = true; });
 
-async function renderIds() {
+function renderIds() {
   const w = stage.clientWidth, h = stage.clientHeight;
   const k = Math.min(1, MAX_ID_SIDE / Math.max(w, h));
   const iw = Math.max(8, Math.round(w * k)), ih = Math.max(8, Math.round(h * k));
@@ -121,10 +121,8 @@ async function renderIds() {
   if (idPixels.length !== iw * ih * 4) idPixels = new Uint8Array(iw * ih * 4);
   renderer.setRenderTarget(idTarget);
   renderer.render(idScene, camera);
+  renderer.readRenderTargetPixels(idTarget, 0, 0, iw, ih, idPixels);
   renderer.setRenderTarget(null);
-  // read back without blocking: the page keeps drawing and answering while the GPU (on a
-  // machine without one, SwiftShader on the CPU) finishes the buffer
-  await renderer.readRenderTargetPixelsAsync(idTarget, 0, 0, iw, ih, idPixels);
   // two bytes a pixel (part + 1, 0 = background) instead of four: half the data to send
   if (idPacked.length !== iw * ih) idPacked = new Uint16Array(iw * ih);
   for (let i = 0, j = 0; i < idPacked.length; i++, j += 4) idPacked[i] = idPixels[j] | (idPixels[j + 1] << 8);
@@ -135,18 +133,18 @@ async function requestLayout() {
   dirty = false;
   inFlight = true;
   const t0 = performance.now();
-  // the camera of the ID buffer, taken before the read-back lets the view move on
-  const cam = {
-    position: camera.position.toArray(), target: controls.target.toArray(),
-    up: camera.up.toArray(), fov: camera.fov,
+  const [iw, ih] = renderIds();
+  const t1 = performance.now();
+  const header = {
+    viewer, seq: ++seq, width: iw, height: ih, format: wide ? 'rgba' : 'u16',
+    camera: {
+      position: camera.position.toArray(), target: controls.target.toArray(),
+      up: camera.up.toArray(), fov: camera.fov,
+    },
   };
-  camera.updateMatrixWorld();
   const sentCamera = camera.matrixWorld.clone();
   stats.sent++;
   try {
-    const [iw, ih] = await renderIds();
-    const t1 = performance.now();
-    const header = { viewer, seq: ++seq, width: iw, height: ih, format: wide ? 'rgba' : 'u16', camera: cam };
     const res = await fetch('layout', {
       method: 'POST', body: wide ? idPixels : idPacked, headers: { 'X-Meshvis-Frame': JSON.stringify(header) },
     });
