@@ -25,7 +25,7 @@ const viewer = Math.random().toString(36).slice(2);
 const info = await (await fetch('scene.json')).json();
 // more parts than two bytes can number: send the RGBA read-out as it is
 const wide = info.parts.length >= 65535;
-const renderer = new THREE.WebGLRenderer({ antialias: false });
+const renderer = new THREE.WebGLRenderer({ antialias: false, preserveDrawingBuffer: true });
 renderer.setPixelRatio(1); // one canvas pixel per CSS pixel: the overlay's coordinates
 stage.appendChild(renderer.domElement);
 
@@ -160,9 +160,6 @@ async function requestLayout() {
     inFlight = false;
     if (!camera.matrixWorld.equals(sentCamera)) dirty = true;
   }
-  // the view moved while this frame was laid out: send the next one now, not at the next
-  // animation frame
-  if (dirty) requestLayout();
 }
 
 function accept(answer, iw) {
@@ -191,7 +188,6 @@ function accept(answer, iw) {
   for (const [part, entry] of state.labels) {
     if (!seen.has(part)) { entry.node.remove(); state.labels.delete(part); }
   }
-  overlayDirty = true;
 }
 
 // ------------------------------------------------------------------ the overlay
@@ -212,15 +208,8 @@ function project(p) {
   return [(tmp.x + 1) / 2 * stage.clientWidth, (1 - tmp.y) / 2 * stage.clientHeight];
 }
 
-// the overlay is drawn again only when the view moved, a layout arrived or a box still
-// glides: every change of the SVG costs the browser a style, layout and paint pass
-let overlayDirty = true;
-// a box closer than this to its place (pixels) has arrived
-const SETTLED = 0.05;
-
 function drawLabels() {
   const s = state.scale;
-  let gliding = false;
   for (const entry of state.labels.values()) {
     const a0 = [entry.anchor[0] * s, entry.anchor[1] * s];
     // the anchor's surface point where the camera sees it now; the label moves with it
@@ -230,8 +219,6 @@ function drawLabels() {
     if (!entry.shown) entry.shown = target.slice();
     entry.shown[0] += (target[0] - entry.shown[0]) * GLIDE;
     entry.shown[1] += (target[1] - entry.shown[1]) * GLIDE;
-    if (Math.abs(target[0] - entry.shown[0]) + Math.abs(target[1] - entry.shown[1]) > SETTLED) gliding = true;
-    else entry.shown = target.slice();
     const gx = entry.shown[0] - target[0], gy = entry.shown[1] - target[1];
     const pts = entry.leader.map(([x, y], i) => {
       if (i === 0) return a;
@@ -254,15 +241,13 @@ function drawLabels() {
     text.setAttribute('textLength', Math.max(1, w - 6 * s));
     text.setAttribute('lengthAdjust', 'spacingAndGlyphs');
   }
-  overlayDirty = gliding;
 }
 
 function showStatus() {
   const now = performance.now();
   while (stats.answers.length && now - stats.answers[0] > 1000) stats.answers.shift();
-  const line = `${state.labels.size} labels · layout ${state.layoutMs.toFixed(1)} ms · ` +
+  status.textContent = `${state.labels.size} labels · layout ${state.layoutMs.toFixed(1)} ms · ` +
     `${stats.answers.length} updates/s`;
-  if (status.textContent !== line) status.textContent = line;
 }
 
 // ------------------------------------------------------------------ the loop
@@ -275,10 +260,9 @@ function animate() {
     renderer.render(view, camera);
     drawn = camera.matrixWorld.clone();
     resized = false;
-    overlayDirty = true;
   }
   if (dirty && !inFlight) requestLayout();
-  if (overlayDirty) drawLabels();
+  drawLabels();
   showStatus();
   requestAnimationFrame(animate);
 }
