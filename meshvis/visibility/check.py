@@ -310,17 +310,23 @@ def _aim(
         return 0
     by = owner[corners[faces]]
     pick = by[np.arange(len(faces)), np.argmax(by >= 0, axis=1)]
-    faces = np.repeat(faces, AIM_RAYS)
-    direction = found.direction[np.repeat(pick, AIM_RAYS)] + AIM_SPREAD * rng.normal(size=(len(faces), 3))
-    direction /= np.linalg.norm(direction, axis=1, keepdims=True)
-    u, v = rng.random(len(faces)), rng.random(len(faces))
-    flip = u + v > 1
-    u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
-    tri = caster.soup.triangles[faces]
-    point = tri[:, 0] + u[:, None] * (tri[:, 1] - tri[:, 0]) + v[:, None] * (tri[:, 2] - tri[:, 0])
-    origin, ok = region.origin_on_line(point, direction)
-    hit, _ = trace(caster, origin[ok], direction[ok])
-    return int(ok.sum()) + _spread(caster, region, hit, todo, seen_side, sightings)
+    rays, hits = 0, []
+    per_batch = max(1, CHECK_BATCH // AIM_RAYS)
+    for lo in range(0, len(faces), per_batch):
+        face = np.repeat(faces[lo : lo + per_batch], AIM_RAYS)
+        direction = found.direction[np.repeat(pick[lo : lo + per_batch], AIM_RAYS)]
+        direction = direction + AIM_SPREAD * rng.normal(size=direction.shape)
+        direction /= np.linalg.norm(direction, axis=1, keepdims=True)
+        u, v = rng.random(len(face)), rng.random(len(face))
+        flip = u + v > 1
+        u[flip], v[flip] = 1 - u[flip], 1 - v[flip]
+        tri = caster.soup.triangles[face]
+        point = tri[:, 0] + u[:, None] * (tri[:, 1] - tri[:, 0]) + v[:, None] * (tri[:, 2] - tri[:, 0])
+        origin, ok = region.origin_on_line(point, direction)
+        hit, _ = trace(caster, origin[ok], direction[ok])
+        rays += int(ok.sum())
+        hits.append(hit)
+    return rays + _spread(caster, region, Sightings.concat(hits), todo, seen_side, sightings)
 
 
 def _cast(
