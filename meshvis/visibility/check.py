@@ -102,7 +102,7 @@ class SelfCheck:
 
     def report(self) -> dict:
         """JSON-ready summary."""
-        d = {
+        d: dict[str, int | float | None] = {
             "rays_per_face": self.rays_per_face,
             "faces_checked": self.faces,
             "faces_seen": int(self.seen.sum()),
