@@ -150,3 +150,11 @@ def test_seen_from_every_direction_the_wall_takes_the_side_seen_more(ground, up)
     r = orient(_courtyard(0.1), seed=0, ground=ground, up=up)
     assert not r.visibility["ground"] and r.visibility["kept_seen_from_above"] == 0
     np.testing.assert_array_equal(np.flatnonzero(r.flipped), [4, 5])
+
+
+@pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6)])
+def test_the_courtyard_wall_keeps_its_patch_at_any_scale_and_far_away(scale, shift):
+    soup = _courtyard(0.1)
+    soup = Soup(soup.vertices * scale + shift, soup.faces)
+    r = orient(soup, seed=0, ground=None)
+    assert r.visibility["kept_seen_from_above"] == 2 and not r.flipped.any()
