@@ -412,8 +412,13 @@ def conservative_from(
 def facing_sides(triangles: np.ndarray, position: np.ndarray, delta: float) -> np.ndarray:
     """(n,) int8: the side of each triangle that faces ``position`` (0 front, 1 back, 2 both).
 
-    Both when the point is within ``2 delta`` of the triangle's plane (or the triangle has
-    no area): a ray from there meets it at a grazing angle, on either side.
+    Both when moving the corners and the point by ``delta`` may put the point on the other
+    side of the triangle's plane (or the triangle has no area): a ray from there meets it
+    at a grazing angle, and rounding decides the side.  The side test is the sign of
+    ``det[b - a, c - a, p - a]``; to first order, the moves change it by at most ``delta``
+    times ``|n| + 2 |(c - a) x (p - a)| + 2 |(p - a) x (b - a)|`` (``n`` the normal), and the
+    point is taken as in the plane within twice that.  A tiny face seen from afar tilts
+    most.
 
     Examples
     --------
@@ -423,8 +428,10 @@ def facing_sides(triangles: np.ndarray, position: np.ndarray, delta: float) -> n
     """
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
     n = np.cross(b - a, c - a)
-    toward = np.einsum("ij,ij->i", n, position - a)
-    near = np.abs(toward) <= 2.0 * delta * np.linalg.norm(n, axis=1)
+    pa = position - a
+    toward = np.einsum("ij,ij->i", n, pa)
+    tilt = np.linalg.norm(np.cross(c - a, pa), axis=1) + np.linalg.norm(np.cross(pa, b - a), axis=1)
+    near = np.abs(toward) <= 2.0 * delta * (np.linalg.norm(n, axis=1) + 2.0 * tilt)
     return np.where(near, 2, np.where(toward > 0, 0, 1)).astype(np.int8)
 
 

@@ -276,6 +276,17 @@ def test_a_sliver_thinner_than_the_margin_that_a_ray_hits_stays_in_the_set():
     assert c.visible_side[1:, 1].all() and not c.visible_side[1:, 0].any()  # the wall around it
 
 
+def test_a_tiny_face_seen_from_afar_nearly_in_its_plane_is_kept_with_both_sides():
+    # a triangle 1e-4 across, 0.05 away, the point 4e-6 in front of its plane: rounding its
+    # corners by the margin (about 5e-8 here) can tilt the plane past the point
+    from meshvis.visibility.conservative import facing_sides
+
+    tri = np.array([[[0.05, 0.0, 0.0], [0.05, 1e-4, 0.0], [0.05 + 1e-4, 0.0, 0.0]]])
+    point = np.array([0.0, 0.0, 4e-6])
+    assert facing_sides(tri, point, 5e-8).tolist() == [2]
+    assert facing_sides(tri, np.array([0.0, 0.0, 0.01]), 5e-8).tolist() == [1]  # clearly off it
+
+
 def test_rays_through_the_open_frusta_see_only_what_the_set_holds_and_repeat_with_the_seed():
     # a wall with a slit 0.02 wide: frusta along the slit's edges stay open at the limit
     wall = quad_x(-5, -0.01, -5, 5, 1) + quad_x(0.01, 5, -5, 5, 1)
