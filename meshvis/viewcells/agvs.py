@@ -135,6 +135,7 @@ def pvs(
     sampler = GlobalSampler(vc, caster)
     surface = st.SurfacePoints(soup)
     push = caster.offset * caster.diagonal
+    walls = st.CellWalls(vc, push)
     mixture = Mixture(st.STRATEGIES)
     estimate = ErrorEstimate()
     stats = {n: {"samples": 0, "rays": 0, "contribution": 0, "seconds": 0.0} for n in st.STRATEGIES}
@@ -209,7 +210,7 @@ def pvs(
                         parts.append(
                             (
                                 name,
-                                _draw(name, k, vs, surface, sampler, rng, caster, push),
+                                _draw(name, k, vs, surface, walls, sampler, rng, caster, push),
                                 time.perf_counter() - t,
                             )
                         )
@@ -339,13 +340,15 @@ def _check_memory(cells: ViewCells, n_faces: int) -> None:
         )
 
 
-def _draw(name: str, k: int, vs, surface, sampler: GlobalSampler, rng, caster, push) -> st.Samples:
+def _draw(name: str, k: int, vs, surface, walls, sampler: GlobalSampler, rng, caster, push) -> st.Samples:
     if name == "uniform":
         return st.uniform(vs, k, rng)
     if name == "object":
         return st.object_direction(surface, k, rng, push)
     if name == "two-point":
         return st.two_point(vs, surface, k, rng)
+    if name == "wall":
+        return st.wall(walls, surface, k, rng)
     if name == "mutation":
         return st.two_point_mutation(sampler.buffer, k, rng)
     if name == "silhouette":
@@ -354,7 +357,7 @@ def _draw(name: str, k: int, vs, surface, sampler: GlobalSampler, rng, caster, p
         if sampler.adjacent is None:
             sampler.adjacent = sampler.cells.adjacent()
         return st.adjacent_cell(
-            sampler.spread, k, rng, sampler.bits, sampler.adjacent, sampler.cells, surface
+            sampler.spread, k, rng, sampler.bits, sampler.adjacent, sampler.cells, surface, push
         )
     if sampler.neighbours is None:
         sampler.neighbours = st.face_neighbours(caster.soup)

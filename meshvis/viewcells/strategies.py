@@ -21,10 +21,17 @@ view cell it pierces (:mod:`.sampler`).
 * **border** (border mutation, after GVS's adaptive border sampling): from the point of the
   cell that saw a face new to it, a ray towards a neighbour of that face (sharing a
   vertex) the cell has not seen yet.
-* **adjacent** (adjacent-cell mutation): a face new to a cell is aimed at from a random
-  point of a cell next to it (sharing a piece of wall) that has not seen the face yet.  The
-  faces a cell misses are mostly small faces that its neighbours see: a viewer near the
-  wall between two cells sees nearly what the other side sees.
+* **adjacent** (adjacent-cell mutation): a face new to a cell is aimed at from a cell next
+  to it (sharing a piece of wall) that has not seen the face yet, from a random point of
+  the wall they share (three samples in four) or of the whole cell.  The faces a cell misses
+  are mostly small faces that its neighbours see: a viewer near the wall between two cells
+  sees nearly what the other side sees, and a free segment through a point of the wall
+  pierces both cells, so it adds the face to both.
+* **wall** (two-point from the cells' walls): a uniform point on the walls of the view cells
+  (the sides of their boxes, by area) aimed at a point on the surface.  The views a PVS
+  gets most wrong stand near their cell's walls, where the cell's own samples are thinnest
+  and the view reaches past what the rest of the cell sees; a segment through a point of a
+  wall shared by two cells serves both, so neighbours agree along their common wall.
 
 Mutation candidates are kept in :class:`MutationBuffer`, the least mutated first.
 """
@@ -38,7 +45,7 @@ import numpy as np
 from meshvis.rays.samples import tangent_frames, uniform_sphere
 
 #: the distributions, in the order of the mixture
-STRATEGIES = ("uniform", "object", "two-point", "mutation", "silhouette", "border", "adjacent")
+STRATEGIES = ("uniform", "object", "two-point", "mutation", "silhouette", "border", "adjacent", "wall")
 #: discovery rays per round of the silhouette search, and rounds
 SILHOUETTE_RAYS = 4
 SILHOUETTE_ROUNDS = 2
@@ -51,7 +58,15 @@ RAYS_PER_SAMPLE = {
     "silhouette": 2 + SILHOUETTE_RAYS * SILHOUETTE_ROUNDS,
     "border": 2,
     "adjacent": 2,
+    "wall": 2,
 }
+#: share of the adjacent-cell mutations that start on the wall the two cells share
+ON_WALL = 0.75
+#: points drawn on a cell's wall move off it, to a random side, by this many times the
+#: caster's push off surfaces: a surface lying in the wall's plane (auto cells often split
+#: along floors and walls) is then hit, not started on and passed through (Embree's ray
+#: starts at t = 0, and an origin on a triangle misses it about half of the time)
+WALL_PUSH = 10.0
 #: candidates the mutation buffer holds (AGVS §7 uses 2 M)
 BUFFER_SIZE = 1 << 20
 #: a vertex shared by more faces than this (the hub of a fan) makes no neighbours for border mutations
@@ -116,6 +131,56 @@ def two_point(view_space, surface: SurfacePoints, n: int, rng: np.random.Generat
     """Two-point samples: from a view space point towards a surface point."""
     v = view_space.sample(n, rng)
     _, o = surface.draw(n, rng)
+    if len(o) == 0:
+        return Samples(np.zeros((0, 3)), np.zeros((0, 3)))
+    d = o - v
+    ok = np.linalg.norm(d, axis=1) > 0
+    return Samples(v[ok], _unit(d[ok]))
+
+
+class CellWalls:
+    """Area-uniform points on the walls of the view cells (the six sides of every cell's box).
+
+    A wall two cells share is drawn from both sides (twice the weight of a wall of the
+    view space's outside); points under the ground are dropped.  Each point moves off its
+    wall by ``WALL_PUSH * push`` to a random side.
+
+    Parameters
+    ----------
+    cells : ViewCells
+        The view cells.
+    push : float
+        The caster's push off surfaces (its offset times its diagonal).
+    """
+
+    def __init__(self, cells, push: float):
+        self.cells = cells
+        self.push = WALL_PUSH * push
+        ext = cells.cell_hi - cells.cell_lo
+        # the area of side (cell, axis, low or high): the product of the two other extents
+        area = np.stack([ext[:, 1] * ext[:, 2], ext[:, 0] * ext[:, 2], ext[:, 0] * ext[:, 1]], axis=1)
+        area = np.repeat(area, 2, axis=1).ravel()
+        total = float(area.sum())
+        self.cdf = np.cumsum(area) / total if total > 0 else None
+
+    def draw(self, n: int, rng: np.random.Generator) -> np.ndarray:
+        """(<= n, 3) points on the cells' walls, in the view space."""
+        if self.cdf is None or n == 0:
+            return np.zeros((0, 3))
+        side = np.minimum(np.searchsorted(self.cdf, rng.random(n), side="right"), len(self.cdf) - 1)
+        cell, axis, high = side // 6, (side // 2) % 3, side % 2
+        lo, hi = self.cells.cell_lo[cell], self.cells.cell_hi[cell]
+        x = lo + rng.random((n, 3)) * (hi - lo)
+        rows = np.arange(n)
+        x[rows, axis] = np.where(high == 1, hi[rows, axis], lo[rows, axis])
+        x[rows, axis] += np.where(rng.random(n) < 0.5, self.push, -self.push)
+        return x[self.cells.view_space.contains(x)]
+
+
+def wall(walls: CellWalls, surface: SurfacePoints, n: int, rng: np.random.Generator) -> Samples:
+    """Wall samples: from a point on a view cell's wall towards a surface point."""
+    v = walls.draw(n, rng)
+    _, o = surface.draw(len(v), rng)
     if len(o) == 0:
         return Samples(np.zeros((0, 3)), np.zeros((0, 3)))
     d = o - v
@@ -317,13 +382,22 @@ def border_mutation(
 
 
 def adjacent_cell(
-    buf: MutationBuffer, k: int, rng: np.random.Generator, bits, adjacent, cells, surface
+    buf: MutationBuffer,
+    k: int,
+    rng: np.random.Generator,
+    bits,
+    adjacent,
+    cells,
+    surface,
+    push: float = 0.0,
 ) -> Samples:
     """Adjacent-cell mutations of ``k`` new PVS entries (least mutated first).
 
     For an entry (cell, face): a random cell sharing a wall with the cell, and when that
-    cell has not seen the face, a ray from a random point of it (in the view space) towards
-    a random point of the face.
+    cell has not seen the face, a ray towards a random point of the face from a random
+    point (in the view space) of the wall the two cells share (a share :data:`ON_WALL` of
+    the samples) or of the other cell.  A point on the wall moves off it by
+    ``WALL_PUSH * push`` (the caster's push off surfaces) to a random side.
     """
     ptr, nbr = adjacent
     c = buf.take(k)
@@ -335,9 +409,18 @@ def adjacent_cell(
     other = nbr[ptr[cell] + np.minimum((rng.random(len(cell)) * count).astype(np.int64), count - 1)]
     word = bits[other, face >> 6]
     unseen = ((word >> (face & 63).astype(np.uint64)) & np.uint64(1)) == 0
-    other, face = other[unseen], face[unseen]
+    cell, other, face = cell[unseen], other[unseen], face[unseen]
     lo, hi = cells.cell_lo[other], cells.cell_hi[other]
-    x = lo + rng.random((len(other), 3)) * (hi - lo)
+    # the shared wall: the overlap of the two boxes, flat along the axis where they touch
+    on_wall = (rng.random(len(other)) < ON_WALL)[:, None]
+    lo = np.where(on_wall, np.maximum(lo, cells.cell_lo[cell]), lo)
+    hi = np.where(on_wall, np.minimum(hi, cells.cell_hi[cell]), hi)
+    x = lo + rng.random((len(other), 3)) * np.maximum(hi - lo, 0.0)
+    flat = np.argmin(hi - lo, axis=1)
+    rows = np.arange(len(other))
+    x[rows, flat] += np.where(on_wall[:, 0], np.where(rng.random(len(other)) < 0.5, 1.0, -1.0), 0.0) * (
+        WALL_PUSH * push
+    )
     r1, r2 = rng.random(len(face)), rng.random(len(face))
     s = np.sqrt(r1)
     w = np.stack([1 - s, s * (1 - r2), s * r2], axis=1)

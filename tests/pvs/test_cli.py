@@ -165,3 +165,26 @@ def test_bench_pvs_reports_cpu_seconds_and_reuses_its_cached_run(tmp_path, capsy
     assert fl["mean_pvs"] == pytest.approx(fl["filter"]["mean_pvs_sampled"] + fl["filter"]["mean_added"])
     assert fl["final"]["mean"] <= fl["filter"]["sampled"]["mean"]
     assert fl["filter"]["mean_pvs_sampled"] == pytest.approx(first["mean_pvs"])
+
+
+@pytest.mark.slow
+def test_bench_pvs_curves_at_equal_cpu_seconds_cached_per_part(tmp_path):
+    model = os.path.join(os.path.dirname(__file__), "..", "..", "models", "house.obj")
+    argv = ["bench", "pvs", model, "--rays", "200000", "--cells", "grid:2,1,1", "--points", "8"]
+    argv += ["--path", "4", "--size", "8", "--cache", str(tmp_path)]
+    assert main([*argv, "--parts", "agvs,random", "--json", str(tmp_path / "a.json")]) == 0
+    first = json.loads((tmp_path / "a.json").read_text())["results"][0]
+    agvs, rnd = first["agvs_curve"], first["random_curve"]
+    # a point of per-cell random sampling where AGVS had used as many CPU seconds (or just past it)
+    assert len(rnd) == len(agvs)
+    assert all(r["cpu_seconds"] >= a["cpu_seconds"] for r, a in zip(rnd, agvs))
+    assert main([*argv, "--parts", "gvs", "--json", str(tmp_path / "b.json")]) == 0
+    gvs = json.loads((tmp_path / "b.json").read_text())["results"][0]["gvs_curve"]
+    assert [g["budget_per_cell"] for g in gvs] == [int(first["rays"] * s / 2) for s in (1 / 16, 0.25, 1.0)]
+    # a last call reads both parts from the cache (the same numbers) and draws them
+    png = tmp_path / "curve.png"
+    argv += ["--parts", "agvs,random,gvs", "--curve", str(png), "--json", str(tmp_path / "c.json")]
+    assert main(argv) == 0
+    last = json.loads((tmp_path / "c.json").read_text())["results"][0]
+    assert last["random_curve"] == rnd and last["gvs_curve"] == gvs
+    assert png.stat().st_size > 1000

@@ -97,7 +97,16 @@ def test_every_distribution_is_drawn_and_counted(levels):
     soup, _ = levels.two_rooms()
     result = pvs(soup, "grid:2,1,1", view_space=levels.VIEW_SPACE, budget=2_500_000, target_error=0)
     stats = result.summary["strategies"]
-    assert set(stats) == {"uniform", "object", "two-point", "mutation", "silhouette", "border", "adjacent"}
+    assert set(stats) == {
+        "uniform",
+        "object",
+        "two-point",
+        "mutation",
+        "silhouette",
+        "border",
+        "adjacent",
+        "wall",
+    }
     assert all(s["rays"] > 0 for s in stats.values()), stats
     assert sum(s["contribution"] for s in stats.values()) == int(result.sizes().sum())
     assert sum(s["rays"] for s in stats.values()) == result.summary["rays"]["total"]

@@ -112,6 +112,31 @@ def test_the_buffer_hands_out_the_least_mutated_newest_first():
     assert buf.take(0) is None
 
 
+def test_wall_points_lie_on_the_cells_walls_pushed_off_to_either_side():
+    from meshvis.viewcells.cells import ViewCells
+    from meshvis.viewcells.strategies import CellWalls
+    from meshvis.viewcells.viewspace import ViewSpace
+
+    vc = ViewCells.grid(ViewSpace(np.zeros(3), np.array([4.0, 1, 1])), (2, 1, 1))
+    x = CellWalls(vc, push=1e-3).draw(4000, np.random.default_rng(0))
+    # the distance to the nearest plane x = 0, 2, 4 or y, z = 0, 1 is the push (10 x 1e-3)
+    planes = np.stack(
+        [
+            np.abs(x[:, :1] - [0.0, 2.0, 4.0]).min(axis=1),
+            np.abs(x[:, 1:] - [[0.0]]).min(axis=1),
+            np.abs(x[:, 1:] - [[1.0]]).min(axis=1),
+        ],
+        axis=1,
+    ).min(axis=1)
+    # (or less, for the few drawn within the push of another plane)
+    assert np.all(planes <= 1e-2 + 1e-12) and np.isclose(planes, 1e-2).mean() > 0.95
+    # only the points inside the view space are kept (half of those pushed off the outside)
+    assert vc.view_space.contains(x).all() and 1500 < len(x) < 2500
+    # the wall at x = 2 is drawn from both cells: both sides of it by area
+    mid = np.abs(x[:, 0] - 2.0) < 0.02
+    assert 0.4 < (x[mid, 0] > 2.0).mean() < 0.6
+
+
 def test_adjacent_cell_mutations_aim_from_a_neighbour_at_the_face_it_has_not_seen():
     from meshvis.soup import Soup
     from meshvis.viewcells.cells import ViewCells
@@ -125,9 +150,14 @@ def test_adjacent_cell_mutations_aim_from_a_neighbour_at_the_face_it_has_not_see
     buf = MutationBuffer(("face", "cell"))
     buf.add(face=np.zeros(200, np.int64), cell=np.r_[np.zeros(100, np.int64), np.full(100, 2)])
     s = adjacent_cell(buf, 200, np.random.default_rng(0), bits, vc.adjacent(), vc, SurfacePoints(soup))
-    # every entry's only unseeing neighbour is cell 1: all samples start there, aimed at the face
+    # every entry's only unseeing neighbour is cell 1: all samples start in its closed box,
+    # about three in four on the wall it shares with the cell that saw the face
     assert len(s.origin) == 200
-    assert vc.locate(s.origin).tolist() == [1] * 200
+    x = s.origin[:, 0]
+    assert np.all((x >= 1.0) & (x <= 2.0))
+    on_wall = (x == 1.0) | (x == 2.0)
+    assert 120 <= on_wall.sum() <= 180
+    assert vc.locate(s.origin[~on_wall]).tolist() == [1] * int((~on_wall).sum())
     t = (5.0 - s.origin[:, 0]) / s.direction[:, 0]
     hit = s.origin + t[:, None] * s.direction
     assert (

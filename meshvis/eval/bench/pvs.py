@@ -10,10 +10,10 @@ For each level (default: zdm2, pandora and the monastery, each in its default vi
    it was at log-spaced moments of the run (the error-against-time curve), and the
    on-the-fly estimate (AGVS §4.5) beside the measured error;
 3. per-cell random sampling (AGVS §7's REF: a random cell, a random point in it, a random
-   direction; the hit counts for that cell only), judged when it has run as long as AGVS
-   had at each point of AGVS's curve;
+   direction; the hit counts for that cell only), judged when it has used as many CPU
+   seconds as AGVS had at each point of AGVS's curve;
 4. per-cell guided sampling: :func:`meshvis.visible_from` with a ``box:`` region per cell,
-   (a) on every cell with a ray budget per cell of 1/4 and 1 times AGVS's rays shared out,
+   (a) on every cell with a ray budget per cell of 1/16, 1/4 and 1 times AGVS's rays shared out,
    (b) to its own stop rule on ``--gvs-cells`` random cells, extrapolated to all cells by
    the mean time per cell (as AGVS §7 does for GVS), and the time AGVS took to reach the
    same mean PVS size on those cells;
@@ -43,13 +43,13 @@ SECONDS = 300.0
 #: random cells that get a converged per-cell guided search
 GVS_CELLS = 8
 #: per-cell guided sampling with these shares of AGVS's rays, shared out over the cells
-GVS_SHARES = (0.25, 1.0)
+GVS_SHARES = (1 / 16, 0.25, 1.0)
 #: points of the error-against-time curve
 SNAPSHOTS = 10
 #: the estimate is compared with the measured error below this (wrong pixels per million)
 COMPARE_BELOW = 100.0
 #: bump when the sampler changes, so that cached runs are not reused
-RUN_VERSION = 3
+RUN_VERSION = 4
 
 
 def add_arguments(p: argparse.ArgumentParser) -> None:
@@ -128,8 +128,8 @@ def _since(start: tuple[float, float]) -> tuple[float, float]:
 
 #: the parts of the benchmark (each needs the AGVS run, cached in ``--cache`` by the first)
 PARTS = ("agvs", "random", "gvs", "converged", "grid")
-#: the random-sampling curve stops at this many seconds (its points are at AGVS's times)
-RANDOM_SECONDS = 120.0
+#: the random-sampling curve stops at this many CPU seconds (its points are at AGVS's CPU seconds)
+RANDOM_CPU_SECONDS = 120.0
 #: the grid of the same count gets this share of AGVS's rays (and is compared with the auto
 #: cells' PVS after as many rays)
 GRID_SHARE = 0.25
@@ -181,19 +181,58 @@ def run_level(path: str, args: argparse.Namespace) -> dict:
         if p["mean"] < COMPARE_BELOW
     ]
     total = out["rays"]
+    key = _run_key(soup, args)
     if "random" in parts:
-        times = [p["seconds"] for p in out["agvs_curve"] if p["seconds"] <= RANDOM_SECONDS]
-        out["random_curve"] = _random_curve(soup, cells, caster, table, times, args.seed)
+        times = [p["cpu_seconds"] for p in out["agvs_curve"] if p["cpu_seconds"] <= RANDOM_CPU_SECONDS]
+        out["random_curve"] = _part(
+            args.cache,
+            ("random", key, times),
+            lambda: _random_curve(soup, cells, caster, table, times, args.seed),
+        )
     if "gvs" in parts:
-        out["gvs_curve"] = [
-            _gvs_all(soup, cells, caster, table, int(total * share / cells.n_cells), args.seed)
-            for share in GVS_SHARES
-        ]
+        out["gvs_curve"] = _part(
+            args.cache,
+            ("gvs", key, GVS_SHARES),
+            lambda: [
+                _gvs_all(soup, cells, caster, table, int(total * share / cells.n_cells), args.seed)
+                for share in GVS_SHARES
+            ],
+        )
     if "converged" in parts and args.gvs_cells > 0:
         out["gvs_converged"] = _gvs_converged(soup, result, caster, args.gvs_cells, args.seed)
     if "grid" in parts and cells.kind.startswith("auto"):
         out["grid"] = _grid(soup, result, caster, table, int(total * GRID_SHARE), args.seed)
     return out
+
+
+def _run_key(soup, args) -> str:
+    """The cache key of the AGVS run of this level and options."""
+    from meshvis.viewcells.result import model_key
+
+    return hashlib.sha256(
+        repr(
+            (model_key(soup), args.cells, args.rays, None if args.rays else args.time, args.seed, RUN_VERSION)
+            + (("filter",) if args.filter else ())
+        ).encode()
+    ).hexdigest()[:20]
+
+
+def _part(cache: str, what: tuple, compute):
+    """A part's numbers, cached as JSON by ``what`` (its name, the run's key, its settings).
+
+    The curves of per-cell random and guided sampling take minutes each: cached, they can
+    run one per benchmark call and still be drawn together by a last call with ``--curve``.
+    """
+    from meshvis.io import atomic_write
+
+    path = os.path.join(cache, f"pvs-part-{hashlib.sha256(repr(what).encode()).hexdigest()[:20]}.json")
+    if os.path.isfile(path):
+        with open(path) as fh:
+            return json.load(fh)
+    value = compute()
+    with atomic_write(path, "w") as fh:
+        json.dump(value, fh)
+    return value
 
 
 def _agvs_run(soup, args, caster):
@@ -204,14 +243,8 @@ def _agvs_run(soup, args, caster):
     """
     from meshvis.io import atomic_write
     from meshvis.viewcells import PVS, pvs
-    from meshvis.viewcells.result import model_key
 
-    key = hashlib.sha256(
-        repr(
-            (model_key(soup), args.cells, args.rays, None if args.rays else args.time, args.seed, RUN_VERSION)
-            + (("filter",) if args.filter else ())
-        ).encode()
-    ).hexdigest()[:20]
+    key = _run_key(soup, args)
     path = os.path.join(args.cache, f"pvs-run-{key}.npz")
     log_path = os.path.join(args.cache, f"pvs-run-{key}.log.npz")
     if os.path.isfile(path) and os.path.isfile(log_path):
@@ -336,7 +369,7 @@ def _sizes(bits) -> np.ndarray:
 
 
 def _random_curve(soup, cells, caster, table, checkpoints: list[float], seed: int) -> list[dict]:
-    """Per-cell random sampling (AGVS §7's REF), judged when it has run the given seconds."""
+    """Per-cell random sampling (AGVS §7's REF), judged when it has used the given CPU seconds."""
     from meshvis.rays.samples import uniform_sphere
     from meshvis.viewcells import judge
 
@@ -348,7 +381,7 @@ def _random_curve(soup, cells, caster, table, checkpoints: list[float], seed: in
     start = _clock()
     chunk = 1 << 18
     for target in checkpoints:
-        while _since(start)[0] < target:
+        while _since(start)[1] < target:
             k = chunk
             cell = rng.integers(0, cells.n_cells, k)
             o = cells.cell_lo[cell] + rng.random((k, 3)) * (cells.cell_hi[cell] - cells.cell_lo[cell])
@@ -544,7 +577,7 @@ def format_level(r: dict) -> str:
 
 
 def plot_curves(results: list[dict], path: str) -> None:
-    """Mean wrong pixels per million against time, one panel per level."""
+    """Mean (solid) and worst (dotted) wrong pixels per million against CPU seconds, one panel per level."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -554,20 +587,22 @@ def plot_curves(results: list[dict], path: str) -> None:
 
     fig, axes = plt.subplots(1, len(results), figsize=(5 * len(results), 4), squeeze=False)
     for ax, r in zip(axes[0], results):
-        for name, key, style in (
-            ("AGVS", "agvs_curve", "o-"),
-            ("per-cell random", "random_curve", "s--"),
-            ("per-cell guided", "gvs_curve", "^:"),
+        for name, key, marker, colour in (
+            ("AGVS", "agvs_curve", "o", "C0"),
+            ("per-cell random", "random_curve", "s", "C1"),
+            ("per-cell guided", "gvs_curve", "^", "C2"),
         ):
             pts = [p for p in r.get(key, []) if p["mean"] > 0]
             if pts:
-                ax.plot([p["seconds"] for p in pts], [p["mean"] for p in pts], style, label=name)
+                cpu = [p["cpu_seconds"] for p in pts]
+                ax.plot(cpu, [p["mean"] for p in pts], marker + "-", color=colour, label=f"{name}, mean")
+                ax.plot(cpu, [p["worst"] for p in pts], marker + ":", color=colour, label=f"{name}, worst")
         est = [p for p in r["agvs_curve"] if np.isfinite(p["estimate"]) and p["estimate"] > 0]
-        ax.plot([p["seconds"] for p in est], [p["estimate"] for p in est], "k.", label="AGVS estimate")
+        ax.plot([p["cpu_seconds"] for p in est], [p["estimate"] for p in est], "k.", label="AGVS estimate")
         ax.set_xscale("log")
         ax.set_yscale("log")
-        ax.set_xlabel("seconds")
-        ax.set_ylabel("mean wrong pixels per million")
+        ax.set_xlabel("CPU seconds")
+        ax.set_ylabel("wrong pixels per million")
         ax.set_title(r["level"])
         ax.legend(fontsize=8)
     fig.tight_layout()
