@@ -87,20 +87,27 @@ def orient_row(models: str, out: str) -> str:
     return f"orient: {int(result.flipped.sum())} of {car.n_faces} faces turned"
 
 
-def remove_row(models: str, out: str) -> str:
-    """The remove-interior row: boolean.glb seen through, the output, the removed faces."""
-    part = meshvis.load(os.path.join(models, "real", "boolean.glb"))
-    result = meshvis.remove_interior(part, seed=SEED)
-    camera = meshvis.Camera.fit(part, azimuth=30, elevation=20)
-    see_through = render_layers(part, np.where(result.keep, 1, 2), camera, size=(640, 480))
+def removal_strip(path: str, picture: str) -> str:
+    """A removal's strip: the model seen through with its hidden faces, the output, the removed faces."""
+    model = meshvis.load(path)
+    result = meshvis.remove_interior(model, seed=SEED)
+    camera = meshvis.Camera.fit(model, azimuth=30, elevation=20)
+    see_through = render_layers(model, np.where(result.keep, 1, 2), camera, size=(640, 480))
     kept, removed = int(result.keep.sum()), int((~result.keep).sum())
     panels = [
         (see_through, f"input, seen through: {removed} hidden faces (green)"),
         (meshvis.render(result.kept, camera, size=(640, 480)).image, f"remove-interior: {kept} faces kept"),
         (meshvis.render(result.removed, camera, size=(640, 480)).image, "the faces removed"),
     ]
-    strip(panels, os.path.join(out, "remove-interior.png"))
-    return f"remove-interior: {kept} of {part.n_faces} faces kept"
+    strip(panels, picture)
+    return f"remove-interior: {kept} of {model.n_faces} faces kept"
+
+
+def remove_row(models: str, out: str) -> str:
+    """The remove-interior row: boolean.glb seen through, the output, the removed faces."""
+    return removal_strip(
+        os.path.join(models, "real", "boolean.glb"), os.path.join(out, "remove-interior.png")
+    )
 
 
 def layers_row(models: str, out: str) -> str:
@@ -124,18 +131,10 @@ def layers_row(models: str, out: str) -> str:
 
 def generated_row(models: str, out: str) -> str:
     """The second remove-interior row: a generated helmet whose parts pass through each other."""
-    helmet = meshvis.load(os.path.join(models, "ai", "holopart_helmet.glb"))
-    result = meshvis.remove_interior(helmet, seed=SEED)
-    camera = meshvis.Camera.fit(helmet, azimuth=30, elevation=20)
-    see_through = render_layers(helmet, np.where(result.keep, 1, 2), camera, size=(640, 480))
-    kept, removed = int(result.keep.sum()), int((~result.keep).sum())
-    panels = [
-        (see_through, f"input, seen through: {removed} hidden faces (green)"),
-        (meshvis.render(result.kept, camera, size=(640, 480)).image, f"remove-interior: {kept} faces kept"),
-        (meshvis.render(result.removed, camera, size=(640, 480)).image, "the faces removed"),
-    ]
-    strip(panels, os.path.join(out, "remove-interior-generated.png"))
-    return f"remove-interior: {kept} of {helmet.n_faces} faces kept"
+    return removal_strip(
+        os.path.join(models, "ai", "holopart_helmet.glb"),
+        os.path.join(out, "remove-interior-generated.png"),
+    )
 
 
 def label_row(models: str, out: str) -> str:
