@@ -379,6 +379,11 @@ def _pushed_origins(
     a copy of a face (``duplicate_first``) meets the partners of its group's first face,
     whose pairs stand for the whole group's (:func:`meshvis.geometry.intersect.intersection_flags`).
     """
+    flagged = np.flatnonzero(flagged_index >= 0)
+    point_start = np.asarray(point_start, np.int64)
+    if point_start.shape != (len(flagged) + 1,) or point_start[-1] != len(pos):
+        # the kernel indexes by these offsets: a wrong layout would read out of bounds
+        raise ValueError("point_start must hold the offsets of every flagged face's points")
     # (face, partner) candidates: every pair both ways, grouped by face (stable: in that order)
     both = np.concatenate([pairs, pairs[:, ::-1]]) if len(pairs) else np.zeros((0, 2), np.int64)
     by_face = np.argsort(both[:, 0], kind="stable")
@@ -390,7 +395,7 @@ def _pushed_origins(
         int(side),
         np.ascontiguousarray(triangles, np.float64),
         np.ascontiguousarray(normals, np.float64),
-        np.ascontiguousarray(np.flatnonzero(flagged_index >= 0), np.int64),
+        np.ascontiguousarray(flagged, np.int64),
         np.ascontiguousarray(start, np.int64),
         np.ascontiguousarray(both[by_face, 1], np.int64),
         np.ascontiguousarray(first, np.int64),
