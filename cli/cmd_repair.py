@@ -217,14 +217,7 @@ def removal_options(p: argparse.ArgumentParser) -> None:
         metavar="N",
         help="self-check: fresh random rays from every removed face, reported (0: no check)",
     )
-    p.add_argument(
-        "--rescue-rays",
-        type=int,
-        default=d["rescue_rays"],
-        metavar="N",
-        help="rescue pass (view and both): random rays from every face the search did not see; a face one "
-        "of them sees from is kept (0: no rescue)",
-    )
+    _rescue_option(p, d["rescue_rays"], "view and both")
     p.add_argument(
         "--level",
         choices=LEVELS,
@@ -258,6 +251,17 @@ def _budget_option(p: argparse.ArgumentParser, default, what: str) -> None:
     )
 
 
+def _rescue_option(p: argparse.ArgumentParser, default: int, what: str) -> None:
+    p.add_argument(
+        "--rescue-rays",
+        type=int,
+        default=default,
+        metavar="N",
+        help=f"rescue pass ({what}): random rays from every face the search did not see next to a seen one "
+        "(fewer from the others); a face one of them sees from is kept (0: no rescue)",
+    )
+
+
 def _transparent_option(p: argparse.ArgumentParser, default: str) -> None:
     p.add_argument(
         "--transparent",
@@ -271,8 +275,8 @@ def _transparent_option(p: argparse.ArgumentParser, default: str) -> None:
 def layer_options(p: argparse.ArgumentParser) -> None:
     """Add the options of ``layers``, with the defaults of :func:`meshvis.layers`.
 
-    The options are ``--max-layers``, ``--visibility``, ``--from``, ``--budget`` and
-    ``--transparent``.
+    The options are ``--max-layers``, ``--visibility``, ``--from``, ``--budget``,
+    ``--transparent`` and ``--rescue-rays``.
 
     Parameters
     ----------
@@ -296,6 +300,7 @@ def layer_options(p: argparse.ArgumentParser) -> None:
     region_option(p, d["from_region"], "where viewers are, for --visibility view")
     _budget_option(p, d["budget"], "stop each layer's search for views")
     _transparent_option(p, d["transparent"])
+    _rescue_option(p, d["rescue_rays"], "--visibility view, every layer")
 
 
 def add_parser(sub) -> None:

@@ -6,9 +6,9 @@
   layers 1 .. k-1 are taken out of the scene (the search asks about the remaining faces
   only, and rays pass where the peeled faces were).  The faces no search sees form the last
   bucket, ``n_layers + 1``.  Each layer's search ends with the removal's rescue pass
-  (:data:`~meshvis.visibility.check.RESCUE_RAYS` random rays from every face left that it did
-  not see; a face one of them sees from joins the layer), so layer 1 is the default
-  removal's kept faces.
+  (:func:`~meshvis.visibility.check.rescue_pass`, ``rescue_rays`` random rays from every face
+  left that it did not see and that is next to a face it saw, fewer from the others; a face
+  one of them sees from joins the layer), so layer 1 is the default removal's kept faces.
 * ``visibility="object"`` (the paper's "Layer Computation"): layer 1 is every face with an
   outside side after the first cut.  Then the nodes of the layer-1 faces (in particular
   their inside nodes) are tied to the source and the graph is cut again: what becomes
@@ -30,10 +30,15 @@ from meshvis.errors import ParameterError
 from meshvis.graphcut.classify import Classification, classify
 from meshvis.io import as_soup
 from meshvis.rays.caster import VISIBILITY_OFFSET, RayCaster
-from meshvis.repair.remove_modes import DEFAULT_LAYER_VISIBILITY, DEFAULT_TRANSPARENT, LAYER_MODES
+from meshvis.repair.remove_modes import (
+    DEFAULT_LAYER_VISIBILITY,
+    DEFAULT_TRANSPARENT,
+    LAYER_MODES,
+    RESCUE_RAYS,
+)
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, parse_region, visible_from
-from meshvis.visibility.check import RESCUE_RAYS, RESCUE_STREAM, self_check
+from meshvis.visibility.check import RESCUE_SHARE, rescue_pass
 from meshvis.visibility.walls import walls
 
 
@@ -143,6 +148,7 @@ def layers(
     transparent: str = DEFAULT_TRANSPARENT,
     classification: Classification | None = None,
     progress=None,
+    rescue_rays: int = RESCUE_RAYS,
     **classify_kw: Any,
 ) -> LayerResult:
     """Peel the model into nested layers (module notes).
@@ -168,6 +174,9 @@ def layers(
         Reuse an existing classification of the same model (by the cut).
     progress : callable, optional
         Called as ``progress(layer, faces with a layer, faces)`` after every layer.
+    rescue_rays : int
+        By sight: the rescue pass's rays from every face next to a seen one, as in
+        :func:`meshvis.remove_interior` (0: no rescue pass).
     **classify_kw
         Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...); ``seed``
         also seeds the searches.
@@ -180,7 +189,8 @@ def layers(
     Raises
     ------
     ParameterError
-        Unknown ``visibility`` or ``transparent``, ``max_layers`` below 1.
+        Unknown ``visibility`` or ``transparent``, ``max_layers`` below 1, a negative
+        ``rescue_rays``.
 
     Examples
     --------
@@ -195,17 +205,21 @@ def layers(
     """
     _validate.repair_args(classification, Classification, classify_kw, classify)
     max_layers = None if max_layers is None else _validate.integer("max_layers", max_layers, 1)
+    rescue_rays = _validate.integer("rescue_rays", rescue_rays, 0)
     if visibility not in LAYER_MODES:
         raise ParameterError(f"unknown visibility {visibility!r}; choose one of {', '.join(LAYER_MODES)}")
     if visibility == "view":
+        seed = int(classify_kw.get("seed", 0))
         return _layers_by_sight(
-            model, max_layers, region, budget, up, transparent, int(classify_kw.get("seed", 0)), progress
+            model, max_layers, region, budget, up, transparent, seed, progress, rescue_rays
         )
     c = classification or classify(model, **classify_kw)
     return _layers_by_cut(c, max_layers, progress)
 
 
-def _layers_by_sight(model, max_layers, region, budget, up, transparent, seed: int, progress) -> LayerResult:
+def _layers_by_sight(
+    model, max_layers, region, budget, up, transparent, seed: int, progress, rescue_rays: int
+) -> LayerResult:
     """Layer k: what a search sees of the faces left once layers 1 .. k-1 are out of the scene."""
     soup = as_soup(model)
     t0 = time.perf_counter()
@@ -226,13 +240,19 @@ def _layers_by_sight(model, max_layers, region, budget, up, transparent, seed: i
         vis = visible_from(soup, region, budget=budget, seed=seed, up=up, faces=asked, caster=caster)
         searches.append(vis)
         unseen = left & active & ~vis.seen
-        rescue = self_check(caster, bound, unseen, rays=RESCUE_RAYS, seed=seed, stream=RESCUE_STREAM)
-        new = (vis.seen | rescue.seen) & left & active
+        seen_side = vis.seen_side
+        if rescue_rays:
+            cap = int(RESCUE_SHARE * vis.rays["total"])
+            rescue = rescue_pass(
+                caster, bound, unseen, vis.seen & left, rays=rescue_rays, seed=seed, budget=cap
+            )
+            seen_side = seen_side | rescue.seen_side
+        new = seen_side.any(axis=1) & left & active
         if not new.any():
             break
         k += 1
         layer[new] = k
-        seen = (vis.seen_side | rescue.seen_side)[new]
+        seen = seen_side[new]
         outer_side[new] = np.where(seen.all(axis=1), 2, np.argmax(seen, axis=1))
         if progress is not None:
             progress(k, int((layer > 0).sum()), m)

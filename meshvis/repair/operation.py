@@ -71,6 +71,7 @@ OPERATION_OPTIONS: dict[str, dict[str, tuple[str, str]]] = {
         "budget": (LAYERS, "budget"),
         "up": (LAYERS, "up"),
         "transparent": (LAYERS, "transparent"),
+        "rescue_rays": (LAYERS, "rescue_rays"),
     },
 }
 #: options that are no keyword of a library function: the hints (lists of points and boxes,
@@ -454,6 +455,7 @@ def layer_kwargs(options: Mapping[str, Any] | Any) -> dict[str, Any]:
             up=_up(o["up"]),
             seed=int(o["seed"]),
             transparent=o["transparent"],
+            rescue_rays=int(o["rescue_rays"]),
         )
     return kw
 

@@ -41,6 +41,11 @@
    region's viewers), so a courtyard floor whose underside opens onto the empty space
    below the scene faces up.
 
+   There, a face whose evidence would take it away from the side its patch shows (most
+   of the patch's area) keeps that side where viewers above the ground see it
+   (:func:`_seen_from_above`): a wall seen from both sides from above, more often
+   through its other side, keeps the winding of the walls it belongs to.
+
 The evidence does not depend on how a face comes in wound: the cut and every ray are
 drawn on the canonically wound model (:func:`classify_for_orient`,
 :mod:`meshvis.geometry.winding`), each face's rays from a stream of its own
@@ -114,6 +119,11 @@ OPENING_NEAR = 0.5
 #: (the per-face dominance of :mod:`meshvis.repair.evidence`): the patch vote counts only
 #: the faces the cut settled on one side, which can be a few faces against the rest
 POOLED_DOMINANCE = 4.0
+#: rays through the side of its patch of a face about to leave it, on a scene seen from
+#: above its ground: that side is seen from above where at least
+#: :data:`~meshvis.repair.evidence.MIN_ESCAPES` of them escape upward (0.8 %; the walls of
+#: the monastery's courtyards let 1-5 % of the rays through their less seen side escape)
+ABOVE_RAYS = 1024
 
 
 @dataclass
@@ -140,7 +150,8 @@ class OrientResult:
         The per-face visibility test: faces ``tested``, faces ``turned``
         to show the side a viewer sees, ``rays`` cast, ``pooled_patches`` (patches
         given the side their faces' rays see, pooled), ``ground`` (seen from above its
-        ground only)
+        ground only), ``kept_seen_from_above`` (faces kept on their patch's side,
+        seen from above the ground: :func:`_seen_from_above`)
     double_sided : int
         Faces kept as they are because they are one copy of a sheet stored
         twice with opposite winding (:mod:`meshvis.geometry.duplicates`)
@@ -695,6 +706,48 @@ def _visible_sides(
     return decided | pooled, report
 
 
+def _seen_from_above(
+    c: Classification,
+    p: Patches,
+    outer: np.ndarray,
+    movable: np.ndarray,
+    undecided: np.ndarray,
+    seed: int,
+    up: np.ndarray,
+) -> int:
+    """Give a face leaving its patch its patch's side where viewers above the ground see it (in place).
+
+    On a scene seen from above its ground, a face whose evidence shows the side its patch
+    does not show (the side most of the area of the patch's ``movable`` faces shows, as
+    decided or kept, the face's own included) goes back to its patch's side where that
+    side is seen from above the ground: at least :data:`~meshvis.repair.evidence.MIN_ESCAPES` of
+    :data:`ABOVE_RAYS` rays through it escape upward.  The evidence against it then
+    comes from viewers above who see the face's other side more often (a wall seen
+    from both sides): a viewer above may see either side, and the patch keeps its
+    winding whole, as faces seen from both sides keep theirs under ``two_sided="keep"``.
+
+    Returns the faces given back to their patch.
+    """
+    from meshvis.repair import evidence
+
+    node, patch = p.clustering.side_node, p.clustering.cluster
+    rows = np.flatnonzero(movable & (patch >= 0) & (p.size > 1) & ~p.closed)
+    shown = node[rows, np.asarray(outer, np.int64)[rows]]
+    votes = np.bincount(shown, c.soup.areas[rows], p.clustering.n_nodes)
+    v0, v1 = votes[node[rows, 0]], votes[node[rows, 1]]
+    side = (v1 > v0).astype(np.int64)
+    away = (v0 != v1) & (outer[rows] != side) & ~undecided[rows]
+    leaving, side = rows[away], side[away]
+    if len(leaving) == 0:
+        return 0
+    stream = evidence.RayStream(seed, c.soup.n_faces, up)
+    caster = c.caster.with_offset(VISIBILITY_OFFSET)
+    escaped = evidence.escapes(c.soup, caster, leaving, ABOVE_RAYS, stream, through=side)
+    seen = escaped[np.arange(len(leaving)), side] >= evidence.MIN_ESCAPES
+    outer[leaving[seen]] = side[seen]
+    return int(seen.sum())
+
+
 def _kept_with_patch(
     p: Patches, outer: np.ndarray, given: np.ndarray, undecided: np.ndarray, areas: np.ndarray
 ) -> None:
@@ -854,7 +907,9 @@ def orient(
         True: the model is a scene standing on a ground, seen from above it only (the rays
         of the visible-sides step that leave it downward do not count); None: where
         :func:`meshvis.repair.evidence.stands_on_ground` says so; False (default): seen
-        from every direction, as the graph cut sees it.
+        from every direction, as the graph cut sees it.  Seen from above its ground, a
+        face does not leave its patch's side where viewers above the ground see that side
+        (:func:`_seen_from_above`).
     up : None, "x", "y", "z" or (3,) float
         The up direction of the ground; None: the model's own (``Soup.up``).
     classification : Classification, optional
@@ -916,6 +971,10 @@ def orient(
     visibility["ground"] = bool(ground)
     undecided &= ~seen
     _kept_with_patch(p, outer, given, undecided, c.soup.areas)
+    # seen from above its ground, a face seen through both sides keeps its patch's side
+    visibility["kept_seen_from_above"] = (
+        _seen_from_above(c, p, outer, movable, undecided, seed, up_dir) if ground else 0
+    )
     flip = outer != given
     if front == "cw":
         flip = ~flip

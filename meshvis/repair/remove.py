@@ -22,13 +22,14 @@ Sight passes the faces of see-through materials unless ``transparent="opaque"``
 (:mod:`meshvis.visibility.walls`): what shows through a windshield stays.  The cut does not
 look at materials.
 
-A removal by sight (``"view"``, ``"both"``) ends with a rescue pass: ``rescue_rays`` random
-rays from every face it is about to remove, to random viewers of the region
-(:func:`meshvis.visibility.check.self_check` on the stream
-:data:`~meshvis.visibility.check.RESCUE_STREAM`); a face one of them sees from is kept.  The
-search stops once new views have become rare, and a small face seen through a narrow gap
-can be one it never aimed at often enough; the rescue gives every such face the same number
-of rays of its own.  Every removal then ends with a self-check: ``check_rays`` fresh random
+A removal by sight (``"view"``, ``"both"``) ends with a rescue pass
+(:func:`meshvis.visibility.check.rescue_pass`): random rays from every face it is about to
+remove, to random viewers of the region, ``rescue_rays`` of them from each face next to a
+seen or rescued face and :data:`~meshvis.visibility.check.RESCUE_FIRST_RAYS` from the
+others; a face one of them sees from is kept, and the neighbours of a rescued face are
+also tried along its line of sight.  The search stops once new views have become rare,
+and a small face seen through a narrow gap can be one it never aimed at often enough; the
+rescue gives every such face rays of its own.  Every removal then ends with a self-check: ``check_rays`` fresh random
 rays from every removed face, from another stream than the rescue's; the report says how
 many removed faces and how much of their area one of them saw.
 
@@ -65,7 +66,7 @@ from meshvis.repair.remove_modes import (
 )
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, parse_region, visible_from
-from meshvis.visibility.check import RESCUE_STREAM, SelfCheck, self_check
+from meshvis.visibility.check import RESCUE_FIRST_RAYS, RESCUE_SHARE, SelfCheck, rescue_pass, self_check
 from meshvis.visibility.walls import walls
 
 #: reason of each face, by code
@@ -179,9 +180,17 @@ class RemovalResult:
                 "before its stop rule: some removed faces may be visible (raise --budget)"
             )
         if self.rescue is not None:
+            r = self.rescue
+            short = (
+                f", {r.short_faces} next to one got fewer (the pass stopped at {RESCUE_SHARE:.0%} of the "
+                "search's rays)"
+                if r.short_faces
+                else ""
+            )
             lines.append(
-                f"rescue: {self.rescue.rays_per_face} random rays from each of {self.rescue.faces} faces the "
-                f"search did not see found a view of {int(self.rescue.seen.sum())} of them (kept)"
+                f"rescue: random rays from each of {r.faces} faces the search did not see "
+                f"({r.rays_per_face} from the {r.full_faces} next to a seen face, {RESCUE_FIRST_RAYS} from the "
+                f"others{short}; {r.rays} rays) found a view of {int(r.seen.sum())} of them (kept)"
             )
         if self.check is not None:
             lines.append(self.check.summary())
@@ -245,8 +254,10 @@ def remove_interior(
         :func:`meshvis.visible_from` with ``conservative=True``): nothing visible from them
         is removed.  No cut; ``visibility`` is not used.
     rescue_rays : int
-        Random rays from every face that a removal by sight (``"view"``, ``"both"``) is about
-        to remove; a face one of them sees from is kept (0: no rescue pass).
+        Random rays from every face next to a seen face that a removal by sight (``"view"``,
+        ``"both"``) is about to remove (the others get
+        :data:`~meshvis.visibility.check.RESCUE_FIRST_RAYS`, or ``rescue_rays`` if fewer); a
+        face one of them sees from is kept (0: no rescue pass).
     **classify_kw
         Passed to :func:`meshvis.classify` (``seed``, ``rays_per_node``, ...);
         in ``"both"`` an unset ``rays_per_point`` is ``rays_per_node // samples_per_face``
@@ -326,7 +337,8 @@ def remove_interior(
     by_rays = (check_rays or rescue_rays) and not _is_cells(region)  # cells: judged by meshvis bench pvs
     bound = parse_region(region, up=up).bind(soup) if by_rays else None
     if bound is not None and rescue_rays and visibility in ("view", "both"):
-        rescue = self_check(caster, bound, ~keep, rays=rescue_rays, seed=seed, stream=RESCUE_STREAM)
+        cap = None if vis is None else int(RESCUE_SHARE * vis.rays["total"])
+        rescue = rescue_pass(caster, bound, ~keep, keep, rays=rescue_rays, seed=seed, budget=cap)
         code[rescue.seen] = _KEPT_RESCUE
         keep = keep | rescue.seen
     keep = _widen(soup, keep, code, level, int(keep_border))

@@ -15,8 +15,23 @@ Depth is measured along the root's ``axis``.  For each frustum the kernel
    whose rays reach it) or a blocker is found for just the rays that reach it
    (:func:`_hidden_in_cut`);
 3. without a blocker, asks for the frustum to be split in four (FastV §3.4), or at the
-   subdivision limit keeps each triangle it meets unless a blocker is found for the rays
-   that reach it (FastV keeps them all).
+   subdivision limit tries *occluder fusion* (FastV keeps everything there): the union
+   of the nearest triangles meeting the frustum covers it, and what lies behind its
+   deepest point is hidden (:func:`_cover`); each triangle kept otherwise is kept unless
+   the union of the triangles wholly before it covers the rays that may reach it, or a
+   blocker is found for those rays.
+
+Why a cut-out proves a cover.  In the frustum's coordinates ``(u, w)`` (rays ``axis + u
+right + w up``) the rays that hit a triangle at a positive distance are exactly those on
+the inner side of the three planes through ``v`` and its sides: three half-planes, the
+signs of the ray's barycentric coordinates.  Each is moved inwards by the margin of the
+side test (a ray that passes counts only when rounding cannot make it miss), except along
+a side another face continues exactly (a welded neighbour, or a face whose side lies on
+the same line, on the other side of the plane through ``v``): there the rays just past
+the side hit that face.  A convex piece of the uncovered part minus such a triangle is at
+most three convex pieces (outside side 0; inside 0 and outside 1; inside 0 and 1 and
+outside 2), taken with a slack so that rounding keeps more; when no piece is left, every
+ray of the frustum hits a triangle of the union no deeper than the union's deepest point.
 
 Why a walk proves a blocker.  The walk starts at a seed triangle and, for every edge of a
 triangle in the set that meets the frustum (segment against the frustum's planes), adds
@@ -57,6 +72,9 @@ import numpy as np
 #: status of a frustum after :func:`trace_frusta` (and the modes of :func:`_collect`; ANY is
 #: the mode that only asks whether a triangle meets the frustum)
 EMPTY, BLOCKED, SPLIT, OPEN, ANY = 0, 1, 2, 3, 4
+#: status of a frustum at the limit without a blocker that the union of the triangles
+#: meeting it covers (:func:`_fuse`)
+FUSED = 5
 #: nodes a traversal stack holds (the builder's trees are at most ~130 levels deep)
 STACK = 512
 #: vertices a clipped triangle can have (3 + one per clipping plane, 8 planes) and spare
@@ -79,6 +97,20 @@ TOUCH_SLACK = 1e-6
 TOUCH_WIDTH = 100.0
 #: fillers looked through at one edge, and faces beyond them that may span it
 MAX_FILLERS, MAX_SPAN = 32, 16
+#: occluder fusion (:func:`_fuse`): the nearest triangles it tries, the convex pieces of
+#: the part not yet covered, and the vertices of one piece; beyond any of them a frustum
+#: keeps everything, as without fusion
+FUSE_TRIANGLES, FUSE_PIECES, PIECE_VERTS = 64, 64, 24
+#: slack of fusion's cuts in (u, w), so that rounding never drops a sliver the union
+#: leaves uncovered: pieces overlap by it (float64 rounding of coordinates below 2)
+FUSE_SLACK = 1e-13
+#: a side of another face lies on a fusion candidate's side (a T-junction) when its ends
+#: are within this fraction of ``delta`` (1e-12 of the scene's size by default) of its line
+FUSE_COLLINEAR = 0.0
+#: pieces thinner in (u, w) than this fraction of the angle margin ``eta`` (1e-11 by
+#: default) are the rounding of cuts along a side two triangles share exactly, and are
+#: dropped: a hole in the cover is at least about ``2 eta`` wide, the margins of its sides
+FUSE_SLIVER = 1e-5
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -801,15 +833,17 @@ def _hidden_in_cut(
 @numba.njit(cache=True, nogil=True, error_model="numpy")
 def _collect(
     mode, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
-    planes, axis, far, delta, eta, mu, keep, blocks, starts, n_blocks, seeds, sc, stack,
+    planes, axis, far, delta, eta, mu, keep, blocks, starts, n_blocks, seeds, sc, stack, fz, n_cand,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Walk the hierarchy over the triangles meeting the frustum before ``far``.
 
     ``mode`` :data:`ANY`: return 1 at the first (marking nothing); :data:`BLOCKED`: mark
     the blockers' triangles, and the others unless they lie behind a blocker
     (:func:`_behind_a_blocker`) or one is found for the rays that reach them
-    (:func:`_hidden_in_cut`); :data:`OPEN`: mark those for which none is found.  Triangles already marked are
-    skipped.  Returns the number marked.
+    (:func:`_hidden_in_cut`); :data:`OPEN`: mark those for which none is found, and that
+    the union of the first ``n_cand`` fusion candidates before them does not cover
+    (:func:`_cover`, with the scratch ``fz``).  Triangles already marked are skipped.
+    Returns the number marked.
     """
     X, Y, poly, tmp, cut, cap, T, probe, blocker, cand, clip_a, clip_b, ray_stack, found, fill, seg = sc
     top = 0
@@ -850,15 +884,391 @@ def _collect(
                     clip_a, clip_b, ray_stack, found, fill, seg,
                 ):  # fmt: skip
                     continue
-            elif mode == OPEN and _hidden_in_cut(
-                t, poly, n_poly, planes, axis, seeds, v, tri, wid, face_edge, edge_start, edge_face, filler,
-                lo, hi, first, count, order, delta, eta, mu, cut, cap, T, probe, blocker, cand, X, Y,
-                clip_a, clip_b, ray_stack, found, fill, seg,
-            ):  # fmt: skip
-                continue
+            elif mode == OPEN:
+                # hidden behind the union of the triangles before it, or behind a blocker
+                if n_cand > 0 and _cover(
+                    t, _depth_range(poly, n_poly, axis)[0], n_cand, v, axis, tri, wid, face_edge, edge_start,
+                    edge_face, filler, delta, eta, mu, fz, Y, T,
+                ) < np.inf:  # fmt: skip
+                    continue
+                if _hidden_in_cut(
+                    t, poly, n_poly, planes, axis, seeds, v, tri, wid, face_edge, edge_start, edge_face, filler,
+                    lo, hi, first, count, order, delta, eta, mu, cut, cap, T, probe, blocker, cand, X, Y,
+                    clip_a, clip_b, ray_stack, found, fill, seg,
+                ):  # fmt: skip
+                    continue
             keep[t] = mode  # BLOCKED or OPEN: why the triangle is kept
             marked += 1
     return marked
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _clip2(pu, pw, n, a, b, c, ou, ow):  # pragma: no cover - compiled
+    """Keep the part of the (u, w) polygon ``pu, pw [:n]`` where ``a + b u + c w >= 0``.
+
+    Writes it to ``ou, ow`` and returns its size; -1 when it would exceed their length.
+    """
+    k = 0
+    for i in range(n):
+        j = (i + 1) % n
+        fi = a + b * pu[i] + c * pw[i]
+        fj = a + b * pu[j] + c * pw[j]
+        if fi >= 0:
+            if k == len(ou):
+                return -1
+            ou[k], ow[k] = pu[i], pw[i]
+            k += 1
+        if (fi >= 0) != (fj >= 0):
+            if k == len(ou):
+                return -1
+            t = fi / (fi - fj)
+            ou[k], ow[k] = pu[i] + t * (pu[j] - pu[i]), pw[i] + t * (pw[j] - pw[i])
+            k += 1
+    return k
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _width2(pu, pw, n):  # pragma: no cover - compiled
+    """Width of the convex (u, w) polygon ``pu, pw [:n]``: its least extent across one of its sides."""
+    width = 0.0 if n < 3 else np.inf
+    for i in range(n if n >= 3 else 0):
+        j = (i + 1) % n
+        eu, ew = pu[j] - pu[i], pw[j] - pw[i]
+        length = math.sqrt(eu * eu + ew * ew)
+        if not length > 0:
+            continue
+        reach = 0.0
+        for k in range(n):
+            reach = max(reach, abs(eu * (pw[k] - pw[i]) - ew * (pu[k] - pu[i])) / length)
+        width = min(width, reach)
+    return 0.0 if width == np.inf else width
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _sealed(
+    t, k, X, v, tri, wid, face_edge, edge_start, edge_face, filler, delta, eta, Y
+):  # pragma: no cover - compiled
+    """Whether side ``k`` of triangle ``t`` (corners ``X``) is shared, exactly, with a face on the
+    other side of the plane through ``v`` and the side (by a margin): rays just past the side
+    meet that face, so the side needs no margin where both are used."""
+    e = face_edge[t, k]
+    if e < 0:
+        return False
+    P, Q, Z = X[k], X[(k + 1) % 3], X[(k + 2) % 3]
+    m0, m1, m2 = _cross(P[0], P[1], P[2], Q[0], Q[1], Q[2])
+    ez = Z[0] * m0 + Z[1] * m1 + Z[2] * m2
+    if abs(ez) <= _edge_tolerance(P, Q, m0, m1, m2, Z, delta, eta, True):
+        return False
+    a, b = wid[t, k], wid[t, (k + 1) % 3]
+    for h in range(edge_start[e], edge_start[e + 1]):
+        g = edge_face[h]
+        if (
+            g != t
+            and filler[g] < 0
+            and _other_side(g, a, b, P, Q, m0, m1, m2, ez, v, tri, wid, delta, eta, Y)
+        ):
+            return True
+    return False
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _fusion_candidates(
+    v, planes, axis, tri, filler, lo, hi, first, count, order, delta, mu, cand, near, deep, X, poly, tmp, stack,
+):  # fmt: skip  # pragma: no cover - compiled
+    """The nearest triangles meeting the frustum that may cover part of it, nearest first.
+
+    Writes at most ``len(cand)`` of them to ``cand`` with the nearest and deepest depth of
+    their part in the frustum widened by ``mu`` (``near``, ``deep``); returns how many.
+    Triangles whose plane passes near ``v`` and slivers whose corners lie on one line
+    cover nothing.
+    """
+    n_cand = 0
+    top = 0
+    stack[0] = 0
+    while top >= 0:
+        k = stack[top]
+        top -= 1
+        if not _box_meets(lo, hi, k, v, planes, axis, np.inf, mu):
+            continue
+        if count[k] == 0:
+            top += 1
+            stack[top] = first[k]
+            top += 1
+            stack[top] = first[k] + 1
+            continue
+        for i in range(first[k], first[k] + count[k]):
+            t = order[i]
+            if filler[t] >= 0:
+                continue
+            _relative(tri, t, v, X)
+            if _sees_plane(X, delta) == 0:
+                continue
+            n_poly = _clip_triangle(X, planes, FRUSTUM_PLANES, axis, np.inf, mu, poly, tmp)
+            if n_poly == 0:
+                continue
+            a, b = _depth_range(poly, n_poly, axis)
+            slot = n_cand
+            if n_cand == len(cand):  # full: replace the farthest, if farther
+                slot = 0
+                for j in range(1, n_cand):
+                    if near[j] > near[slot]:
+                        slot = j
+                if near[slot] <= a:
+                    continue
+            else:
+                n_cand += 1
+            cand[slot], near[slot], deep[slot] = t, a, b
+    for i in range(1, n_cand):
+        j = i
+        while j > 0 and near[j - 1] > near[j]:
+            cand[j - 1], cand[j] = cand[j], cand[j - 1]
+            near[j - 1], near[j] = near[j], near[j - 1]
+            deep[j - 1], deep[j] = deep[j], deep[j - 1]
+            j -= 1
+    return n_cand
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _seal_candidates(
+    n_cand, cand, planes, axis, v, tri, wid, face_edge, edge_start, edge_face, filler, delta, eta, mu, sealed,
+    seg, X, Y,
+):  # fmt: skip  # pragma: no cover - compiled
+    """For each side of each fusion candidate: whether faces on its other side continue the cover.
+
+    A side is sealed when :func:`_sealed` (a welded neighbour), or when the sides of other
+    candidates that lie on its line (within :data:`FUSE_COLLINEAR` times ``delta``: a
+    T-junction, a corner of one face on the side of another), with their faces on its
+    other side, span the stretch of the side inside the frustum widened by ``mu``.
+    """
+    line = FUSE_COLLINEAR * delta
+    for q in range(n_cand):
+        s = cand[q]
+        _relative(tri, s, v, X)
+        for k in range(3):
+            sealed[q, k] = _sealed(
+                s, k, X, v, tri, wid, face_edge, edge_start, edge_face, filler, delta, eta, Y
+            )
+            if sealed[q, k]:
+                continue
+            P, Q, Z = X[k], X[(k + 1) % 3], X[(k + 2) % 3]
+            # the stretch [t0, t1] of P-Q inside the widened frustum
+            t0, t1 = 0.0, 1.0
+            for c in range(FRUSTUM_PLANES + 1):
+                p0, p1, p2, off = _constraint(c, planes, FRUSTUM_PLANES, axis, np.inf, mu)
+                fp = p0 * P[0] + p1 * P[1] + p2 * P[2] + off
+                fq = p0 * Q[0] + p1 * Q[1] + p2 * Q[2] + off
+                if fp < 0 and fq < 0:
+                    t0, t1 = 1.0, 0.0
+                    break
+                if fp < 0:
+                    t0 = max(t0, fp / (fp - fq))
+                elif fq < 0:
+                    t1 = min(t1, fp / (fp - fq))
+            if t0 > t1:
+                sealed[q, k] = True  # the side misses the frustum: nothing to seal
+                continue
+            lx, ly, lz = Q[0] - P[0], Q[1] - P[1], Q[2] - P[2]
+            ll = lx * lx + ly * ly + lz * lz
+            if not ll > 0:
+                continue
+            m0, m1, m2 = _cross(P[0], P[1], P[2], Q[0], Q[1], Q[2])
+            ez = Z[0] * m0 + Z[1] * m1 + Z[2] * m2
+            if abs(ez) <= _edge_tolerance(P, Q, m0, m1, m2, Z, delta, eta, True):
+                continue
+            n_seg = 0
+            for j in range(n_cand):
+                g = cand[j]
+                if g == s:
+                    continue
+                for e in range(3):
+                    # side e of g on the line of P-Q: both ends within `line` of it
+                    on = True
+                    for end in (e, (e + 1) % 3):
+                        rx = tri[g, end, 0] - v[0] - P[0]
+                        ry = tri[g, end, 1] - v[1] - P[1]
+                        rz = tri[g, end, 2] - v[2] - P[2]
+                        c0, c1, c2 = _cross(rx, ry, rz, lx, ly, lz)
+                        if not c0 * c0 + c1 * c1 + c2 * c2 <= line * line * ll:
+                            on = False
+                            break
+                    if not on:
+                        continue
+                    # g's third corner on the other side of the plane through v and P-Q
+                    for d in range(3):
+                        Y[0, d] = tri[g, (e + 2) % 3, d] - v[d]
+                    ey = Y[0, 0] * m0 + Y[0, 1] * m1 + Y[0, 2] * m2
+                    if ez * ey >= 0 or abs(ey) <= _edge_tolerance(P, Q, m0, m1, m2, Y[0], delta, eta, True):
+                        continue
+                    if n_seg == len(seg):
+                        break
+                    a, b = 0.0, 0.0
+                    for end in range(2):
+                        r = (e + end) % 3
+                        s0 = ((tri[g, r, 0] - v[0] - P[0]) * lx + (tri[g, r, 1] - v[1] - P[1]) * ly
+                              + (tri[g, r, 2] - v[2] - P[2]) * lz) / ll  # fmt: skip
+                        if end == 0:
+                            a = s0
+                        else:
+                            b = s0
+                    seg[n_seg, 0], seg[n_seg, 1] = min(a, b), max(a, b)
+                    n_seg += 1
+            # those stretches must span [t0, t1]: sweep them from t0
+            reach = t0
+            progress = True
+            while progress and reach < t1:
+                progress = False
+                for j in range(n_seg):
+                    if seg[j, 0] <= reach and seg[j, 1] > reach:
+                        reach = seg[j, 1]
+                        progress = True
+            sealed[q, k] = reach >= t1
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _half_planes(
+    X, grow, sealed, rays, reach, axis, right, up, delta, eta, hp
+):  # pragma: no cover - compiled
+    """The rays of a triangle (corners ``X``) in the frustum's ``(u, w)``: three half-planes.
+
+    Row ``k`` of ``hp`` is ``a, b, c, slack`` of ``a + b u + c w >= 0`` for side ``k``
+    (``d . (P x Q)`` with the sign of the triangle's orientation, ``d = axis + u right +
+    w up``), moved by the margin of :func:`_edge_tolerance` bounded over the frustum's
+    rays (its ``delta`` terms are norms of linear functions of the ray, largest at a
+    corner ray ``rays[:4]``; ``reach`` is the longest): out when ``grow`` (every ray that
+    may reach the triangle), else in (rays that surely hit it), except across a side that
+    is ``sealed`` (:func:`_seal_candidates`).
+    ``slack`` is :data:`FUSE_SLACK` in the units of ``a + b u + c w``.
+    """
+    n0, n1, n2 = _cross(X[1, 0], X[1, 1], X[1, 2], X[2, 0], X[2, 1], X[2, 2])
+    sign = 1.0 if X[0, 0] * n0 + X[0, 1] * n1 + X[0, 2] * n2 > 0 else -1.0
+    for k in range(3):
+        P, Q = X[k], X[(k + 1) % 3]
+        m0, m1, m2 = _cross(P[0], P[1], P[2], Q[0], Q[1], Q[2])
+        m0, m1, m2 = sign * m0, sign * m1, sign * m2
+        hp[k, 0] = axis[0] * m0 + axis[1] * m1 + axis[2] * m2
+        hp[k, 1] = right[0] * m0 + right[1] * m1 + right[2] * m2
+        hp[k, 2] = up[0] * m0 + up[1] * m1 + up[2] * m2
+        if grow or not sealed[k]:
+            turn = 0.0  # the largest |Q x d| + |d x P| over the frustum's rays d
+            for c in range(4):
+                d = rays[c]
+                a0, a1, a2 = _cross(Q[0], Q[1], Q[2], d[0], d[1], d[2])
+                b0, b1, b2 = _cross(d[0], d[1], d[2], P[0], P[1], P[2])
+                turn = max(
+                    turn, math.sqrt(a0 * a0 + a1 * a1 + a2 * a2) + math.sqrt(b0 * b0 + b1 * b1 + b2 * b2)
+                )
+            lm = math.sqrt(m0 * m0 + m1 * m1 + m2 * m2)
+            margin = 2.0 * (delta * turn + eta * reach * lm)
+            hp[k, 0] += margin if grow else -margin
+        hp[k, 3] = FUSE_SLACK * math.sqrt(hp[k, 1] ** 2 + hp[k, 2] ** 2)
+
+
+@numba.njit(cache=True, nogil=True, error_model="numpy")
+def _cover(
+    t, near_t, n_cand, v, axis, tri, wid, face_edge, edge_start, edge_face, filler, delta, eta, mu, fz, X, Y
+):  # pragma: no cover - compiled
+    """Occluder fusion: whether the union of the nearest triangles covers the frustum's rays,
+    all of them (``t < 0``) or those that may reach triangle ``t`` (from depth ``near_t``).
+
+    The frustum's rays are ``axis + u right + w up`` over its box; each triangle's rays
+    are three half-planes in ``(u, w)`` (:func:`_half_planes`; moved out for ``t``, in
+    for the triangles that cover).  Starting from the box (cut to ``t``'s rays), the part
+    not yet covered is kept as convex pieces, and each candidate (:func:`_fusion_candidates`),
+    nearest first, is cut out of them: a piece it enters leaves at most three pieces
+    outside it.  For ``t`` only candidates wholly before it count (deepest depth ``2 mu``
+    before ``near_t``).  Pieces thinner than :data:`FUSE_SLIVER` times ``eta`` are the
+    rounding of cuts along a shared side, and are dropped.
+
+    Returns the deepest depth of the candidates that cut something, plus ``mu``, once
+    nothing is left (``-inf`` when nothing was to cover); ``inf`` when a cap is hit or the
+    cover has a hole.
+    """
+    cand, near, deep, sealed, pu, pw, pn, qu, qw, qn, hp, cu, cw, ru, rw, right, up, box, rays = fz
+    sliver = FUSE_SLIVER * eta
+    reach = 0.0  # longest corner ray: bounds the margins over the frustum
+    for k in range(4):
+        reach = max(reach, math.sqrt(rays[k, 0] ** 2 + rays[k, 1] ** 2 + rays[k, 2] ** 2))
+    cu[0], cu[1], cu[2], cu[3] = box[0], box[1], box[1], box[0]
+    cw[0], cw[1], cw[2], cw[3] = box[2], box[2], box[3], box[3]
+    n = 4
+    if t >= 0:
+        _relative(tri, t, v, X)
+        _half_planes(X, True, sealed[0], rays, reach, axis, right, up, delta, eta, hp)
+        for k in range(3):
+            n = _clip2(cu, cw, n, hp[k, 0] + hp[k, 3], hp[k, 1], hp[k, 2], ru, rw)
+            if n < 0:
+                return np.inf
+            for i in range(n):
+                cu[i], cw[i] = ru[i], rw[i]
+    if _width2(cu, cw, n) <= sliver:
+        return -np.inf
+    pn[0] = n
+    for i in range(n):
+        pu[0, i], pw[0, i] = cu[i], cw[i]
+    n_pieces = 1
+    far = -np.inf
+    for q in range(n_cand):
+        s = cand[q]
+        if t >= 0:
+            if near[q] + 2.0 * mu >= near_t:
+                break  # the rest start no nearer
+            if s == t or deep[q] + 2.0 * mu >= near_t:
+                continue
+        _relative(tri, s, v, X)
+        _half_planes(X, False, sealed[q], rays, reach, axis, right, up, delta, eta, hp)
+        used = False
+        n_next = 0
+        for p in range(n_pieces):
+            n = pn[p]
+            # a piece outside one of the half-planes is left whole
+            outside = False
+            for k in range(3):
+                most = -np.inf
+                for i in range(n):
+                    most = max(most, hp[k, 0] + hp[k, 1] * pu[p, i] + hp[k, 2] * pw[p, i])
+                if most <= hp[k, 3]:
+                    outside = True
+                    break
+            if outside:
+                if n_next == len(qn):
+                    return np.inf
+                qn[n_next] = n
+                for i in range(n):
+                    qu[n_next, i], qw[n_next, i] = pu[p, i], pw[p, i]
+                n_next += 1
+                continue
+            used = True
+            # what is left: outside half-plane 0; inside 0, outside 1; inside 0 and 1, outside 2
+            for i in range(n):
+                cu[i], cw[i] = pu[p, i], pw[p, i]
+            for k in range(3):
+                if n_next == len(qn):
+                    return np.inf
+                m = _clip2(cu, cw, n, hp[k, 3] - hp[k, 0], -hp[k, 1], -hp[k, 2], qu[n_next], qw[n_next])
+                if m < 0:
+                    return np.inf
+                if _width2(qu[n_next], qw[n_next], m) > sliver:
+                    qn[n_next] = m
+                    n_next += 1
+                if k == 2:
+                    break
+                n = _clip2(cu, cw, n, hp[k, 0] + hp[k, 3], hp[k, 1], hp[k, 2], ru, rw)
+                if n < 0:
+                    return np.inf
+                for i in range(n):
+                    cu[i], cw[i] = ru[i], rw[i]
+                if _width2(cu, cw, n) <= sliver:
+                    break
+        if used:
+            far = max(far, deep[q])
+        n_pieces = n_next
+        for p in range(n_pieces):
+            pn[p] = qn[p]
+            for i in range(qn[p]):
+                pu[p, i], pw[p, i] = qu[p, i], qw[p, i]
+        if n_pieces == 0:
+            return far + mu
+    return np.inf
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
@@ -866,7 +1276,7 @@ def trace_frusta(
     v, roots, root, box, at_limit, seeds,
     tri, wid, face_edge, edge_start, edge_face, filler,
     lo, hi, first, count, order,
-    delta, eta, mu, max_walk, keep, status, far_depth,
+    delta, eta, mu, max_walk, fusion, keep, status, far_depth,
 ):  # fmt: skip  # pragma: no cover - compiled
     """Blockers, far planes and kept triangles of a batch of frusta from ``v``.
 
@@ -898,13 +1308,16 @@ def trace_frusta(
         Length margin, angle margin, and the widening of the frustum and of its far depth.
     max_walk : int
         Most triangles in one blocker.
+    fusion : bool
+        At the limit, try the union of the triangles meeting a frustum without a blocker
+        (:func:`_fuse`).
     keep : (m,) uint8, in/out
         Set for every triangle kept, to the status of the frustum that kept it first
         (:data:`BLOCKED`: in front of a blocker's far plane; :data:`OPEN`: at the limit).
     status : (n,) int8, out
-        :data:`EMPTY`, :data:`BLOCKED`, :data:`SPLIT` or :data:`OPEN` per frustum.
+        :data:`EMPTY`, :data:`BLOCKED`, :data:`SPLIT`, :data:`OPEN` or :data:`FUSED` per frustum.
     far_depth : (n,) float64, out
-        Far depth of each frustum (``inf`` without a blocker).
+        Far depth of each frustum (``inf`` without a blocker or a covering union).
     """
     n_seeds = seeds.shape[1]
     rays = np.empty((5, 3))
@@ -921,6 +1334,15 @@ def trace_frusta(
         np.empty(MAX_SPAN, np.int64), np.empty(MAX_FILLERS, np.int64), np.empty((MAX_SPAN, 2)),
     )  # fmt: skip
     found, fill, seg = sc[13], sc[14], sc[15]
+    cand = np.empty(FUSE_TRIANGLES, np.int64)
+    near, deep = np.empty(FUSE_TRIANGLES), np.empty(FUSE_TRIANGLES)
+    sealed = np.zeros((FUSE_TRIANGLES, 3), np.bool_)
+    pu, pw = np.empty((FUSE_PIECES, PIECE_VERTS)), np.empty((FUSE_PIECES, PIECE_VERTS))
+    qu, qw = np.empty((FUSE_PIECES, PIECE_VERTS)), np.empty((FUSE_PIECES, PIECE_VERTS))
+    pn, qn = np.empty(FUSE_PIECES, np.int64), np.empty(FUSE_PIECES, np.int64)
+    hp = np.empty((3, 4))
+    cu, cw = np.empty(PIECE_VERTS), np.empty(PIECE_VERTS)
+    ru, rw = np.empty(PIECE_VERTS), np.empty(PIECE_VERTS)
     X, Y, poly, tmp = sc[0], sc[1], sc[2], sc[3]
     stack = np.empty(STACK, np.int64)
     for i in range(len(root)):
@@ -931,6 +1353,9 @@ def trace_frusta(
         )
         for k in range(len(PROBES)):
             _probe_ray(rays, PROBES[k, 0], PROBES[k, 1], probes[k])
+        fz = (
+            cand, near, deep, sealed, pu, pw, pn, qu, qw, qn, hp, cu, cw, ru, rw, roots[r, 1], roots[r, 2], box[i], rays
+        )  # fmt: skip
         far = np.inf
         hit_any = False
         n_blocks = 0
@@ -970,13 +1395,13 @@ def trace_frusta(
             status[i] = BLOCKED
             _collect(
                 BLOCKED, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
-                planes, axis, far, delta, eta, mu, keep, blocks, starts, n_blocks, seeds[i], sc, stack,
+                planes, axis, far, delta, eta, mu, keep, blocks, starts, n_blocks, seeds[i], sc, stack, fz, 0,
             )  # fmt: skip
             continue
         if not hit_any:
             n_any = _collect(
                 ANY, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
-                planes, axis, far, delta, eta, mu, keep, blocks, starts, 0, seeds[i], sc, stack,
+                planes, axis, far, delta, eta, mu, keep, blocks, starts, 0, seeds[i], sc, stack, fz, 0,
             )  # fmt: skip
             hit_any = n_any > 0
         if not hit_any:
@@ -985,9 +1410,28 @@ def trace_frusta(
             status[i] = SPLIT
         else:
             status[i] = OPEN
+            n_cand = 0
+            if fusion:
+                n_cand = _fusion_candidates(
+                    v, planes, axis, tri, filler, lo, hi, first, count, order, delta, mu, cand, near, deep,
+                    X, poly, tmp, stack,
+                )  # fmt: skip
+                _seal_candidates(
+                    n_cand, cand, planes, axis, v, tri, wid, face_edge, edge_start, edge_face, filler, delta, eta,
+                    mu, sealed, seg, X, Y,
+                )  # fmt: skip
+                cover = _cover(
+                    -1, np.inf, n_cand, v, axis, tri, wid, face_edge, edge_start, edge_face, filler,
+                    delta, eta, mu, fz, X, Y,
+                )  # fmt: skip
+                if cover < np.inf:
+                    status[i] = FUSED
+                    far = far_depth[i] = cover
+            # what lies beyond a covering union's far depth is hidden; the rest is kept
+            # unless the union before it covers its rays, or a blocker is found for them
             _collect(
                 OPEN, v, tri, wid, face_edge, edge_start, edge_face, filler, lo, hi, first, count, order,
-                planes, axis, far, delta, eta, mu, keep, blocks, starts, 0, seeds[i], sc, stack,
+                planes, axis, far, delta, eta, mu, keep, blocks, starts, 0, seeds[i], sc, stack, fz, n_cand,
             )  # fmt: skip
 
 

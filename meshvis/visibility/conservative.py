@@ -14,8 +14,10 @@ ray of the frustum provably hits, grown from the first hits of the frustum's cen
 corner rays (traced by Embree, one batch per level); its deepest point in the frustum is
 the far plane (FastV §3.3), and every triangle meeting the frustum in front of it is kept
 unless it lies behind the blocker.  A frustum without a blocker is split in four, level
-by level (FastV §3.4), down to ``max_level``; there, it keeps every triangle it meets for
-which no blocker is found among the rays that reach that triangle.
+by level (FastV §3.4), down to ``max_level``; there, occluder fusion (which FastV lacks)
+looks for a union of triangles that covers the frustum, or the rays that reach one
+triangle, without being joined across edges, and the frustum keeps every triangle it
+meets that neither such a union nor a blocker hides.
 
 A face is kept with the side that faces the point (both when the point lies within the
 margin of its plane, or the face's corners lie on one line, :func:`fillers`).  Every test takes margins of ``tolerance`` times the scene's size
@@ -73,6 +75,8 @@ SAMPLE_BATCH = 1 << 20
 CONFIRM = 4
 #: rays in all of a camera path's views when cameras look into views and no budget is given
 VIEW_RAYS = 1 << 22
+#: frusta counted by outcome (:attr:`ConservativeSet.frusta`)
+COUNTS = ("traced", "blocked", "split", "open", "fused", "empty")
 
 
 @dataclass
@@ -94,7 +98,8 @@ class ConservativeSet:
         Face areas.
     frusta : dict
         Frusta traced, in total and by outcome (``blocked``, ``split``, ``open`` at the
-        limit, ``empty``), and per viewpoint (``per_point``).
+        limit, of which ``fused`` were covered by a union of triangles, ``empty``), and per
+        viewpoint (``per_point``).
     at_limit : (m,) bool
         Faces in the set only because of the subdivision limit: from every viewpoint that
         keeps them, the first frustum to keep them was at the limit, without a blocker
@@ -105,8 +110,8 @@ class ConservativeSet:
     seconds : float
         Time taken.
     open_frusta : list of tuple
-        Per viewpoint, its frusta at the limit without a blocker, where the set keeps what
-        it cannot prove hidden: ``(roots, root, box)``, the viewpoint's (r, 3, 3) roots
+        Per viewpoint, its frusta at the limit without a blocker (covered by a union of
+        triangles or not), where the set keeps what it cannot prove hidden: ``(roots, root, box)``, the viewpoint's (r, 3, 3) roots
         (``axis``, ``right``, ``up``), and each frustum's (k,) root and (k, 4) box
         ``u0, u1, w0, w1`` (its directions are ``axis + u right + w up``).
     """
@@ -310,6 +315,7 @@ def conservative_from(
     tolerance: float = DEFAULT_TOLERANCE,
     scene: FrustumScene | None = None,
     caster: RayCaster | None = None,
+    fusion: bool = True,
 ) -> ConservativeSet:
     """The faces that may be seen from the viewpoints of ``region``, per face and side.
 
@@ -332,6 +338,10 @@ def conservative_from(
         A prepared scene of the same model to reuse.
     caster : RayCaster, optional
         A caster of the same model for the seed rays.
+    fusion : bool
+        At the subdivision limit, a frustum without a blocker hides what lies behind the
+        union of the triangles that cover it (occluder fusion); ``False`` keeps everything
+        it meets that no blocker hides, as FastV does.
 
     Returns
     -------
@@ -361,10 +371,10 @@ def conservative_from(
     visible_side = np.zeros((m, 2), bool)
     at_limit, in_front = np.zeros(m, bool), np.zeros(m, bool)
     point_faces, point_sides, per_point, open_frusta = [], [], [], []
-    totals = dict.fromkeys(("traced", "blocked", "split", "open", "empty"), 0)
+    totals = dict.fromkeys(COUNTS, 0)
     for view in views:
         t0 = time.perf_counter()
-        keep, counts, leaves = _trace_viewpoint(scene, view, base_level, max_level, tolerance)
+        keep, counts, leaves = _trace_viewpoint(scene, view, base_level, max_level, tolerance, fusion)
         open_frusta.append((np.asarray(view.roots, np.float64), *leaves))
         faces = np.flatnonzero(keep)
         at_limit |= keep == fk.OPEN
@@ -387,7 +397,12 @@ def conservative_from(
         point_sides=point_sides,
         area=soup.areas.copy(),
         frusta={**totals, "per_point": per_point},
-        parameters={"base_level": base_level, "max_level": max_level, "tolerance": tolerance},
+        parameters={
+            "base_level": base_level,
+            "max_level": max_level,
+            "tolerance": tolerance,
+            "fusion": fusion,
+        },
         seconds=time.perf_counter() - start,
         at_limit=at_limit & ~in_front,
         open_frusta=open_frusta,
@@ -397,8 +412,13 @@ def conservative_from(
 def facing_sides(triangles: np.ndarray, position: np.ndarray, delta: float) -> np.ndarray:
     """(n,) int8: the side of each triangle that faces ``position`` (0 front, 1 back, 2 both).
 
-    Both when the point is within ``2 delta`` of the triangle's plane (or the triangle has
-    no area): a ray from there meets it at a grazing angle, on either side.
+    Both when moving the corners and the point by ``delta`` may put the point on the other
+    side of the triangle's plane (or the triangle has no area): a ray from there meets it
+    at a grazing angle, and rounding decides the side.  The side test is the sign of
+    ``det[b - a, c - a, p - a]``; to first order, the moves change it by at most ``delta``
+    times ``|n| + 2 |(c - a) x (p - a)| + 2 |(p - a) x (b - a)|`` (``n`` the normal), and the
+    point is taken as in the plane within twice that.  A tiny face seen from afar tilts
+    most.
 
     Examples
     --------
@@ -408,8 +428,10 @@ def facing_sides(triangles: np.ndarray, position: np.ndarray, delta: float) -> n
     """
     a, b, c = triangles[:, 0], triangles[:, 1], triangles[:, 2]
     n = np.cross(b - a, c - a)
-    toward = np.einsum("ij,ij->i", n, position - a)
-    near = np.abs(toward) <= 2.0 * delta * np.linalg.norm(n, axis=1)
+    pa = position - a
+    toward = np.einsum("ij,ij->i", n, pa)
+    tilt = np.linalg.norm(np.cross(c - a, pa), axis=1) + np.linalg.norm(np.cross(pa, b - a), axis=1)
+    near = np.abs(toward) <= 2.0 * delta * (np.linalg.norm(n, axis=1) + 2.0 * tilt)
     return np.where(near, 2, np.where(toward > 0, 0, 1)).astype(np.int8)
 
 
@@ -457,14 +479,19 @@ def _seed_rays(roots: np.ndarray, root: np.ndarray, box: np.ndarray) -> np.ndarr
 
 
 def _trace_viewpoint(
-    scene: FrustumScene, view: Viewpoint, base_level: int, max_level: int, tolerance: float
+    scene: FrustumScene,
+    view: Viewpoint,
+    base_level: int,
+    max_level: int,
+    tolerance: float,
+    fusion: bool = True,
 ) -> tuple[np.ndarray, dict, tuple[np.ndarray, np.ndarray]]:
     """Trace one viewpoint's frusta level by level: the kept faces (m,) uint8, the counts, and the open frusta's ``(root, box)``."""
     from meshvis._threads import in_threads
 
     m = scene.soup.n_faces
     keep = np.zeros(m, np.uint8)
-    counts = dict.fromkeys(("traced", "blocked", "split", "open", "empty"), 0)
+    counts = dict.fromkeys(COUNTS, 0)
     open_root, open_box = [np.zeros(0, np.int64)], [np.zeros((0, 4))]
     if m == 0:
         return keep, counts, (open_root[0], open_box[0])
@@ -490,15 +517,18 @@ def _trace_viewpoint(
                     v, roots, root[s], box[s], at_limit[s], seeds[i:j],
                     scene.triangles, scene.welded, scene.face_edge, scene.edge_start, scene.edge_face, scene.filler,
                     bvh.lo, bvh.hi, bvh.first, bvh.count, bvh.order,
-                    delta, eta, mu, MAX_WALK, keep, status[s], far[s],
+                    delta, eta, mu, MAX_WALK, fusion, keep, status[s], far[s],
                 )  # fmt: skip
 
             in_threads(work, b - a, rows_per_item=64)
         counts["traced"] += len(root)
         counts["blocked"] += int((status == fk.BLOCKED).sum())
-        counts["open"] += int((status == fk.OPEN).sum())
-        open_root.append(root[status == fk.OPEN])
-        open_box.append(box[status == fk.OPEN])
+        # at the limit without a blocker: kept open, or covered by a union (fused)
+        at_open = (status == fk.OPEN) | (status == fk.FUSED)
+        counts["open"] += int(at_open.sum())
+        counts["fused"] += int((status == fk.FUSED).sum())
+        open_root.append(root[at_open])
+        open_box.append(box[at_open])
         counts["empty"] += int((status == fk.EMPTY).sum())
         split = status == fk.SPLIT
         counts["split"] += int(split.sum())

@@ -39,3 +39,21 @@ def test_the_soup_input_keeps_the_models_up_axis():
     soup, turned = soup_of(model, seed=1)
     assert soup.up == (0.0, 1.0, 0.0)
     assert turned.sum() == round(FLIP * 10) and soup.n_vertices == 30
+
+
+def test_from_above_reports_the_back_facing_pixels_before_and_after(tmp_path):
+    """``--elevations``: one row per model and elevation, input and both outputs."""
+    import csv
+
+    from helpers import REAL
+
+    from meshvis.cli.main import main
+
+    out = tmp_path / "out"
+    argv = ["bench", "orientation", "--out", str(out), "--models", str(REAL), "--quiet"]
+    assert main([*argv, "--only", "wallhole", "--elevations", "20", "60"]) == 0
+    rows = list(csv.DictReader(open(out / "from_above.csv")))
+    assert [float(r["elevation"]) for r in rows] == [20.0, 60.0]
+    assert all(r["model"] == "wallhole.obj" and r["ground_found"] == "True" for r in rows)
+    assert all(0.0 <= float(r[k]) <= 1.0 for r in rows for k in ("input", "default", "ground_auto"))
+    assert "| wallhole.obj | 66 | 60° |" in (out / "from_above.md").read_text()

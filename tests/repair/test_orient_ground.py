@@ -99,3 +99,62 @@ def test_no_ground_under_nothing_or_a_wall():
     assert not stands_on_ground(wall, RayCaster(wall), UP)
     empty = Soup(np.zeros((0, 3)), np.zeros((0, 3), np.int64))
     assert not stands_on_ground(empty, None, UP)  # type: ignore[arg-type]
+
+
+def _courtyard(gap: float) -> Soup:
+    """A ground (z up), three walls around a courtyard open on one side, fronts out, and a
+    closed block ``gap`` away from the back wall's front (every face wound outward).
+
+    The back wall (faces 4 and 5) is seen from both sides from above: through its back
+    from the open courtyard, through its front down the slit to the block.  Its own rays
+    see its back more than 4x as often; its patch (the three walls) shows their fronts.
+    """
+
+    def quad(a: int, b: int, c: int, d: int) -> list[list[int]]:
+        return [[a, b, c], [a, c, d]]
+
+    ground = [[-10, -10, 0], [10, -10, 0], [10, 10, 0], [-10, 10, 0]]
+    corners = [[2, -2], [-2, -2], [-2, 2], [2, 2]]
+    walls = [[x, y, 0] for x, y in corners] + [[x, y, 2] for x, y in corners]
+    x0 = -2 - gap
+    foot = [[x0 - 1, -2, 0], [x0, -2, 0], [x0, 2, 0], [x0 - 1, 2, 0]]
+    block = foot + [[x, y, 4] for x, y, _ in foot]
+    faces = quad(0, 1, 2, 3)
+    faces += [f for i in range(3) for f in quad(4 + i, 8 + i, 9 + i, 5 + i)]
+    b = [[0, 3, 2, 1], [4, 5, 6, 7], [0, 1, 5, 4], [1, 2, 6, 5], [2, 3, 7, 6], [3, 0, 4, 7]]
+    faces += [f for q in b for f in quad(*(12 + i for i in q))]
+    return Soup(np.array(ground + walls + block, float), np.array(faces, np.int64))
+
+
+@pytest.mark.parametrize("gap", [0.05, 0.1])
+@pytest.mark.parametrize("ground", [True, None])
+def test_a_wall_seen_from_both_sides_above_the_ground_keeps_its_patch(gap, ground):
+    """Seen from above its ground, a face does not leave its patch for the side seen more
+    often where viewers above see its patch's side: the back wall keeps the winding of
+    the walls it belongs to.  It was turned before (at 0.05 by the cut, at 0.1 by the
+    wall's own rays)."""
+    soup = _courtyard(gap)
+    back_wall = [4, 5]
+    assert (soup.normals[back_wall] @ [-1.0, 0, 0] > 0.99).all()  # its front faces the block
+    r = orient(soup, seed=0, ground=ground)
+    assert r.visibility["ground"]
+    assert not r.flipped.any(), np.flatnonzero(r.flipped)
+    assert r.visibility["kept_seen_from_above"] == len(back_wall)
+    assert not orient(r.soup, seed=0, ground=ground).flipped.any()
+
+
+@pytest.mark.parametrize("ground, up", [(False, None), (None, "y")])
+def test_seen_from_every_direction_the_wall_takes_the_side_seen_more(ground, up):
+    """By default, or where the scene stands on no ground (along y), viewers all around
+    see the back wall through the courtyard more than 4x as often: it is turned."""
+    r = orient(_courtyard(0.1), seed=0, ground=ground, up=up)
+    assert not r.visibility["ground"] and r.visibility["kept_seen_from_above"] == 0
+    np.testing.assert_array_equal(np.flatnonzero(r.flipped), [4, 5])
+
+
+@pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6)])
+def test_the_courtyard_wall_keeps_its_patch_at_any_scale_and_far_away(scale, shift):
+    soup = _courtyard(0.1)
+    soup = Soup(soup.vertices * scale + shift, soup.faces)
+    r = orient(soup, seed=0, ground=None)
+    assert r.visibility["kept_seen_from_above"] == 2 and not r.flipped.any()

@@ -84,6 +84,56 @@ def test_two_coplanar_triangles_sharing_an_edge_block_together_and_a_gap_between
     assert c.at_limit.tolist() == [False, False, True]
 
 
+# occluder fusion: a frustum at the subdivision limit without one connected blocker, covered
+# by the union of the triangles that meet it.  Seen from the origin up +z; the far triangle
+# spans x/z in [-0.3, 0.3] and y/z in [-0.1, 0.1]; the covers meet along x/z = 0.1 within
+# one frustum of the limit, so no frustum there has a single blocker.
+BEHIND = [[(-1.2, -0.4, 4.0), (1.2, -0.4, 4.0), (0.0, 0.4, 4.0)]]
+LEFT = [(-10, -10, 1), (0.1, -10, 1), (0.1, 10, 1)]  # x/z up to 0.1
+
+
+def strip(p, q):
+    """Two triangles joining the lines (x0, y, z0) and (x1, y, z1), |y| <= 5."""
+    (x0, z0), (x1, z1) = p, q
+    a, b, c, d = (x0, -5, z0), (x1, -5, z1), (x1, 5, z1), (x0, 5, z0)
+    return [[a, b, c], [a, c, d]]
+
+
+def test_two_separate_triangles_that_cover_a_view_together_hide_what_is_behind_them():
+    right = [(0.198, -10, 2), (20, 10, 2), (0.198, 10, 2)]  # from x/z = 0.099, further away
+    soup = soup_from([LEFT, right] + BEHIND)
+    c = conservative_from(soup, "points:0,0,0", max_level=LEVEL)
+    assert c.visible.tolist() == [True, True, False]
+    assert c.frusta["fused"] > 0 and c.parameters["fusion"]
+    # without fusion the frusta along the seam keep it, as FastV does
+    off = conservative_from(soup, "points:0,0,0", max_level=LEVEL, fusion=False)
+    assert off.visible.tolist() == [True, True, True] and off.frusta["fused"] == 0
+    assert off.frusta["open"] == c.frusta["open"]
+
+
+def test_a_hairline_gap_between_two_triangles_shows_what_is_behind_it():
+    # the second triangle starts 1e-13 after the first ends, in the same plane: rays pass
+    # between them, however thin the gap (fusion's margins widen it, never close it)
+    right = [(0.1 + 1e-13, -10, 1), (20, 10, 1), (0.1 + 1e-13, 10, 1)]
+    soup = soup_from([LEFT, right] + BEHIND)
+    c = conservative_from(soup, "points:0,0,0", max_level=LEVEL)
+    assert c.visible.tolist() == [True, True, True]
+    assert c.at_limit.tolist() == [False, False, True]
+
+
+def test_a_part_folded_over_itself_hides_what_is_behind_the_fold():
+    # one connected strip: near at z = 1 up to x/z = 0.2, folded back to x/z = 0.199, folded
+    # again and on, further away: each fold is a silhouette that no blocker crosses
+    fold = strip((-1, 1), (0.2, 1)) + strip((0.2, 1), (0.2985, 1.5)) + strip((0.2985, 1.5), (2, 2.5))
+    soup = soup_from(fold + BEHIND)
+    assert len(np.unique(soup.faces[:6])) == 8  # one part, its corners shared
+    c = conservative_from(soup, "points:0,0,0", max_level=LEVEL)
+    assert c.visible.tolist() == [True] * 6 + [False]
+    assert c.frusta["fused"] > 0
+    off = conservative_from(soup, "points:0,0,0", max_level=LEVEL, fusion=False)
+    assert off.visible.tolist() == [True] * 7
+
+
 @pytest.mark.slow
 def test_a_grazing_view_over_a_floor_keeps_what_stands_on_it_and_not_what_lies_under_it():
     floor = quad_x(-100, 100, -100, 100, 0)
@@ -224,6 +274,17 @@ def test_a_sliver_thinner_than_the_margin_that_a_ray_hits_stays_in_the_set():
     c = conservative_from(soup, "points:0,0,0", max_level=LEVEL, scene=scene)
     assert c.visible_side[0, 1]  # its back side faces the point (its corners lie on one line: both)
     assert c.visible_side[1:, 1].all() and not c.visible_side[1:, 0].any()  # the wall around it
+
+
+def test_a_tiny_face_seen_from_afar_nearly_in_its_plane_is_kept_with_both_sides():
+    # a triangle 1e-4 across, 0.05 away, the point 4e-6 in front of its plane: rounding its
+    # corners by the margin (about 5e-8 here) can tilt the plane past the point
+    from meshvis.visibility.conservative import facing_sides
+
+    tri = np.array([[[0.05, 0.0, 0.0], [0.05, 1e-4, 0.0], [0.05 + 1e-4, 0.0, 0.0]]])
+    point = np.array([0.0, 0.0, 4e-6])
+    assert facing_sides(tri, point, 5e-8).tolist() == [2]
+    assert facing_sides(tri, np.array([0.0, 0.0, 0.01]), 5e-8).tolist() == [1]  # clearly off it
 
 
 def test_rays_through_the_open_frusta_see_only_what_the_set_holds_and_repeat_with_the_seed():

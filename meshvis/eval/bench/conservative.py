@@ -24,7 +24,9 @@ outside, around it), and for each:
   (:attr:`~meshvis.visibility.conservative.ConservativeSet.at_limit`); ``parts``, hidden
   along the aimed rays by two or more parts (faces joined across edges) that no one
   blocker can span;
-* frusta traced, seconds and CPU seconds (all threads), frusta per second of each.
+* frusta traced; of them, at the limit without a blocker (``open``) and, of those, covered
+  by the union of the triangles meeting them (``fused``, occluder fusion);
+* seconds and CPU seconds (all threads), frusta per second of each.
 
 ``--sweep`` adds the error against run time: the area ratio and frusta of the first scene's
 points at several subdivision limits.  ``--throughput`` measures frusta per second over the
@@ -229,6 +231,7 @@ def run_scene(
                 "excess_several_parts": float(area[gap[hidden & (parts >= 2)]].sum()) / excess,
                 "frusta": int(c.frusta["traced"]),
                 "open": int(c.frusta["open"]),
+                "fused": int(c.frusta["fused"]),
                 "seconds": c.seconds,
                 "cpu_seconds": cpu,
                 "scene_seconds": build,
@@ -356,7 +359,7 @@ def main(args: argparse.Namespace) -> int:
     )
     head = (
         f"{'scene':<28} {'point':<8} {'faces':>7} {'seen':>7} {'seen*':>7} {'in set':>7} {'missed':>6} "
-        f"{'miss*':>6} {'ratio':>6} {'ratio*':>6} {'limit':>6} {'parts':>6} {'frusta':>9} {'open':>8} "
+        f"{'miss*':>6} {'ratio':>6} {'ratio*':>6} {'limit':>6} {'parts':>6} {'frusta':>9} {'open':>8} {'fused':>8} "
         f"{'time':>7} {'frusta/s':>9} {'CPU':>7} {'per CPU s':>9}"
     )
     print(head)
@@ -376,7 +379,7 @@ def main(args: argparse.Namespace) -> int:
                 f"{r['aimed_seen_faces']:>7} {r['conservative_faces']:>7} {r['missed_faces']:>6} "
                 f"{r['missed_faces_aimed']:>6} {r['area_ratio']:>6.2f} {r['area_ratio_aimed']:>6.2f} "
                 f"{r['excess_at_limit']:>6.0%} {r['excess_several_parts']:>6.0%} {r['frusta']:>9} "
-                f"{r['open']:>8} {r['seconds']:>6.2f}s {r['frusta'] / r['seconds']:>9.0f} "
+                f"{r['open']:>8} {r['fused']:>8} {r['seconds']:>6.2f}s {r['frusta'] / r['seconds']:>9.0f} "
                 f"{r['cpu_seconds']:>6.2f}s {r['frusta'] / r['cpu_seconds']:>9.0f}"
             )
         mean = float(np.mean([r["area_ratio"] for r in scene_rows]))
@@ -390,7 +393,8 @@ def main(args: argparse.Namespace) -> int:
             f"{os.path.basename(path)[:28]:<28} {'all':<8} {'':>7} {'':>7} {'':>7} {'':>7} "
             f"{sum(r['missed_faces'] for r in scene_rows):>6} {sum(r['missed_faces_aimed'] for r in scene_rows):>6} "
             f"{mean:>6.2f} {mean_aimed:>6.2f} {at_limit:>6.0%} {several:>6.0%} {frusta:>9} "
-            f"{sum(r['open'] for r in scene_rows):>8} {wall:>6.2f}s {frusta / wall:>9.0f} "
+            f"{sum(r['open'] for r in scene_rows):>8} {sum(r['fused'] for r in scene_rows):>8} "
+            f"{wall:>6.2f}s {frusta / wall:>9.0f} "
             f"{cpu:>6.2f}s {frusta / cpu:>9.0f}"
         )
         rows += scene_rows

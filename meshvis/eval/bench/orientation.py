@@ -22,6 +22,13 @@ instead: they are left out of the error, and the pairs a method writes with one 
 Output under ``DIR``: ``orientation.csv`` (one row per run), ``orientation.md`` (the
 machine, a table per input kind, the orientation targets checked on the numbers) and
 ``orientation.png`` (error against time, one panel per model).
+
+``meshvis bench orientation --out DIR --elevations 20 60 [--only A,B]`` measures what a
+viewer above a scene sees instead (no reference, no baselines): each model as it is,
+``orient``'s output at its defaults and with ``--ground auto``, rendered from each
+elevation above the model's up axis (azimuth 30, 512 x 512), and the share of the
+model's pixels that show a back side (``meshvis render --color-by side`` draws them
+orange).  Output: ``from_above.csv`` and ``from_above.md``.
 """
 
 from __future__ import annotations
@@ -56,6 +63,7 @@ SPEED_TARGET = 5.0
 #: errors below this are drawn on the floor of the log axis
 FLOOR = 1e-6
 OUTPUTS = ("orientation.csv", "orientation.md", "orientation.png")
+FROM_ABOVE_OUTPUTS = ("from_above.csv", "from_above.md")
 DEFAULT_CACHE = "/tmp/meshvis-refcache"
 
 
@@ -222,15 +230,95 @@ def run(
     return runs
 
 
+@dataclass
+class FromAbove:
+    """Back-facing pixels of one model seen from one elevation: the input and ``orient``'s outputs."""
+
+    model: str
+    faces: int
+    elevation: float
+    input: float  # share of the model's pixels showing a back side
+    default: float  # after ``orient`` at its defaults
+    ground_auto: float  # after ``orient(ground=None)``
+    ground_found: bool
+    seconds_default: float
+    seconds_auto: float
+    load1: float = 0.0
+
+
+def from_above(paths: list[str], elevations: list[float], *, seed: int, log=print) -> list[FromAbove]:
+    """Back-facing pixels seen from ``elevations`` before and after ``orient`` (default and ``ground=None``).
+
+    Parameters
+    ----------
+    paths : list of str
+        Model files.
+    elevations : list of float
+        Degrees above the horizon of the model's up axis (azimuth 30).
+    seed : int
+        Seed of ``orient``.
+    log : callable
+        Progress lines.
+
+    Returns
+    -------
+    list of FromAbove
+        One row per model and elevation.
+    """
+    from meshvis.eval.bench.orient_twice import back_facing
+    from meshvis.io import load
+    from meshvis.repair.orient import orient
+
+    rows = []
+    for path in paths:
+        soup = load(path)
+        t = time.perf_counter()
+        default = orient(soup, seed=seed)
+        t_default = time.perf_counter() - t
+        t = time.perf_counter()
+        auto = orient(soup, seed=seed, ground=None)
+        t_auto = time.perf_counter() - t
+        found = bool(auto.visibility and auto.visibility["ground"])
+        for e in elevations:
+            shares = [back_facing(s, e, soup.up) for s in (soup, default.soup, auto.soup)]
+            rows.append(
+                FromAbove(
+                    os.path.basename(path), soup.n_faces, e, *shares, found, t_default, t_auto, C.load1()
+                )
+            )
+            log(f"{rows[-1].model}: {e:g} degrees, back-facing " + ", ".join(f"{x:.3%}" for x in shares))
+    return rows
+
+
+def from_above_markdown(rows: list[FromAbove], command: str) -> str:
+    """The table of :func:`from_above`: one row per model and elevation."""
+    lines = [
+        "Back-facing pixels: the share of the model's pixels that show a back side, seen from the "
+        "elevation above its up axis (azimuth 30, 512 x 512), as it comes and after `orient`.",
+        "",
+        f"Command: `{command}`",
+        "",
+        "| model | faces | elevation | input | `orient` | `orient --ground auto` (ground found) | `orient` time, default / auto |",
+        "|---|---:|---:|---:|---:|---:|---:|",
+    ]
+    for r in rows:
+        lines.append(
+            f"| {r.model} | {r.faces} | {r.elevation:g}° | {r.input:.3%} | {r.default:.3%} | "
+            f"{r.ground_auto:.3%} ({'yes' if r.ground_found else 'no'}) | "
+            f"{r.seconds_default:.1f} s / {r.seconds_auto:.1f} s (load {r.load1:.1f}) |"
+        )
+    return "\n".join(lines)
+
+
 # ====================================================================== reporting
-def write_csv(path: str, runs: list[Run]) -> None:
+def write_csv(path: str, runs: list) -> None:
     """Write one CSV row per run to ``path`` (atomically).
 
     Parameters
     ----------
     path : str
         The CSV file.
-    runs : list of Run
+    runs : list of Run or FromAbove
         The runs, in order.
     """
     from meshvis.io import atomic_write
@@ -431,6 +519,14 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
     p.add_argument("--force", action="store_true", help="overwrite earlier results in DIR")
     p.add_argument("--quiet", action="store_true")
     p.add_argument(
+        "--elevations",
+        nargs="+",
+        type=float,
+        metavar="DEG",
+        help="instead of the errors: back-facing pixels seen from these elevations above the up axis, "
+        "before and after orient (default and --ground auto)",
+    )
+    p.add_argument(
         "--confirm",
         action="store_true",
         help="also judge on the faces a recount of the reference confirms (2,048 rays per face, up to "
@@ -452,14 +548,25 @@ def main(args: argparse.Namespace) -> int:
         Exit status 0.
     """
     paths = model_paths(args.only, args.quick, args.models_dir)
-    prepare_out(args.out, OUTPUTS, args.force)
     log = (lambda *a: None) if args.quiet else (lambda *a: print(*a, file=sys.stderr, flush=True))
+    command = "meshvis bench orientation " + " ".join(sys.argv[3:]) if len(sys.argv) > 2 else ""
+    if args.elevations:
+        from meshvis.io import atomic_write
+
+        prepare_out(args.out, FROM_ABOVE_OUTPUTS, args.force)
+        rows = from_above(paths, args.elevations, seed=args.seed, log=log)
+        write_csv(os.path.join(args.out, "from_above.csv"), rows)
+        md = from_above_markdown(rows, command.strip())
+        with atomic_write(os.path.join(args.out, "from_above.md"), "w") as fh:
+            fh.write(md + "\n")
+        print(md)
+        return 0
+    prepare_out(args.out, OUTPUTS, args.force)
     machine = C.machine()
     C.warm_up()
     t0 = time.perf_counter()
     runs = run(paths, quick=args.quick, seed=args.seed, cache=args.cache, log=log, recount=args.confirm)
     seconds = time.perf_counter() - t0
-    command = "meshvis bench orientation " + " ".join(sys.argv[3:]) if len(sys.argv) > 2 else ""
     write_csv(os.path.join(args.out, "orientation.csv"), runs)
     md = markdown(runs, machine, command.strip(), seconds)
     from meshvis.io import atomic_write
