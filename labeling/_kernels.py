@@ -155,34 +155,128 @@ def lower_f4_near(px, py, d_a, w4, ax, ay, done, static, cell, f4, f4w, S, acc, 
 
 
 @numba.njit(**_JIT)
-def boundary_endpoints(inside, k, qx, qy, px, py, n):
-    """Endpoints of nearest-boundary leaders (for :func:`meshvis.labeling.candidates._radial`).
+def radial_image(mask, ri, ci, oy, ox, H, W):
+    """Nearest-boundary candidates of the image's pixels (for :func:`meshvis.labeling.candidates.leader_candidates`).
 
-    ``inside`` (m,): flat indices of the inside pixels of a grid of ``n`` pixels, ``k``
-    (m,): flat index of each one's nearest outside pixel ``q``, ``qx``, ``qy``: its centre,
-    ``px``, ``py``: the inside pixel's centre.  The endpoint is ``q`` moved half a pixel back
-    along the mean unit direction of all the pixels that share ``q`` (summed in index
-    order, as ``np.bincount`` does).  Returns, over the grid, the key ``q`` (-1 outside),
-    the endpoint (NaN outside) and the leader length (inf outside).
+    ``mask`` (hb, wb): a window of the grid of ``A_I`` whose pixel (r, c) is the image's
+    pixel (r + oy, c + ox), centre (c + ox + 0.5, r + oy + 0.5); ``ri``, ``ci`` (hb, wb):
+    the window row and column of each inside pixel's nearest outside pixel ``q`` (the
+    EDT's feature transform).  The endpoint is ``q`` moved half a pixel back along the
+    mean unit direction of all the inside pixels that share ``q`` (summed in row-major
+    order, as ``np.bincount`` does); the leader runs from the pixel's centre to it.
+    Returns, over the (H, W) image: endpoint x, y and leader length (NaN outside),
+    endpoint id (-1 outside; the ids number the endpoints of the image's pixels in
+    row-major order of ``q``), then the endpoints (n_e, 2) and the longest leader of the
+    window (-inf when nothing is inside).
     """
-    m = inside.shape[0]
-    sx, sy = np.zeros(n), np.zeros(n)
-    ux, uy = np.empty(m), np.empty(m)
-    for i in range(m):
-        dx, dy = qx[i] - px[i], qy[i] - py[i]
-        norm = max(math.hypot(dx, dy), 1e-12)
-        ux[i], uy[i] = dx / norm, dy / norm
-        sx[k[i]] += ux[i]
-        sy[k[i]] += uy[i]
-    key = np.full(n, -1, np.int64)
-    ex, ey = np.full(n, np.nan), np.full(n, np.nan)
-    length = np.full(n, np.inf)
-    for i in range(m):
-        mx, my = sx[k[i]], sy[k[i]]
-        mn = max(math.hypot(mx, my), 1e-12)
-        p = inside[i]
-        key[p] = k[i]
-        ex[p] = qx[i] - 0.5 * (mx / mn)
-        ey[p] = qy[i] - 0.5 * (my / mn)
-        length[p] = math.hypot(ex[p] - px[i], ey[p] - py[i])
-    return key, ex, ey, length
+    hb, wb = mask.shape
+    sx, sy = np.zeros((hb, wb)), np.zeros((hb, wb))
+    dense = np.full((hb, wb), -1, np.int64)
+    for r in range(hb):
+        for c in range(wb):
+            if mask[r, c]:
+                qr, qc = ri[r, c], ci[r, c]
+                dx, dy = float(qc - c), float(qr - r)
+                norm = max(math.hypot(dx, dy), 1e-12)
+                sx[qr, qc] += dx / norm
+                sy[qr, qc] += dy / norm
+                if 0 <= r + oy < H and 0 <= c + ox < W:
+                    dense[qr, qc] = 0
+    # the endpoints of the image's pixels, numbered in row-major order of q
+    n_e = 0
+    for r in range(hb):
+        for c in range(wb):
+            if dense[r, c] == 0:
+                dense[r, c] = n_e
+                n_e += 1
+    ex, ey = np.full((H, W), np.nan), np.full((H, W), np.nan)
+    length = np.full((H, W), np.nan)
+    eid = np.full((H, W), -1, np.int64)
+    endpoints = np.empty((n_e, 2))
+    d_max = -np.inf
+    for r in range(hb):
+        for c in range(wb):
+            if not mask[r, c]:
+                continue
+            qr, qc = ri[r, c], ci[r, c]
+            mx, my = sx[qr, qc], sy[qr, qc]
+            mn = max(math.hypot(mx, my), 1e-12)
+            x = (qc + ox + 0.5) - 0.5 * (mx / mn)
+            y = (qr + oy + 0.5) - 0.5 * (my / mn)
+            d = math.hypot(x - (c + ox + 0.5), y - (r + oy + 0.5))
+            d_max = max(d_max, d)
+            i, j = r + oy, c + ox
+            if 0 <= i < H and 0 <= j < W:
+                k = dense[qr, qc]
+                ex[i, j], ey[i, j], length[i, j], eid[i, j] = x, y, d, k
+                endpoints[k, 0], endpoints[k, 1] = x, y
+    return ex, ey, length, eid, endpoints, d_max
+
+
+@numba.njit(**_JIT)
+def _on_silhouette(ids, r, c):
+    """Pixel (r, c) lies on the border of ``ids`` or has a 4-neighbour with another id."""
+    h, w = ids.shape
+    if r == 0 or c == 0 or r == h - 1 or c == w - 1:
+        return True
+    v = ids[r, c]
+    return v != ids[r - 1, c] or v != ids[r + 1, c] or v != ids[r, c - 1] or v != ids[r, c + 1]
+
+
+@numba.njit(**_JIT)
+def own_silhouette_distance(ids):
+    """Distance of every pixel of ``ids`` (h, w) to the silhouette of its own area, plus 1.
+
+    For :func:`meshvis.labeling.membership.silhouette_distance`: a silhouette pixel (one on
+    the border, or with a 4-neighbour of another id) gets 1, every other pixel 1 + the
+    Euclidean distance to the nearest silhouette pixel; background (id < 0) gets 0.  The
+    exact squared distances are found in integers by the separable lower envelope of
+    parabolas (Felzenszwalb and Huttenlocher), column pass then row pass, so the square
+    roots are those of an exact EDT.
+    """
+    h, w = ids.shape
+    g = np.empty((h, w), np.int64)  # vertical distance to the nearest silhouette pixel
+    for c in range(w):
+        last = -1
+        for r in range(h):
+            if _on_silhouette(ids, r, c):
+                last = r
+                g[r, c] = 0
+            else:
+                g[r, c] = r - last if last >= 0 else h + w
+        last = -1
+        for r in range(h - 1, -1, -1):
+            if g[r, c] == 0:
+                last = r
+            elif last >= 0:
+                g[r, c] = min(g[r, c], last - r)
+    out = np.zeros((h, w))
+    f = np.empty(w, np.int64)
+    v = np.empty(w, np.int64)
+    z = np.empty(w + 1)
+    for r in range(h):
+        for c in range(w):
+            f[c] = g[r, c] * g[r, c]
+        k = 0
+        v[0] = 0
+        z[0], z[1] = -np.inf, np.inf
+        for q in range(1, w):
+            fq = f[q] + q * q
+            while True:
+                p = v[k]
+                s = (fq - (f[p] + p * p)) / (2.0 * (q - p))
+                if s <= z[k]:
+                    k -= 1
+                else:
+                    break
+            k += 1
+            v[k] = q
+            z[k], z[k + 1] = s, np.inf
+        k = 0
+        for q in range(w):
+            while z[k + 1] < q:
+                k += 1
+            if ids[r, q] >= 0:
+                p = v[k]
+                out[r, q] = math.sqrt(float((q - p) * (q - p) + f[p])) + 1.0
+    return out

@@ -32,7 +32,7 @@ from scipy import ndimage
 
 from meshvis.errors import ParameterError
 
-from ._kernels import boundary_endpoints
+from ._kernels import radial_image
 from .internal_area import InternalArea
 
 #: side codes of a leader: the direction it leaves the model in
@@ -96,48 +96,25 @@ class Candidates:
     d_max: float
 
 
-def _nearest_outside(mask: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """The inside pixels of ``mask`` (flat indices, row-major) and the row and column of each one's nearest outside pixel.
-
-    The exact EDT's feature transform runs on the bounding box of ``mask`` plus one pixel
-    (every inside pixel lies there, and so does its nearest outside pixel).
-    """
-    rows = np.flatnonzero(mask.any(axis=1))
-    cols = np.flatnonzero(mask.any(axis=0))
-    r0, r1 = max(rows[0] - 1, 0), min(rows[-1] + 2, mask.shape[0])
-    c0, c1 = max(cols[0] - 1, 0), min(cols[-1] + 2, mask.shape[1])
-    box = mask[r0:r1, c0:c1]
-    ri, ci = ndimage.distance_transform_edt(box, return_distances=False, return_indices=True)
-    inside = np.flatnonzero(box.ravel())
-    row, col = np.divmod(inside, box.shape[1])
-    flat = (row + r0) * mask.shape[1] + (col + c0)
-    return flat, ri.ravel()[inside] + r0, ci.ravel()[inside] + c0
-
-
-def _radial(
-    mask: np.ndarray, X: np.ndarray, Y: np.ndarray
-) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
-    """Nearest-boundary candidates: (length, ex, ey, key) on the grid of ``mask``.
-
-    ``X``, ``Y``: image coordinates of the pixel centres of ``mask``; ``key`` = flat index
-    into ``mask`` of the nearest outside pixel (-1 outside ``mask``).
+def _radial(area: InternalArea, window: tuple[int, int, int, int]) -> Candidates:
+    """The silhouette layout's candidates: every pixel's leader to the nearest boundary point.
 
     The EDT gives every inside pixel its nearest outside pixel ``q``; the endpoint of all
     pixels that share ``q`` is ``q`` moved half a pixel back along their mean direction,
-    i.e. onto the boundary of ``A_I``.
+    i.e. onto the boundary of ``A_I`` (:func:`._kernels.radial_image`, straight into the
+    image's arrays).
     """
-    hp, wp = mask.shape
-    inside, ri, ci = _nearest_outside(mask)
-    key, ex, ey, length = boundary_endpoints(
-        inside,
-        ri * wp + ci,
-        ci + X[0, 0],
-        ri + Y[0, 0],
-        np.ascontiguousarray(X.ravel()[inside]),
-        np.ascontiguousarray(Y.ravel()[inside]),
-        hp * wp,
-    )
-    return length.reshape(hp, wp), ex.reshape(hp, wp), ey.reshape(hp, wp), key
+    r0, r1, c0, c1 = window
+    p = area.pad
+    hp, wp = area.mask.shape
+    # the window is the bounding box of A_I plus a pixel: every inside pixel's nearest
+    # outside pixel lies in it
+    mask = area.mask[r0:r1, c0:c1]
+    ri, ci = ndimage.distance_transform_edt(mask, return_distances=False, return_indices=True)
+    ex, ey, length, eid, endpoints, d_max = radial_image(mask, ri, ci, r0 - p, c0 - p, hp - 2 * p, wp - 2 * p)
+    side = np.where(eid >= 0, np.int8(RADIAL), np.int8(-1))
+    d_max = float(d_max) if np.isfinite(d_max) else 1.0
+    return Candidates(ex, ey, length, side, eid, endpoints, max(d_max, _MIN_D_MAX))
 
 
 #: floor of ``d_max`` (pixels), which divides the leader lengths in ``f2``
@@ -163,7 +140,7 @@ def _shortest(
     prefer: np.ndarray | None = None,
     keep: float = 1.0,
 ) -> tuple:
-    """Find the shortest leader over ``sides`` for each pixel of the window.
+    """Find the shortest leader over ``sides`` (west, east, north, south) for each pixel of the window.
 
     Returns its length, endpoint, endpoint key on the padded grid and side code; the first
     side listed wins ties.  A pixel whose ``prefer`` (window-sized side codes, -1: none)
@@ -217,13 +194,8 @@ def _shortest(
                 offer(code, right - X, right, Y, hp + R)
             elif code == NORTH:
                 offer(code, Y - top, X, top, 2 * hp + C)
-            elif code == SOUTH:
-                offer(code, bottom - Y, X, bottom, 2 * hp + wp + C)
             else:
-                length, bx, by, k = _radial(mask, X, Y)
-                # the EDT ran on the box: back to the padded grid's pixel indices
-                k = (k // wb + r0) * wp + k % wb + c0
-                offer(code, length, bx, by, 2 * hp + 2 * wp + k.reshape(hb, wb))
+                offer(code, bottom - Y, X, bottom, 2 * hp + wp + C)
     if prefer is not None and len(sides) > 1:
         shortest = best.copy()
         for code, length, bx, by, k in offers:
@@ -280,6 +252,8 @@ def leader_candidates(
     p = area.pad
     # work on the bounding box of A_I only (plus a pixel); keys keep the padded grid's indices
     r0, r1, c0, c1 = window = _window(area.mask)
+    if sides == (RADIAL,):
+        return _radial(area, window)
     pref = None
     if prefer is not None:
         padded = np.full((hp, wp), -1, np.int8)

@@ -209,8 +209,9 @@ class LiveLabeler:
         center, diameter = projected_sphere(self.soup, camera, w, h)
         return IdBuffer(
             ids=ids,
-            face=np.full(ids.shape, -1, np.int64),
-            depth=np.full(ids.shape, np.inf),
+            # unknown here; read-only views, not buffers of the image's size
+            face=np.broadcast_to(np.int64(-1), ids.shape),
+            depth=np.broadcast_to(np.inf, ids.shape),
             image=np.zeros((1, 1, 3), np.uint8),
             camera=camera,
             areas=np.bincount(ids[ids >= 0], minlength=n).astype(np.int64),

@@ -27,9 +27,10 @@ from __future__ import annotations
 from dataclasses import asdict, dataclass
 
 import numpy as np
-from scipy import ndimage
 
 from meshvis.errors import ParameterError
+
+from ._kernels import own_silhouette_distance
 
 
 @dataclass(frozen=True)
@@ -129,11 +130,5 @@ def silhouette_distance(ids: np.ndarray) -> np.ndarray:
         return dist
     # work on the model's bounding box only: background pixels are silhouette anyway
     r0, r1, c0, c1 = rows[0], rows[-1] + 1, cols[0], cols[-1] + 1
-    crop = ids[r0:r1, c0:c1]
-    pad = np.pad(crop, 1, constant_values=np.iinfo(np.int64).min)
-    c = pad[1:-1, 1:-1]
-    edge = (c != pad[:-2, 1:-1]) | (c != pad[2:, 1:-1]) | (c != pad[1:-1, :-2]) | (c != pad[1:-1, 2:])
-    d = ndimage.distance_transform_edt(~edge) + 1.0
-    d[crop < 0] = 0.0
-    dist[r0:r1, c0:c1] = d
+    dist[r0:r1, c0:c1] = own_silhouette_distance(np.ascontiguousarray(ids[r0:r1, c0:c1], np.int64))
     return dist

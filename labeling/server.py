@@ -193,6 +193,9 @@ class ViewServer:
         class Handler(BaseHTTPRequestHandler):
             # keep-alive: the page's frames reuse one connection
             protocol_version = "HTTP/1.1"
+            # the headers and the body of an answer go out as two writes: with Nagle's
+            # algorithm the body waits for the client's delayed ACK of the headers (40 ms)
+            disable_nagle_algorithm = True
 
             def log_message(self, format: str, *args: Any) -> None:  # noqa: A002 - the base class's name
                 if server.verbose:

@@ -20,7 +20,7 @@ def _placed_arrays(ctx: Context, exclude: int) -> tuple[np.ndarray, np.ndarray]:
     The arrays of all placed labels are built once per change of the placements (the
     searches of one label ask several times, with the label itself left out).
     """
-    key = tuple(id(p) for p in ctx.placed)
+    key = tuple(map(id, ctx.placed))
     if ctx._cache is None or ctx._cache[0] != key:
         ids = [i for i, p in enumerate(ctx.placed) if p is not None]
         segs = [ctx.placed[i].segments for i in ids]

@@ -178,12 +178,15 @@ class Context:
 
     def future_rays(self, k: int) -> np.ndarray:
         """Rays (m, 2, 2) of the radial labels not placed yet (other than k)."""
-        js = np.array([j for j in self.future if j != k], np.int64)
+        js = np.fromiter((j for j in self.future if j != k), np.int64)
         if len(js) == 0:
             return np.zeros((0, 2, 2))
         self.ray_direction(0)
         e = self.endpoints[js]
-        return np.stack([e, e + self.ray_length * self._rays[js]], axis=1)
+        out = np.empty((len(js), 2, 2))
+        out[:, 0] = e
+        out[:, 1] = e + self.ray_length * self._rays[js]
+        return out
 
     @property
     def reach(self) -> float:
@@ -202,8 +205,11 @@ class Context:
 
     def future_insides(self, k: int) -> np.ndarray:
         """Inside parts (m, 2, 2), anchor to endpoint, of the radial labels not placed yet (other than k)."""
-        js = np.array([j for j in self.future if j != k], np.int64)
-        return np.stack([self.anchors[js], self.endpoints[js]], axis=1).reshape(-1, 2, 2)
+        js = np.fromiter((j for j in self.future if j != k), np.int64)
+        out = np.empty((len(js), 2, 2))
+        out[:, 0] = self.anchors[js]
+        out[:, 1] = self.endpoints[js]
+        return out
 
     @property
     def boundary(self) -> tuple[np.ndarray, np.ndarray]:

@@ -375,6 +375,10 @@ def _place_ring(ctx: Context, idx: np.ndarray) -> None:
     plain = [int(k) for k in ring]
     orders = [_run_order(ctx, ring), plain]
     shifted = ctx.stats.shifted
+
+    def score(placements: list, unplaced: list) -> tuple[int, float]:
+        return len(unplaced), sum(polyline_length(p.leader) for p in placements if p)
+
     best = None
     for order in orders[:1] if orders[0] == plain else orders:
         if best is not None:  # start the second order from the same state as the first
@@ -382,12 +386,13 @@ def _place_ring(ctx: Context, idx: np.ndarray) -> None:
             for k in plain:
                 ctx.placed[k] = None
         unplaced = _place_in_order(ctx, order)
-        score = (len(unplaced), sum(polyline_length(ctx.placed[k].leader) for k in plain if ctx.placed[k]))
-        if best is None or score < best[0]:  # ties keep the first order
-            best = (score, [ctx.placed[k] for k in plain], ctx.stats.shifted, unplaced)
+        found = ([ctx.placed[k] for k in plain], ctx.stats.shifted, unplaced)
+        # ties keep the first order (the scores are measured only when two orders compete)
+        if best is None or score(found[0], found[2]) < score(best[0], best[2]):
+            best = found
         if not unplaced:
             break
-    _, placements, ctx.stats.shifted, unplaced = best
+    placements, ctx.stats.shifted, unplaced = best
     for k, p in zip(plain, placements):
         ctx.placed[k] = p
     ctx.stats.unplaced.extend(unplaced)

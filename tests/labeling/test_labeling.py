@@ -296,6 +296,58 @@ def test_silhouette_distance_matches_brute_force():
     assert d[ids < 0].max() == 0
 
 
+@pytest.mark.parametrize("shape", [(1, 1), (1, 9), (9, 1), (23, 31), (40, 17)])
+def test_silhouette_distance_is_the_exact_edt_of_the_silhouette_pixels(shape):
+    from scipy import ndimage
+
+    rng = np.random.default_rng(sum(shape))
+    for trial in range(6):
+        ids = rng.integers(-1, 3, shape)
+        if trial % 2:  # blobs rather than noise: long distances
+            ids = ndimage.median_filter(ids, 3)
+        ids[0, 0] = 0  # the crop is the whole grid
+        ids[-1, -1] = 1
+        pad = np.pad(ids, 1, constant_values=-9)
+        c = pad[1:-1, 1:-1]
+        edge = (c != pad[:-2, 1:-1]) | (c != pad[2:, 1:-1]) | (c != pad[1:-1, :-2]) | (c != pad[1:-1, 2:])
+        want = np.where(ids >= 0, ndimage.distance_transform_edt(~edge) + 1.0, 0.0)
+        assert np.array_equal(membership.silhouette_distance(ids), want)
+
+
+def test_silhouette_candidates_end_half_a_pixel_before_the_nearest_outside_pixel():
+    from scipy import ndimage
+
+    mask = np.zeros((50, 70), bool)
+    mask[12:37, 10:58] = True
+    mask[20:30, 60:64] = True
+    ia = internal_area(mask, "hull", margin=3.0)
+    c = leader_candidates(ia, "silhouette")
+    # reference: the EDT's nearest outside pixel q of every inside pixel of the padded
+    # grid, the mean unit direction of the pixels sharing q, the endpoint half a pixel before q
+    p = ia.pad
+    inside = np.flatnonzero(ia.mask.ravel())
+    ri, ci = ndimage.distance_transform_edt(ia.mask, return_distances=False, return_indices=True)
+    r, col = np.divmod(inside, ia.mask.shape[1])
+    qr, qc = ri.ravel()[inside], ci.ravel()[inside]
+    d = np.column_stack([qc - col, qr - r]).astype(float)
+    u = d / np.hypot(d[:, 0], d[:, 1])[:, None]
+    key = qr * ia.mask.shape[1] + qc
+    mean = np.column_stack([np.bincount(key, u[:, 0]), np.bincount(key, u[:, 1])])[key]
+    mean /= np.hypot(mean[:, 0], mean[:, 1])[:, None]
+    end = np.column_stack([qc, qr]) + 0.5 - p - 0.5 * mean
+    on = (r >= p) & (r < p + 50) & (col >= p) & (col < p + 70)
+    rr, cc = r[on] - p, col[on] - p
+    assert np.array_equal(np.flatnonzero(c.eid.ravel() >= 0), np.sort(rr * 70 + cc))
+    assert np.allclose(np.column_stack([c.ex[rr, cc], c.ey[rr, cc]]), end[on])
+    assert np.allclose(c.length[rr, cc], np.hypot(*(end[on] - np.column_stack([cc, rr]) - 0.5).T))
+    assert np.array_equal(c.endpoints[c.eid[rr, cc]], np.column_stack([c.ex[rr, cc], c.ey[rr, cc]]))
+    # endpoint ids number the outside pixels in row-major order
+    first = np.unique(key[on], return_inverse=True)[1]
+    assert np.array_equal(c.eid[rr, cc], first)
+    assert (c.side[c.eid >= 0] == RADIAL).all() and (c.side[c.eid < 0] == -1).all()
+    assert np.isclose(c.d_max, np.hypot(*(end - np.column_stack([col, r]) + p - 0.5).T).max())
+
+
 def test_membership_formulas():
     assert np.allclose(membership.f2_length(np.array([0.0, 5.0, 10.0]), 10.0), [1.0, 0.5, 0.0])  # Eq. 2
     assert np.allclose(membership.f3_salience(np.array([2.0, 20.0]), 10.0), [0.2, 1.0])  # Eq. 3 (clipped)

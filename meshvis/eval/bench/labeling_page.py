@@ -51,6 +51,36 @@ def _overlaps(layout: dict) -> int:
     return int(np.triu(hit, 1).sum())
 
 
+def _cpu_seconds(pids: list[int]) -> float:
+    """User + system CPU seconds used so far by the processes ``pids`` (those gone count 0)."""
+    tick = os.sysconf("SC_CLK_TCK")
+    total = 0
+    for pid in pids:
+        try:
+            with open(f"/proc/{pid}/stat") as fh:
+                fields = fh.read().rsplit(")", 1)[1].split()
+        except OSError:
+            continue
+        total += int(fields[11]) + int(fields[12])  # utime, stime (fields 14, 15 of stat)
+    return total / tick
+
+
+def _browser_pids(profile: str) -> list[int]:
+    """The processes of the browser started with the profile folder ``profile``."""
+    pids = []
+    for entry in os.listdir("/proc"):
+        if not entry.isdigit():
+            continue
+        try:
+            with open(f"/proc/{entry}/cmdline", "rb") as fh:
+                cmdline = fh.read()
+        except OSError:
+            continue
+        if profile.encode() in cmdline:
+            pids.append(int(entry))
+    return pids
+
+
 def run(
     model: str,
     *,
@@ -85,7 +115,9 @@ def run(
         ``layouts`` received while turning, ``seconds``, ``per_second``, ``overlaps`` summed
         and ``layouts_with_overlap``, ``labels_mean``, the server's ``layout_ms`` and
         ``server_ms`` (median, max), the page's ``answer_ms`` (median: post to answer) and
-        ``ids_ms`` (median: GPU ID render and read-back), ``machine``.
+        ``ids_ms`` (median: GPU ID render and read-back), ``cpu_ms_per_layout`` (CPU
+        milliseconds of the server's and of the browser's processes while turning, per
+        layout received), ``machine``.
     """
     import tempfile
 
@@ -116,6 +148,8 @@ def run(
             page.wait_for_function("window.meshvisView && window.meshvisView.labels() > 0", timeout=180_000)
             page.wait_for_function("window.meshvisView.idle()", timeout=60_000)
             before = page.evaluate("window.meshvisView.stats.received.length")
+            browser_pids = _browser_pids(profile or tmp)
+            cpu0 = (_cpu_seconds([proc.pid]), _cpu_seconds(browser_pids))
             start = time.perf_counter()
             n = 0
             while time.perf_counter() - start < seconds:
@@ -123,6 +157,7 @@ def run(
                 page.wait_for_timeout(interval)
                 n += 1
             elapsed = time.perf_counter() - start
+            cpu1 = (_cpu_seconds([proc.pid]), _cpu_seconds(browser_pids))
             got = page.evaluate(f"window.meshvisView.stats.received.slice({before})")
             timing = page.evaluate("window.meshvisView.stats.timing")
             for _ in range(gif_frames if gif else 0):
@@ -155,6 +190,12 @@ def run(
         "server_ms": _stats([t["server"] for t in recent]),
         "answer_ms": _stats([t["answer"] for t in recent]),
         "ids_ms": _stats([t["ids"] for t in recent]),
+        # CPU spent while turning, per layout received: the server's and the browser's
+        # processes (all of them: page, renderer, SwiftShader), a load-independent cost
+        "cpu_ms_per_layout": [
+            1000.0 * (cpu1[0] - cpu0[0]) / max(len(got), 1),
+            1000.0 * (cpu1[1] - cpu0[1]) / max(len(got), 1),
+        ],
         "machine": where,
         "load_after": [round(x, 2) for x in os.getloadavg()],
     }
@@ -206,6 +247,7 @@ def format(result: dict[str, Any]) -> str:  # noqa: A001 - the bench modules' co
             f"server frame ms       median {r['server_ms'][0]:.1f}, max {r['server_ms'][1]:.1f} (decode + layout + JSON)",
             f"page post->answer ms  median {r['answer_ms'][0]:.1f}, max {r['answer_ms'][1]:.1f}",
             f"page ID render+read   median {r['ids_ms'][0]:.1f} ms",
+            f"CPU ms per layout     server {r['cpu_ms_per_layout'][0]:.1f}, browser {r['cpu_ms_per_layout'][1]:.1f}",
         ]
     )
 
