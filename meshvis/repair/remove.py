@@ -337,8 +337,7 @@ def remove_interior(
     by_rays = (check_rays or rescue_rays) and not _is_cells(region)  # cells: judged by meshvis bench pvs
     bound = parse_region(region, up=up).bind(soup) if by_rays else None
     if bound is not None and rescue_rays and visibility in ("view", "both"):
-        cap = None if vis is None else int(RESCUE_SHARE * vis.rays["total"])
-        rescue = rescue_pass(caster, bound, ~keep, keep, rays=rescue_rays, seed=seed, budget=cap)
+        rescue = rescue_pass(caster, bound, ~keep, keep, rays=rescue_rays, seed=seed, search=vis)
         code[rescue.seen] = _KEPT_RESCUE
         keep = keep | rescue.seen
     keep = _widen(soup, keep, code, level, int(keep_border))
