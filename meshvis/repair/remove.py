@@ -26,8 +26,9 @@ A removal by sight (``"view"``, ``"both"``) ends with a rescue pass
 (:func:`meshvis.visibility.check.rescue_pass`): random rays from every face it is about to
 remove, to random viewers of the region, ``rescue_rays`` of them from each face next to a
 seen or rescued face and :data:`~meshvis.visibility.check.RESCUE_FIRST_RAYS` from the
-others; a face one of them sees from is kept, and the neighbours of a rescued face are
-also tried along its line of sight.  The search stops once new views have become rare,
+others, and a few along the search's line of sight to each seen neighbour; a face one of
+them sees from is kept, and the neighbours of a rescued face are also tried along its line
+of sight.  The search stops once new views have become rare,
 and a small face seen through a narrow gap can be one it never aimed at often enough; the
 rescue gives every such face rays of its own.  Every removal then ends with a self-check: ``check_rays`` fresh random
 rays from every removed face, from another stream than the rescue's; the report says how
