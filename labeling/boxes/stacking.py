@@ -153,6 +153,29 @@ def _flag_split(ctx: Context, idx: np.ndarray, port_x: np.ndarray) -> np.ndarray
     return left
 
 
+#: along a camera path a row's port follows its anchor from last frame's place and creeps
+#: towards its candidate endpoint by at most this many pixels a frame
+PORT_CREEP = 2.0
+
+
+def _glided_ports(ctx: Context, idx: np.ndarray, side: int, desired: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Where the ports of a row would like to be along a camera path.
+
+    A label that was on this side last frame starts from its port moved with its anchor
+    (the row glides with the surface) and creeps towards its candidate endpoint by at most
+    :data:`PORT_CREEP` pixels; the others start from their endpoints.
+    """
+    out = np.array(desired, np.float64)
+    glided = False
+    for j, k in enumerate(idx):
+        lead = ctx.leaders[k]
+        if np.isfinite(ctx.previous[k, side]) and lead is not None and len(lead):
+            port = float(lead[0][0])
+            out[j] = port + float(np.clip(out[j] - port, -PORT_CREEP, PORT_CREEP))
+            glided = True
+    return out, glided
+
+
 def _place_row(ctx: Context, idx: np.ndarray, side: int) -> None:
     """Spread the ports of one north/south side (shift, swap), then stack flag boxes in tiers."""
     if len(idx) == 0:
@@ -162,6 +185,9 @@ def _place_row(ctx: Context, idx: np.ndarray, side: int) -> None:
     # spacing means fewer tiers, at the price of more slanted leaders
     fair = (ctx.W - 2 * ctx.sp.clearance) / len(idx)
     gap = float(np.clip(fair, ctx.sp.port_gap, ctx.widths[idx].mean() + ctx.sp.gap))
+    desired, glided = _glided_ports(ctx, idx, side, desired)
+    if glided:
+        gap = ctx.sp.port_gap
     order = coherent_order(desired, ctx.previous[idx, side], gap)
     idx, desired = idx[order], desired[order]
     xs = pack_1d(desired, np.zeros(len(idx)), gap, 0.0, ctx.W)
