@@ -146,6 +146,9 @@ class _Previous:
     leader : n polylines (k, 2) (None: absent), the leader without its anchor point
     lines : (4,) float, the x of the west and east columns, the y of the north and south
         rows (NaN: no label there); not moved
+    motion : (n,) float, how far the surface under the previous anchor moved on the screen
+        (pixels; NaN: absent)
+    left_out : (n,) bool, the label was left out for lack of room
     """
 
     anchor: np.ndarray
@@ -155,6 +158,8 @@ class _Previous:
     centre: np.ndarray
     lines: np.ndarray
     leader: list
+    motion: np.ndarray
+    left_out: np.ndarray
 
 
 def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n: int) -> _Previous:
@@ -164,6 +169,11 @@ def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n
     centre = np.full((n, 2), np.nan)
     leader: list = [None] * n
     lines = np.full(4, np.nan)
+    motion = np.full(n, np.nan)
+    left_out = np.zeros(n, bool)
+    for p, _ in previous.unplaced:
+        if p < len(slot) and slot[p] >= 0:
+            left_out[slot[p]] = True
     for lab in previous.labels:
         code = SIDE_NAMES.index(lab.side)
         if code < 4 and lab.tier == 0:
@@ -173,13 +183,14 @@ def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n
             )
     labs = [lab for lab in previous.labels if lab.part < len(slot) and slot[lab.part] >= 0]
     if not labs:
-        return _Previous(anchor, endpoint, box, side, centre, lines, leader)
+        return _Previous(anchor, endpoint, box, side, centre, lines, leader, motion, left_out)
     h, w = idbuf.shape
     moved, _ = idbuf.camera.project(np.array([lab.anchor_3d for lab in labs], np.float64), w, h)
     for lab, now in zip(labs, moved):
         s = slot[lab.part]
         delta = now - lab.anchor if np.all(np.isfinite(now)) else np.zeros(2)
         anchor[s], endpoint[s] = lab.anchor + delta, lab.endpoint + delta
+        motion[s] = float(np.hypot(*delta))
         code = SIDE_NAMES.index(lab.side)
         side[s] = code
         centre[s] = 0.5 * (lab.box[:2] + lab.box[2:]) + delta
@@ -187,7 +198,7 @@ def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n
         if code < 4:
             axis = 1 if code < 2 else 0
             box[s, code] = 0.5 * (lab.box[axis] + lab.box[axis + 2]) + delta[axis]
-    return _Previous(anchor, endpoint, box, side, centre, lines, leader)
+    return _Previous(anchor, endpoint, box, side, centre, lines, leader, motion, left_out)
 
 
 def _preferred_sides(idbuf: IdBuffer, labelled: np.ndarray, prev: _Previous | None) -> np.ndarray | None:
@@ -480,6 +491,8 @@ def _place_labels(
         centres=None if previous is None else previous.centre,
         leaders=None if previous is None else previous.leader,
         lines=None if previous is None else previous.lines,
+        motion=None if previous is None else previous.motion,
+        left_out=None if previous is None else previous.left_out,
     )
     return rank, anchors, endpoints, placements, stats
 
