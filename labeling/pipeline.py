@@ -116,6 +116,9 @@ def _fit_font(
 #: surface) unless a candidate is more than ANCHOR_KEEP times as feasible, and keeps its
 #: side unless the other side's leader is shorter by more than the factor SIDE_KEEP
 ANCHOR_KEEP = 4.0
+#: the same for the top and bottom rows, whose ports follow their anchors from frame to
+#: frame: an anchor that jumps across its part drags its leader and box along
+ANCHOR_KEEP_ROWS = 30.0
 SIDE_KEEP = 5.0
 #: side changes come together: in a frame where some label changes side, every label
 #: whose other side is shorter by more than this factor changes too.  A viewer sees one
@@ -381,6 +384,7 @@ def _fuzzy_picks(
     de_px: float,
     clock: _Stopwatch,
     t: float,
+    keep: float = ANCHOR_KEEP,
 ) -> tuple[tuple[np.ndarray, ...], float]:
     """Compute the memberships and run the greedy loop.
 
@@ -411,7 +415,7 @@ def _fuzzy_picks(
         weights.w5,
         follow=follow,
         drift=max(ANCHOR_DRIFT * d_s, ANCHOR_DRIFT_PX),
-        keep=ANCHOR_KEEP,
+        keep=keep,
     )
     t = clock.tick("greedy", t)
     return (g.area_order, g.pick, g.feasibility, g.priority), t
@@ -754,13 +758,14 @@ def solve(
     de_px = _endpoint_threshold(d_e, d_s, style, widths, layout, spacing)
     da_px = d_a * d_s
     if method == "fuzzy":
-        order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t)
+        keep = ANCHOR_KEEP if is_horizontal(layout) or layout == "silhouette" else ANCHOR_KEEP_ROWS
+        order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t, keep)
         if prev is not None and len(LAYOUTS[layout]) > 1 and _changes_side(px, order, prev):
             # batch the side changes: the other labels that are nearer their other side go too
             cand = leader_candidates(ia, layout, prefer, SIDE_BATCH)
             t = clock.tick("candidates", t)
             px = _pixels(idbuf, cand, dist_sil, labelled, len(names))
-            order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t)
+            order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t, keep)
     else:
         order, t = _two_step_picks(px, len(labelled), clock, t)
     label_texts_ = [texts[p] for p in labelled]
