@@ -119,7 +119,7 @@ ANCHOR_KEEP = 4.0
 #: the same for the top and bottom rows, whose ports follow their anchors from frame to
 #: frame: an anchor that jumps across its part drags its leader and box along
 ANCHOR_KEEP_ROWS = 30.0
-SIDE_KEEP = 5.0
+SIDE_KEEP = 20.0
 #: side changes come together: in a frame where some label changes side, every label
 #: whose other side is shorter by more than this factor changes too.  A viewer sees one
 #: rearrangement instead of one label after another over the next frames
