@@ -374,28 +374,32 @@ def _keep_previous(ctx: Context, idx: np.ndarray, leaders: list | None = None) -
     kept: list[int] = []
     paths = _expected_paths(ctx, idx, leaders)
     for k in sorted(known, key=lambda k: (ctx.rank[k], k)):
-        half = np.array([ctx.widths[k] / 2, ctx.height / 2])
-        offsets = _nudges(ctx, ctx.centres[k])
-        centres = ctx.centres[k] + offsets
-        boxes = np.concatenate([centres - half, centres + half], axis=1)
-        pboxes, psegs = _placed_arrays(ctx, k)
-        ok = ~_outside_image(ctx, boxes)
-        live = np.flatnonzero(ok)
-        ok[live] = _boxes_free(ctx, boxes[live], pboxes, psegs)
         others = [p for j, p in zip(idx, paths) if j != k and ctx.placed[j] is None]
         others = np.concatenate(others) if others else None
         before = None if leaders is None else leaders[k]
-        for m in np.flatnonzero(ok)[:NUDGE_TRIES]:
-            found = False
-            for leader in _kept_leaders(ctx, k, centres[m], half, before, offsets[m]):
-                if _leaders_free(leader[None], pboxes, psegs, others)[0]:
-                    _place(ctx, k, leader, boxes[m], 0, float(np.hypot(*(leader[1] - ctx.endpoints[k]))))
-                    kept.append(k)
-                    found = True
-                    break
-            if found:
-                break
+        # where it was first; the nudged places only when that fails (the usual case is cheap)
+        if _keep_at(ctx, k, np.zeros((1, 2)), before, others) or _keep_at(
+            ctx, k, _nudges(ctx, ctx.centres[k])[1:], before, others
+        ):
+            kept.append(k)
     return kept
+
+
+def _keep_at(ctx: Context, k: int, offsets: np.ndarray, before: np.ndarray | None, others) -> bool:
+    """Place label k at the first valid one of its moved box shifted by ``offsets`` (nearest first)."""
+    half = np.array([ctx.widths[k] / 2, ctx.height / 2])
+    centres = ctx.centres[k] + offsets
+    boxes = np.concatenate([centres - half, centres + half], axis=1)
+    pboxes, psegs = _placed_arrays(ctx, k)
+    ok = ~_outside_image(ctx, boxes)
+    live = np.flatnonzero(ok)
+    ok[live] = _boxes_free(ctx, boxes[live], pboxes, psegs)
+    for m in np.flatnonzero(ok)[:NUDGE_TRIES]:
+        for leader in _kept_leaders(ctx, k, centres[m], half, before, offsets[m]):
+            if _leaders_free(leader[None], pboxes, psegs, others)[0]:
+                _place(ctx, k, leader, boxes[m], 0, float(np.hypot(*(leader[1] - ctx.endpoints[k]))))
+                return True
+    return False
 
 
 def _place_in_order(ctx: Context, order: list[int]) -> list[int]:
