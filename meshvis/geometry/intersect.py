@@ -230,14 +230,22 @@ class _BroadPhase:
         # finest cell: the median box size (at least 2**-20 of the whole: 21-bit keys)
         h0 = max(H0_FACTOR * float(np.median((hi - lo).max(axis=1))), size * 2.0**-20)
         level = _levels(lo, hi, h0, size)
-        grids = {}
-        for L in np.unique(level):
-            grids[L] = _Grid(lo, hi, np.flatnonzero(level == L), h0 * 2.0**L, size, low)
-            self.jobs.append(grids[L].within(hi))
-        for L in list(grids)[1:]:
-            job = grids[L].from_finer(lo, hi, np.flatnonzero(level < L))
-            if job is not None:
-                self.jobs.append(job)
+        levels = [int(L) for L in np.unique(level)]
+        # the levels are independent (each writes the lower cells of its own boxes): both
+        # steps run a level per thread, mostly in compiled kernels that release the GIL
+        threads = pool(default_threads()) if len(levels) > 1 else None
+        each: Callable = map if threads is None else threads.map
+
+        def grid(L: int) -> tuple[_Grid, _Job]:
+            g = _Grid(lo, hi, np.flatnonzero(level == L), h0 * 2.0**L, size, low)
+            return g, g.within(hi)
+
+        grids, within = zip(*each(grid, levels))
+        self.jobs += within
+        finer = each(
+            lambda k: grids[k].from_finer(lo, hi, np.flatnonzero(level < levels[k])), range(1, len(grids))
+        )
+        self.jobs += [job for job in finer if job is not None]
 
     @property
     def candidates(self) -> int:

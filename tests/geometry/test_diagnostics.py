@@ -261,4 +261,5 @@ def test_diagnose_advances_a_progress_bar_through_every_step():
     fractions = [f for _, f in seen]
     assert fractions[0] == 0.0 and fractions[-1] == 1.0
     assert fractions == sorted(fractions)
-    assert len(set(fractions)) >= 6  # weld, edges, degenerate, duplicates, broad and narrow phase
+    # weld, degenerate, duplicates, the intersection tests (the edges are built alongside)
+    assert len(set(fractions)) >= 5
