@@ -418,9 +418,12 @@ def broad_pairs(first, starts, counts, ent, key, cell_rows, cell, lo, hi, bits, 
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def sweep_order(key, x):
-    """Order of grid entries by cell ``key``, then by ``x``, then by position (a stable lexsort)."""
-    order = np.argsort(key, kind="mergesort")
+def sweep_order(key, x, by_key):
+    """Order of grid entries by cell ``key``, then by ``x``, then by position (a stable lexsort).
+
+    ``by_key`` is the stable order of the keys alone (modified in place and returned).
+    """
+    order = by_key
     n = key.shape[0]
     s = 0
     while s < n:

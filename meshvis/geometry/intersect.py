@@ -92,7 +92,7 @@ from meshvis.errors import ModelError, ParameterError
 from meshvis.geometry import _vectorised
 from meshvis.geometry._kernel_constants import COPLANAR, INTERSECTS, TOO_CLOSE
 from meshvis.geometry._vectorised import compiled, kernels
-from meshvis.geometry.adjacency import WELD_TOL, weld
+from meshvis.geometry.adjacency import WELD_TOL, stable_order, weld
 
 #: default distance tolerance, as a fraction of the bounding-box diagonal
 EPS = 1e-6
@@ -231,20 +231,19 @@ class _BroadPhase:
         h0 = max(H0_FACTOR * float(np.median((hi - lo).max(axis=1))), size * 2.0**-20)
         level = _levels(lo, hi, h0, size)
         levels = [int(L) for L in np.unique(level)]
-        # the levels are independent (each writes the lower cells of its own boxes): both
-        # steps run a level per thread, mostly in compiled kernels that release the GIL
+        # the levels are independent (each writes the lower cells of its own boxes, and
+        # the finer boxes find their cells on a level by themselves): a level per thread,
+        # mostly in compiled kernels that release the GIL
         threads = pool(default_threads()) if len(levels) > 1 else None
         each: Callable = map if threads is None else threads.map
 
-        def grid(L: int) -> tuple[_Grid, _Job]:
-            g = _Grid(lo, hi, np.flatnonzero(level == L), h0 * 2.0**L, size, low)
-            return g, g.within(hi)
+        def jobs(L: int) -> tuple[_Job, _Job | None]:
+            grid = _Grid(lo, hi, np.flatnonzero(level == L), h0 * 2.0**L, size, low)
+            finer = grid.from_finer(lo, hi, np.flatnonzero(level < L)) if levels[0] < L else None
+            return grid.within(hi), finer
 
-        grids, within = zip(*each(grid, levels))
+        within, finer = zip(*each(jobs, levels))
         self.jobs += within
-        finer = each(
-            lambda k: grids[k].from_finer(lo, hi, np.flatnonzero(level < levels[k])), range(1, len(grids))
-        )
         self.jobs += [job for job in finer if job is not None]
 
     @property
@@ -264,6 +263,29 @@ def _levels(lo: np.ndarray, hi: np.ndarray, h0: float, size: float) -> np.ndarra
     return grid_levels(lo, hi, float(h0), top, float(MAX_CELLS))
 
 
+def _stable_key_order(key: np.ndarray) -> np.ndarray:
+    """``np.argsort(key, kind="stable")`` of packed cell keys, through a plain sort where it can.
+
+    The keys are renumbered densely over the cells the level spans (the same order) so that
+    :func:`meshvis.geometry.adjacency.stable_order` can add the positions to them and sort
+    values: about 3x faster than a stable argsort of 4 M keys.
+    """
+    if len(key) == 0:
+        return np.zeros(0, np.int64)
+    mask = np.int64((1 << _BITS) - 1)
+    cells = [key >> (2 * _BITS), (key >> _BITS) & mask, key & mask]
+    dense = np.zeros(len(key), np.int64)
+    bound = 1
+    for c in cells:
+        c0, c1 = int(c.min()), int(c.max())
+        if bound * (c1 - c0 + 1) * len(key) >= 2**62:
+            return np.argsort(key, kind="stable")
+        dense *= c1 - c0 + 1
+        dense += c - c0
+        bound *= c1 - c0 + 1
+    return stable_order(dense, bound)
+
+
 class _Grid:
     """The boxes of one level in their cells, sorted for a sweep along x within each cell.
 
@@ -280,7 +302,7 @@ class _Grid:
         del c0
         ent = boxes[owner]
         del owner
-        order = sweep_order(key, lo[ent, 0])
+        order = sweep_order(key, lo[ent, 0], _stable_key_order(key))
         self.key, self.ent = key[order], ent[order]
         del key, ent, order
         self.h, self.xs = h, 0.5 / size
