@@ -707,13 +707,13 @@ def _flagged_pairs(
         job, sl = item
         return kernel(*job.rows(sl), *bounds, _BITS, n, *test.faces, *test.tolerances)
 
+    # every chunk queued at once (no wait for the slowest of a batch); their results are
+    # small (the flagged pairs) and come back in order
+    workers = pool(default_threads()) if len(work) > 1 else None
     out = []
-    step = 4 * default_threads()
-    for s in range(0, len(work), step):
-        part = work[s : s + step]
-        workers = pool(default_threads()) if len(part) > 1 else None
-        out += list(workers.map(run, part)) if workers is not None else [run(w) for w in part]
-        report(0.1 + 0.9 * min(s + step, len(work)) / len(work))
+    for done, result in enumerate(workers.map(run, work) if workers is not None else map(run, work)):
+        out.append(result)
+        report(0.1 + 0.9 * (done + 1) / len(work))
     del broad, work
     keys = np.concatenate([k for k, _ in out]) if out else np.zeros(0, np.int64)
     codes = np.concatenate([c for _, c in out]) if out else np.zeros(0, np.uint8)
