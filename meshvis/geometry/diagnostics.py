@@ -13,12 +13,13 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
-from concurrent.futures import ThreadPoolExecutor
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from meshvis._threads import default_threads
 from meshvis.geometry import adjacency, duplicates, intersect
 from meshvis.io import as_soup
 from meshvis.soup import Soup
@@ -126,9 +127,10 @@ def analyse(
     lap("weld", 0.15)
     # the edges need only the welded faces: they are built in a thread of their own while
     # the rest runs (numpy's sorts release the GIL), so that the second core has work
-    # during the single-threaded steps of the intersection tests
+    # during the single-threaded steps of the intersection tests (in this thread when
+    # meshvis may use one core, as in the workers of ``meshvis batch``)
     seconds["edges"] = 0.0
-    with ThreadPoolExecutor(1, "meshvis-edges") as side:
+    with ThreadPoolExecutor(1, "meshvis-edges") if default_threads() > 1 else _Inline() as side:
         edges = side.submit(_timed, adjacency.edges, fw)
         collapsed = adjacency.collapsed(fw)
         degenerate = adjacency.degenerate_faces(v, f, tol=DEGENERATE_TOL, zero_area=True)
@@ -149,6 +151,21 @@ def analyse(
         table, seconds["edges"] = edges.result()
     report("analyse", 1.0)
     return Analysis(fw, table, degenerate, collapsed, first, flags, seconds)
+
+
+class _Inline:
+    """An executor that runs the work when it is submitted (one thread)."""
+
+    def __enter__(self) -> _Inline:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def submit(self, work: Callable[..., Any], *args: Any) -> Future:
+        done: Future = Future()
+        done.set_result(work(*args))
+        return done
 
 
 def _timed(work: Callable[..., Any], *args: Any) -> tuple[Any, float]:
