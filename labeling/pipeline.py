@@ -116,7 +116,10 @@ def _fit_font(
 #: surface) unless a candidate is more than ANCHOR_KEEP times as feasible, and keeps its
 #: side unless the other side's leader is shorter by more than the factor SIDE_KEEP
 ANCHOR_KEEP = 4.0
-SIDE_KEEP = 5.0
+#: the same for the top and bottom rows, whose ports follow their anchors from frame to
+#: frame: an anchor that jumps across its part drags its leader and box along
+ANCHOR_KEEP_ROWS = 30.0
+SIDE_KEEP = 20.0
 #: side changes come together: in a frame where some label changes side, every label
 #: whose other side is shorter by more than this factor changes too.  A viewer sees one
 #: rearrangement instead of one label after another over the next frames
@@ -146,6 +149,9 @@ class _Previous:
     leader : n polylines (k, 2) (None: absent), the leader without its anchor point
     lines : (4,) float, the x of the west and east columns, the y of the north and south
         rows (NaN: no label there); not moved
+    motion : (n,) float, how far the surface under the previous anchor moved on the screen
+        (pixels; NaN: absent)
+    left_out : (n,) bool, the label was left out for lack of room
     """
 
     anchor: np.ndarray
@@ -155,6 +161,8 @@ class _Previous:
     centre: np.ndarray
     lines: np.ndarray
     leader: list
+    motion: np.ndarray
+    left_out: np.ndarray
 
 
 def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n: int) -> _Previous:
@@ -164,6 +172,11 @@ def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n
     centre = np.full((n, 2), np.nan)
     leader: list = [None] * n
     lines = np.full(4, np.nan)
+    motion = np.full(n, np.nan)
+    left_out = np.zeros(n, bool)
+    for p, _ in previous.unplaced:
+        if p < len(slot) and slot[p] >= 0:
+            left_out[slot[p]] = True
     for lab in previous.labels:
         code = SIDE_NAMES.index(lab.side)
         if code < 4 and lab.tier == 0:
@@ -173,13 +186,14 @@ def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n
             )
     labs = [lab for lab in previous.labels if lab.part < len(slot) and slot[lab.part] >= 0]
     if not labs:
-        return _Previous(anchor, endpoint, box, side, centre, lines, leader)
+        return _Previous(anchor, endpoint, box, side, centre, lines, leader, motion, left_out)
     h, w = idbuf.shape
     moved, _ = idbuf.camera.project(np.array([lab.anchor_3d for lab in labs], np.float64), w, h)
     for lab, now in zip(labs, moved):
         s = slot[lab.part]
         delta = now - lab.anchor if np.all(np.isfinite(now)) else np.zeros(2)
         anchor[s], endpoint[s] = lab.anchor + delta, lab.endpoint + delta
+        motion[s] = float(np.hypot(*delta))
         code = SIDE_NAMES.index(lab.side)
         side[s] = code
         centre[s] = 0.5 * (lab.box[:2] + lab.box[2:]) + delta
@@ -187,7 +201,7 @@ def _previous_frame(previous: LayoutResult, idbuf: IdBuffer, slot: np.ndarray, n
         if code < 4:
             axis = 1 if code < 2 else 0
             box[s, code] = 0.5 * (lab.box[axis] + lab.box[axis + 2]) + delta[axis]
-    return _Previous(anchor, endpoint, box, side, centre, lines, leader)
+    return _Previous(anchor, endpoint, box, side, centre, lines, leader, motion, left_out)
 
 
 def _preferred_sides(idbuf: IdBuffer, labelled: np.ndarray, prev: _Previous | None) -> np.ndarray | None:
@@ -370,6 +384,7 @@ def _fuzzy_picks(
     de_px: float,
     clock: _Stopwatch,
     t: float,
+    keep: float = ANCHOR_KEEP,
 ) -> tuple[tuple[np.ndarray, ...], float]:
     """Compute the memberships and run the greedy loop.
 
@@ -400,7 +415,7 @@ def _fuzzy_picks(
         weights.w5,
         follow=follow,
         drift=max(ANCHOR_DRIFT * d_s, ANCHOR_DRIFT_PX),
-        keep=ANCHOR_KEEP,
+        keep=keep,
     )
     t = clock.tick("greedy", t)
     return (g.area_order, g.pick, g.feasibility, g.priority), t
@@ -480,6 +495,8 @@ def _place_labels(
         centres=None if previous is None else previous.centre,
         leaders=None if previous is None else previous.leader,
         lines=None if previous is None else previous.lines,
+        motion=None if previous is None else previous.motion,
+        left_out=None if previous is None else previous.left_out,
     )
     return rank, anchors, endpoints, placements, stats
 
@@ -741,13 +758,14 @@ def solve(
     de_px = _endpoint_threshold(d_e, d_s, style, widths, layout, spacing)
     da_px = d_a * d_s
     if method == "fuzzy":
-        order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t)
+        keep = ANCHOR_KEEP if is_horizontal(layout) or layout == "silhouette" else ANCHOR_KEEP_ROWS
+        order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t, keep)
         if prev is not None and len(LAYOUTS[layout]) > 1 and _changes_side(px, order, prev):
             # batch the side changes: the other labels that are nearer their other side go too
             cand = leader_candidates(ia, layout, prefer, SIDE_BATCH)
             t = clock.tick("candidates", t)
             px = _pixels(idbuf, cand, dist_sil, labelled, len(names))
-            order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t)
+            order, t = _fuzzy_picks(px, cand, weights, prev, len(labelled), d_s, da_px, de_px, clock, t, keep)
     else:
         order, t = _two_step_picks(px, len(labelled), clock, t)
     label_texts_ = [texts[p] for p in labelled]

@@ -59,6 +59,8 @@ class Context:
         centres=None,
         lines=None,
         leaders=None,
+        motion=None,
+        left_out=None,
     ):
         self.anchors = np.asarray(anchors, np.float64).reshape(-1, 2)
         # per label: its box centre along each side in the previous frame (NaN: elsewhere)
@@ -98,6 +100,13 @@ class Context:
         # side of the centre the port is on), set by the row stacking
         self.leaders = [None] * len(self.anchors) if leaders is None else leaders
         self.flags = np.zeros(len(self.anchors), np.int8)
+        # per label: how far (pixels) the surface under its anchor moved since the previous
+        # frame (0: no previous frame)
+        self.motion = (
+            np.zeros(len(self.anchors)) if motion is None else np.nan_to_num(np.asarray(motion, np.float64))
+        )
+        # per label: left out for lack of room in the previous frame
+        self.left_out = np.zeros(len(self.anchors), bool) if left_out is None else np.asarray(left_out, bool)
         self.stats = BoxStats()
         self._boundary = None
         self._rays = None

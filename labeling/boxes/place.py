@@ -113,6 +113,8 @@ def place_boxes(
     centres: np.ndarray | None = None,
     leaders: list | None = None,
     lines: np.ndarray | None = None,
+    motion: np.ndarray | None = None,
+    left_out: np.ndarray | None = None,
 ) -> tuple[list[Placement | None], BoxStats]:
     """Lay out the boxes and leaders of all labels of one frame.
 
@@ -143,6 +145,11 @@ def place_boxes(
     lines : (4,) float, optional: the x of the west and east columns and the y of the north
         and south rows in the previous frame (NaN: none); a column or row stays there while
         that is still valid and not much farther out than needed
+    motion : (n,) float, optional: how far the surface under each anchor moved on the
+        screen since the previous frame (pixels; NaN or 0: unknown); a row's port creeps
+        towards its endpoint no faster
+    left_out : (n,) bool, optional: the labels left out for lack of room in the previous
+        frame; a row holding one is spread as in a single frame
 
     Returns
     -------
@@ -166,6 +173,8 @@ def place_boxes(
         centres,
         lines,
         leaders,
+        motion,
+        left_out,
     )
     endpoints_in = ctx.endpoints.copy()  # a ring placed afresh starts from these
     _keep_radial_endpoints(ctx, np.flatnonzero(ctx.sides == RADIAL), leaders)

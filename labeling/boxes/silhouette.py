@@ -294,10 +294,42 @@ def _run_order(ctx: Context, ring: np.ndarray) -> list[int]:
 KEEP_COS = 0.5
 
 
-def _kept_leaders(ctx: Context, k: int, c: np.ndarray, half: np.ndarray, before: np.ndarray | None) -> list:
-    """Leaders a kept box may hang off: last frame's moved with the anchor, then one from this frame's endpoint."""
+#: a kept box that now covers the model or another label may move this far (pixels) to
+#: the nearest free place around where it was, in steps of NUDGE_STEP: a small glide
+#: instead of a search that may take it anywhere around the model
+NUDGE_REACH = 24.0
+NUDGE_STEP = 3.0
+#: nudged places whose leaders are tried per label (nearest first)
+NUDGE_TRIES = 20
+
+
+def _nudges(ctx: Context, c: np.ndarray) -> np.ndarray:
+    """Offsets (m, 2) of a kept box centre ``c``, nearest first: none, then outwards and along."""
+    u = c - ctx.center
+    u = u / max(float(np.hypot(*u)), 1e-9)
+    v = np.array([-u[1], u[0]])
+    t = np.arange(0.0, NUDGE_REACH + 1e-9, NUDGE_STEP)
+    t = np.concatenate([-t[:0:-1], t])
+    a, b = np.meshgrid(t, t, indexing="ij")
+    off = a.reshape(-1, 1) * u + b.reshape(-1, 1) * v
+    d = np.hypot(off[:, 0], off[:, 1])
+    keep = d <= NUDGE_REACH + 1e-9
+    order = np.lexsort((b.reshape(-1)[keep], a.reshape(-1)[keep], d[keep]))
+    return off[keep][order]
+
+
+def _kept_leaders(
+    ctx: Context, k: int, c: np.ndarray, half: np.ndarray, before: np.ndarray | None, offset: np.ndarray
+) -> list:
+    """Leaders a kept box may hang off.
+
+    Last frame's leader moved with the anchor (its port moved with the box by ``offset``),
+    then one from this frame's endpoint.
+    """
     out = []
     if before is not None:
+        before = np.array(before, np.float64)
+        before[-1] += offset
         out.append(np.vstack([ctx.anchors[k][None], before]))
     e, n = ctx.endpoints[k], ctx.ray_direction(k)
     ports = c - _ATTACH * half  # the attach points of the box
@@ -309,37 +341,65 @@ def _kept_leaders(ctx: Context, k: int, c: np.ndarray, half: np.ndarray, before:
     return out
 
 
+def _expected_paths(ctx: Context, idx: np.ndarray, leaders: list | None) -> list[np.ndarray]:
+    """Per ring label, the segments (m, 2, 2) its leader is expected to take this frame.
+
+    Last frame's leader moved with its anchor where there is one (it is kept if it can
+    be), else the inside part from its anchor to its endpoint.
+    """
+    out = []
+    for k in idx:
+        before = None if leaders is None else leaders[k]
+        if before is not None and len(before):
+            pts = np.vstack([ctx.anchors[k][None], np.asarray(before, np.float64)])
+        else:
+            pts = np.array([ctx.anchors[k], ctx.endpoints[k]])
+        out.append(np.stack([pts[:-1], pts[1:]], axis=1))
+    return out
+
+
 def _keep_previous(ctx: Context, idx: np.ndarray, leaders: list | None = None) -> list[int]:
     """Hysteresis of the silhouette layout: keep last frame's boxes where they are still valid.
 
     Each label (in greedy order) whose box moved with its anchor (``ctx.centres``) still
     covers no model pixel, no placed box or leader, stays inside the image, and can be
     reached from this frame's endpoint through one of its attach points without crossing
-    a placed leader or the path of another label, is placed there.  Returns the labels
-    placed; the others go through the search.
+    a placed leader or the path of another label, is placed there; where that box is not
+    free, the nearest free place within :data:`NUDGE_REACH` is taken instead.  Returns the
+    labels placed; the others go through the search.
     """
     known = [int(k) for k in idx if np.isfinite(ctx.centres[k, 0])]
     if not known:
         return []
     kept: list[int] = []
-    insides = np.stack([ctx.anchors[idx], ctx.endpoints[idx]], axis=1)
+    paths = _expected_paths(ctx, idx, leaders)
     for k in sorted(known, key=lambda k: (ctx.rank[k], k)):
-        half = np.array([ctx.widths[k] / 2, ctx.height / 2])
-        c = ctx.centres[k]
-        box = np.concatenate([c - half, c + half])[None]
-        if _outside_image(ctx, box)[0]:
-            continue
-        pboxes, psegs = _placed_arrays(ctx, k)
-        if not _boxes_free(ctx, box, pboxes, psegs)[0]:
-            continue
-        others = insides[idx != k]
+        others = [p for j, p in zip(idx, paths) if j != k and ctx.placed[j] is None]
+        others = np.concatenate(others) if others else None
         before = None if leaders is None else leaders[k]
-        for leader in _kept_leaders(ctx, k, c, half, before):
-            if _leaders_free(leader[None], pboxes, psegs, others)[0]:
-                _place(ctx, k, leader, box[0], 0, float(np.hypot(*(leader[1] - ctx.endpoints[k]))))
-                kept.append(k)
-                break
+        # where it was first; the nudged places only when that fails (the usual case is cheap)
+        if _keep_at(ctx, k, np.zeros((1, 2)), before, others) or _keep_at(
+            ctx, k, _nudges(ctx, ctx.centres[k])[1:], before, others
+        ):
+            kept.append(k)
     return kept
+
+
+def _keep_at(ctx: Context, k: int, offsets: np.ndarray, before: np.ndarray | None, others) -> bool:
+    """Place label k at the first valid one of its moved box shifted by ``offsets`` (nearest first)."""
+    half = np.array([ctx.widths[k] / 2, ctx.height / 2])
+    centres = ctx.centres[k] + offsets
+    boxes = np.concatenate([centres - half, centres + half], axis=1)
+    pboxes, psegs = _placed_arrays(ctx, k)
+    ok = ~_outside_image(ctx, boxes)
+    live = np.flatnonzero(ok)
+    ok[live] = _boxes_free(ctx, boxes[live], pboxes, psegs)
+    for m in np.flatnonzero(ok)[:NUDGE_TRIES]:
+        for leader in _kept_leaders(ctx, k, centres[m], half, before, offsets[m]):
+            if _leaders_free(leader[None], pboxes, psegs, others)[0]:
+                _place(ctx, k, leader, boxes[m], 0, float(np.hypot(*(leader[1] - ctx.endpoints[k]))))
+                return True
+    return False
 
 
 def _place_in_order(ctx: Context, order: list[int]) -> list[int]:

@@ -153,6 +153,35 @@ def _flag_split(ctx: Context, idx: np.ndarray, port_x: np.ndarray) -> np.ndarray
     return left
 
 
+#: along a camera path a row's port follows its anchor from last frame's place and creeps
+#: towards its candidate endpoint by at most this many pixels a frame (and no farther than
+#: the surface under its anchor moved: on a still camera nothing moves)
+PORT_CREEP = 2.0
+
+
+#: surface motion (pixels) below which a label counts as not having moved
+STILL_PX = 0.5
+
+
+def _glided_ports(ctx: Context, idx: np.ndarray, side: int, desired: np.ndarray) -> tuple[np.ndarray, bool]:
+    """Where the ports of a row would like to be along a camera path.
+
+    A label that was on this side last frame starts from its port moved with its anchor
+    (the row glides with the surface) and creeps towards its candidate endpoint by at most
+    :data:`PORT_CREEP` pixels and the surface motion; the others start from their endpoints.
+    """
+    out = np.array(desired, np.float64)
+    glided = False
+    for j, k in enumerate(idx):
+        lead = ctx.leaders[k]
+        if np.isfinite(ctx.previous[k, side]) and lead is not None and len(lead):
+            port = float(lead[0][0])
+            creep = min(PORT_CREEP, float(ctx.motion[k]))
+            out[j] = port + float(np.clip(out[j] - port, -creep, creep))
+            glided = True
+    return out, glided
+
+
 def _place_row(ctx: Context, idx: np.ndarray, side: int) -> None:
     """Spread the ports of one north/south side (shift, swap), then stack flag boxes in tiers."""
     if len(idx) == 0:
@@ -162,6 +191,31 @@ def _place_row(ctx: Context, idx: np.ndarray, side: int) -> None:
     # spacing means fewer tiers, at the price of more slanted leaders
     fair = (ctx.W - 2 * ctx.sp.clearance) / len(idx)
     gap = float(np.clip(fair, ctx.sp.port_gap, ctx.widths[idx].mean() + ctx.sp.gap))
+    glided, any_glided = _glided_ports(ctx, idx, side, desired)
+    still = bool((ctx.motion[idx] < STILL_PX).all())
+    if any_glided and not (still and ctx.left_out[idx].any()):
+        # along a camera path the ports follow their anchors and stay near them (the least
+        # port gap), so that two anchors passing each other swap ports a few pixels apart
+        # instead of a box width.  If the tiers this needs leave the image, the row is
+        # spread as in a single frame; so is a row that did not move holding a label left
+        # out last frame for lack of room (a still camera keeps its layout)
+        stats, flags = (ctx.stats.shifted, ctx.stats.swaps), ctx.flags.copy()
+        _stack_row(ctx, idx, side, glided, ctx.sp.port_gap)
+        if not _off_image(ctx, idx):
+            return
+        ctx.stats.shifted, ctx.stats.swaps = stats
+        ctx.flags[:] = flags
+    _stack_row(ctx, idx, side, desired, gap)
+
+
+def _off_image(ctx: Context, idx: np.ndarray) -> bool:
+    """True when a box of the labels ``idx`` reaches beyond the image."""
+    boxes = np.array([ctx.placed[k].box for k in idx if ctx.placed[k] is not None]).reshape(-1, 4)
+    return bool((boxes[:, :2] < 0).any() or (boxes[:, 2] > ctx.W).any() or (boxes[:, 3] > ctx.H).any())
+
+
+def _stack_row(ctx: Context, idx: np.ndarray, side: int, desired: np.ndarray, gap: float) -> None:
+    """Place the ports of one row at least ``gap`` apart near ``desired``, then the flag boxes in tiers."""
     order = coherent_order(desired, ctx.previous[idx, side], gap)
     idx, desired = idx[order], desired[order]
     xs = pack_1d(desired, np.zeros(len(idx)), gap, 0.0, ctx.W)

@@ -38,7 +38,7 @@ from meshvis.repair.remove_modes import (
 )
 from meshvis.soup import Soup
 from meshvis.visibility import Visibility, parse_region, visible_from
-from meshvis.visibility.check import RESCUE_SHARE, rescue_pass
+from meshvis.visibility.check import rescue_pass
 from meshvis.visibility.walls import walls
 
 
@@ -242,9 +242,8 @@ def _layers_by_sight(
         unseen = left & active & ~vis.seen
         seen_side = vis.seen_side
         if rescue_rays:
-            cap = int(RESCUE_SHARE * vis.rays["total"])
             rescue = rescue_pass(
-                caster, bound, unseen, vis.seen & left, rays=rescue_rays, seed=seed, budget=cap
+                caster, bound, unseen, vis.seen & left, rays=rescue_rays, seed=seed, search=vis
             )
             seen_side = seen_side | rescue.seen_side
         new = seen_side.any(axis=1) & left & active

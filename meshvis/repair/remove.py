@@ -26,8 +26,9 @@ A removal by sight (``"view"``, ``"both"``) ends with a rescue pass
 (:func:`meshvis.visibility.check.rescue_pass`): random rays from every face it is about to
 remove, to random viewers of the region, ``rescue_rays`` of them from each face next to a
 seen or rescued face and :data:`~meshvis.visibility.check.RESCUE_FIRST_RAYS` from the
-others; a face one of them sees from is kept, and the neighbours of a rescued face are
-also tried along its line of sight.  The search stops once new views have become rare,
+others, and a few along the search's line of sight to each seen neighbour; a face one of
+them sees from is kept, and the neighbours of a rescued face are also tried along its line
+of sight.  The search stops once new views have become rare,
 and a small face seen through a narrow gap can be one it never aimed at often enough; the
 rescue gives every such face rays of its own.  Every removal then ends with a self-check: ``check_rays`` fresh random
 rays from every removed face, from another stream than the rescue's; the report says how
@@ -337,8 +338,7 @@ def remove_interior(
     by_rays = (check_rays or rescue_rays) and not _is_cells(region)  # cells: judged by meshvis bench pvs
     bound = parse_region(region, up=up).bind(soup) if by_rays else None
     if bound is not None and rescue_rays and visibility in ("view", "both"):
-        cap = None if vis is None else int(RESCUE_SHARE * vis.rays["total"])
-        rescue = rescue_pass(caster, bound, ~keep, keep, rays=rescue_rays, seed=seed, budget=cap)
+        rescue = rescue_pass(caster, bound, ~keep, keep, rays=rescue_rays, seed=seed, search=vis)
         code[rescue.seen] = _KEPT_RESCUE
         keep = keep | rescue.seen
     keep = _widen(soup, keep, code, level, int(keep_border))

@@ -137,6 +137,12 @@ class Visibility:
     conservative : ConservativeSet or None
         With ``conservative=True``: the faces that may be seen from the viewpoints
         (:mod:`meshvis.visibility.conservative`).
+    sighting : (m, 3) float64 or None
+        Per face, the unit direction (from the viewer) of the ray that first saw it; zero
+        for a face never seen or seen without a ray (inside the region).  A face seen only
+        through a gap is seen along the gap: the rescue pass
+        (:func:`meshvis.visibility.check.rescue_pass`) aims its unseen neighbours' rays
+        along it.  None where no rays were traced (a loaded PVS).
     """
 
     seen_side: np.ndarray
@@ -155,6 +161,7 @@ class Visibility:
     see_through: int = 0
     extra: dict = field(default_factory=dict)
     conservative: ConservativeSet | None = None
+    sighting: np.ndarray | None = None
 
     @property
     def seen(self) -> np.ndarray:
@@ -208,6 +215,7 @@ class _State:
         self.rays_seen = np.zeros((m, 2), np.int64)
         self.seed_rays = np.zeros(m, np.int64)
         self.first_seen = np.full(m, -1, np.int64)
+        self.sighting = np.zeros((m, 3))
         self.rays = {"random": 0, "lines": 0, "border": 0, "reverse": 0}
         self.max_unseen = MAX_UNSEEN_PER_MILLION
         self.round = 0  # the round of seed rays under way
@@ -241,6 +249,7 @@ class _State:
         _, first = np.unique(s.face[fresh], return_index=True)
         new = s.subset(np.flatnonzero(fresh)[first])
         self.mark_seen(new.face, self.cast)
+        self.sighting[new.face] = new.direction
         return new
 
     def mark_seen(self, faces: np.ndarray, rays: int) -> None:
@@ -410,6 +419,7 @@ def visible_from(
         seconds=time.perf_counter() - state.start,
         stopped=stopped,
         see_through=0 if caster.walls is None else int((~caster.walls).sum()),
+        sighting=state.sighting,
     )
 
 
