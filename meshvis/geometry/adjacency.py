@@ -312,27 +312,32 @@ def edges(faces_welded: np.ndarray) -> EdgeTable:
     ok = ~collapsed(f)
     a = f[ok]
     b = np.roll(a, -1, axis=1)
-    lo, hi = np.minimum(a, b).ravel(), np.maximum(a, b).ravel()
     forward = (a < b).ravel()
-    face = np.repeat(np.flatnonzero(ok), 3)
-    keys = lo * np.int64(n) + hi
+    keys = np.minimum(a, b).ravel() * np.int64(n)
+    keys += np.maximum(a, b).ravel()
+    del a, b  # the temporaries go as soon as they are used: this runs beside the broad phase
     order = stable_order(keys, n * n)
     sorted_keys = keys[order]
-    new = np.ones(len(keys), bool)
+    del keys
+    h = len(sorted_keys)
+    new = np.ones(h, bool)
     new[1:] = sorted_keys[1:] != sorted_keys[:-1]
     starts = np.flatnonzero(new)
     ukeys = sorted_keys[starts]
+    del sorted_keys
     edge_of = np.cumsum(new) - 1
-    count = np.diff(np.append(starts, len(keys)))
+    del new
+    count = np.diff(np.append(starts, h))
     face_edge = np.full((m, 3), -1, np.int64)
-    per_half = np.empty(len(keys), np.int64)
+    per_half = np.empty(h, np.int64)
     per_half[order] = edge_of
     face_edge[ok] = per_half.reshape(-1, 3)
+    del per_half
     return EdgeTable(
         vertices=np.stack([ukeys // n, ukeys % n], axis=1),
         count=count.astype(np.int64),
         face_edge=face_edge,
-        half_face=face[order],
+        half_face=np.repeat(np.flatnonzero(ok), 3)[order],
         half_edge=edge_of,
         half_forward=forward[order],
     )

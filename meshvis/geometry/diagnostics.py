@@ -13,11 +13,13 @@ from __future__ import annotations
 import os
 import time
 from collections.abc import Callable
+from concurrent.futures import Future, ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
 
+from meshvis._threads import default_threads
 from meshvis.geometry import adjacency, duplicates, intersect
 from meshvis.io import as_soup
 from meshvis.soup import Soup
@@ -49,7 +51,8 @@ class Analysis:
     flags : dict or None
         The flags of :func:`intersect.intersection_flags`; None when not run.
     seconds : dict
-        Time of each step
+        Time of each step (the edges are built alongside the steps after the weld: their
+        seconds overlap the others')
     """
 
     faces_welded: np.ndarray
@@ -122,25 +125,54 @@ def analyse(
     v, f = soup.vertices, soup.faces
     _, fw = adjacency.weld(v, f, weld_tol, vertex_groups)
     lap("weld", 0.15)
-    table = adjacency.edges(fw)
-    lap("edges", 0.25)
-    collapsed = adjacency.collapsed(fw)
-    degenerate = adjacency.degenerate_faces(v, f, tol=DEGENERATE_TOL, zero_area=True)
-    lap("degenerate", 0.3)
-    first = adjacency.duplicate_faces(fw)
-    lap("duplicates", 0.35)
-    flags = None
-    if intersections:
-        flags = intersect.intersection_flags(
-            v,
-            f,
-            eps,
-            faces_welded=fw,
-            duplicate_first=first,
-            progress=lambda x: report("analyse", 0.35 + 0.65 * x),
-        )
-        lap("intersections", 1.0)
+    # the edges need only the welded faces: they are built in a thread of their own while
+    # the rest runs (numpy's sorts release the GIL), so that the second core has work
+    # during the single-threaded steps of the intersection tests (in this thread when
+    # meshvis may use one core, as in the workers of ``meshvis batch``)
+    seconds["edges"] = 0.0
+    with ThreadPoolExecutor(1, "meshvis-edges") if default_threads() > 1 else _Inline() as side:
+        edges = side.submit(_timed, adjacency.edges, fw)
+        collapsed = adjacency.collapsed(fw)
+        degenerate = adjacency.degenerate_faces(v, f, tol=DEGENERATE_TOL, zero_area=True)
+        lap("degenerate", 0.3)
+        first = adjacency.duplicate_faces(fw)
+        lap("duplicates", 0.35)
+        flags = None
+        if intersections:
+            flags = intersect.intersection_flags(
+                v,
+                f,
+                eps,
+                faces_welded=fw,
+                duplicate_first=first,
+                progress=lambda x: report("analyse", 0.35 + 0.65 * x),
+            )
+            lap("intersections", 1.0)
+        table, seconds["edges"] = edges.result()
+    report("analyse", 1.0)
     return Analysis(fw, table, degenerate, collapsed, first, flags, seconds)
+
+
+class _Inline:
+    """An executor that runs the work when it is submitted (one thread)."""
+
+    def __enter__(self) -> _Inline:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        return None
+
+    def submit(self, work: Callable[..., Any], *args: Any) -> Future:
+        done: Future = Future()
+        done.set_result(work(*args))
+        return done
+
+
+def _timed(work: Callable[..., Any], *args: Any) -> tuple[Any, float]:
+    """``work(*args)`` and the seconds it took."""
+    t = time.perf_counter()
+    out = work(*args)
+    return out, round(time.perf_counter() - t, 4)
 
 
 def diagnose(

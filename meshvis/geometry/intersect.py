@@ -92,7 +92,7 @@ from meshvis.errors import ModelError, ParameterError
 from meshvis.geometry import _vectorised
 from meshvis.geometry._kernel_constants import COPLANAR, INTERSECTS, TOO_CLOSE
 from meshvis.geometry._vectorised import compiled, kernels
-from meshvis.geometry.adjacency import WELD_TOL, weld
+from meshvis.geometry.adjacency import WELD_TOL, stable_order, weld
 
 #: default distance tolerance, as a fraction of the bounding-box diagonal
 EPS = 1e-6
@@ -230,14 +230,21 @@ class _BroadPhase:
         # finest cell: the median box size (at least 2**-20 of the whole: 21-bit keys)
         h0 = max(H0_FACTOR * float(np.median((hi - lo).max(axis=1))), size * 2.0**-20)
         level = _levels(lo, hi, h0, size)
-        grids = {}
-        for L in np.unique(level):
-            grids[L] = _Grid(lo, hi, np.flatnonzero(level == L), h0 * 2.0**L, size, low)
-            self.jobs.append(grids[L].within(hi))
-        for L in list(grids)[1:]:
-            job = grids[L].from_finer(lo, hi, np.flatnonzero(level < L))
-            if job is not None:
-                self.jobs.append(job)
+        levels = [int(L) for L in np.unique(level)]
+        # the levels are independent (each writes the lower cells of its own boxes, and
+        # the finer boxes find their cells on a level by themselves): a level per thread,
+        # mostly in compiled kernels that release the GIL
+        threads = pool(default_threads()) if len(levels) > 1 else None
+        each: Callable = map if threads is None else threads.map
+
+        def jobs(L: int) -> tuple[_Job, _Job | None]:
+            grid = _Grid(lo, hi, np.flatnonzero(level == L), h0 * 2.0**L, size, low)
+            finer = grid.from_finer(lo, hi, np.flatnonzero(level < L)) if levels[0] < L else None
+            return grid.within(hi), finer
+
+        within, finer = zip(*each(jobs, levels))
+        self.jobs += within
+        self.jobs += [job for job in finer if job is not None]
 
     @property
     def candidates(self) -> int:
@@ -256,6 +263,29 @@ def _levels(lo: np.ndarray, hi: np.ndarray, h0: float, size: float) -> np.ndarra
     return grid_levels(lo, hi, float(h0), top, float(MAX_CELLS))
 
 
+def _stable_key_order(key: np.ndarray) -> np.ndarray:
+    """``np.argsort(key, kind="stable")`` of packed cell keys, through a plain sort where it can.
+
+    The keys are renumbered densely over the cells the level spans (the same order) so that
+    :func:`meshvis.geometry.adjacency.stable_order` can add the positions to them and sort
+    values: about 3x faster than a stable argsort of 4 M keys.
+    """
+    if len(key) == 0:
+        return np.zeros(0, np.int64)
+    mask = np.int64((1 << _BITS) - 1)
+    cells = [key >> (2 * _BITS), (key >> _BITS) & mask, key & mask]
+    dense = np.zeros(len(key), np.int64)
+    bound = 1
+    for c in cells:
+        c0, c1 = int(c.min()), int(c.max())
+        if bound * (c1 - c0 + 1) * len(key) >= 2**62:
+            return np.argsort(key, kind="stable")
+        dense *= c1 - c0 + 1
+        dense += c - c0
+        bound *= c1 - c0 + 1
+    return stable_order(dense, bound)
+
+
 class _Grid:
     """The boxes of one level in their cells, sorted for a sweep along x within each cell.
 
@@ -272,7 +302,7 @@ class _Grid:
         del c0
         ent = boxes[owner]
         del owner
-        order = sweep_order(key, lo[ent, 0])
+        order = sweep_order(key, lo[ent, 0], _stable_key_order(key))
         self.key, self.ent = key[order], ent[order]
         del key, ent, order
         self.h, self.xs = h, 0.5 / size
@@ -677,13 +707,13 @@ def _flagged_pairs(
         job, sl = item
         return kernel(*job.rows(sl), *bounds, _BITS, n, *test.faces, *test.tolerances)
 
+    # every chunk queued at once (no wait for the slowest of a batch); their results are
+    # small (the flagged pairs) and come back in order
+    workers = pool(default_threads()) if len(work) > 1 else None
     out = []
-    step = 4 * default_threads()
-    for s in range(0, len(work), step):
-        part = work[s : s + step]
-        workers = pool(default_threads()) if len(part) > 1 else None
-        out += list(workers.map(run, part)) if workers is not None else [run(w) for w in part]
-        report(0.1 + 0.9 * min(s + step, len(work)) / len(work))
+    for done, result in enumerate(workers.map(run, work) if workers is not None else map(run, work)):
+        out.append(result)
+        report(0.1 + 0.9 * (done + 1) / len(work))
     del broad, work
     keys = np.concatenate([k for k, _ in out]) if out else np.zeros(0, np.int64)
     codes = np.concatenate([c for _, c in out]) if out else np.zeros(0, np.uint8)

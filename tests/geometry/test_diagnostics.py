@@ -261,4 +261,25 @@ def test_diagnose_advances_a_progress_bar_through_every_step():
     fractions = [f for _, f in seen]
     assert fractions[0] == 0.0 and fractions[-1] == 1.0
     assert fractions == sorted(fractions)
-    assert len(set(fractions)) >= 6  # weld, edges, degenerate, duplicates, broad and narrow phase
+    # weld, degenerate, duplicates, the intersection tests (the edges are built alongside)
+    assert len(set(fractions)) >= 5
+
+
+def test_diagnose_counts_the_same_on_one_thread_and_on_several(monkeypatch):
+    import trimesh
+
+    from meshvis.geometry.diagnostics import analyse, diagnose
+    from meshvis.io import as_soup
+
+    mesh = trimesh.util.concatenate(
+        [trimesh.creation.icosphere(3), trimesh.creation.box(extents=(1.8, 1.8, 1.8))]
+    )
+    counts = []
+    for threads in ("1", "2"):
+        monkeypatch.setenv("MESHVIS_THREADS", threads)
+        d = diagnose(mesh)
+        a = analyse(as_soup(mesh))
+        assert np.array_equal(a.table.face_edge, analyse(as_soup(mesh)).table.face_edge)
+        counts.append(({k: v for k, v in d.items() if "seconds" not in k}, a.table.face_edge))
+    assert counts[0][0] == counts[1][0] and counts[0][0]["intersecting_faces"] > 0
+    assert np.array_equal(counts[0][1], counts[1][1])

@@ -319,3 +319,16 @@ def test_flags_in_threads_are_those_of_one_call(monkeypatch):
     assert 100 < one["intersects"].sum() < 2400 and one["coplanar"].sum() >= 600
     for key, flags in one.items():
         assert np.array_equal(np.asarray(flags), np.asarray(sliced[key])), key
+
+
+def test_the_grid_sorts_cell_keys_as_a_stable_argsort():
+    from meshvis.geometry.intersect import _BITS, _stable_key_order
+
+    rng = np.random.default_rng(5)
+    for span in (1, 7, 1 << 10, 1 << 21):  # the last spans too many cells for the plain sort
+        c = rng.integers(0, span, (3000, 3))
+        c[:1000, 0] = c[0, 0]  # runs of equal keys
+        c[1000:1500] = c[1000]
+        key = (c[:, 0] << (2 * _BITS)) | (c[:, 1] << _BITS) | c[:, 2]
+        assert np.array_equal(_stable_key_order(key), np.argsort(key, kind="stable"))
+    assert len(_stable_key_order(np.zeros(0, np.int64))) == 0
