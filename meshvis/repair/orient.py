@@ -888,7 +888,7 @@ def orient(
     two_sided: str = "keep",
     semantics: str = "layer",
     conflicts: str = "majority",
-    ground: bool | None = None,
+    ground: bool | None = False,
     up: Any = None,
     classification: Classification | None = None,
     **classify_kw: Any,
@@ -914,8 +914,8 @@ def orient(
         Flagged faces whose sample points disagree: the area majority, or both orientations.
     ground : bool or None
         True: the model is a scene standing on a ground, seen from above it only (the rays
-        of the visible-sides step that leave it downward do not count); None (default):
-        where :func:`meshvis.repair.evidence.stands_on_ground` says so; False: seen
+        of the visible-sides step that leave it downward do not count); None: where
+        :func:`meshvis.repair.evidence.stands_on_ground` says so; False (default): seen
         from every direction, as the graph cut sees it.  Seen from above its ground, a
         face does not leave its patch's side where viewers above the ground see that side
         (:func:`_seen_from_above`).

@@ -55,5 +55,5 @@ def test_from_above_reports_the_back_facing_pixels_before_and_after(tmp_path):
     rows = list(csv.DictReader(open(out / "from_above.csv")))
     assert [float(r["elevation"]) for r in rows] == [20.0, 60.0]
     assert all(r["model"] == "wallhole.obj" and r["ground_found"] == "True" for r in rows)
-    assert all(0.0 <= float(r[k]) <= 1.0 for r in rows for k in ("input", "default", "ground_no"))
+    assert all(0.0 <= float(r[k]) <= 1.0 for r in rows for k in ("input", "default", "ground_auto"))
     assert "| wallhole.obj | 66 | 60° |" in (out / "from_above.md").read_text()

@@ -37,10 +37,10 @@ def test_a_ground_sheet_wound_down_faces_up():
     winding; seen from above its ground only, it faces up."""
     soup = _scene()
     assert (soup.normals[:2] @ UP < 0).all()
-    r = orient(soup, seed=0)  # the default: the ground is found
+    r = orient(soup, seed=0, ground=None)
     assert r.visibility["ground"] and r.flipped[:2].all()
     assert (r.soup.normals[:2] @ UP > 0).all()
-    kept = orient(soup, seed=0, ground=False)  # seen from every direction
+    kept = orient(soup, seed=0)  # the default: seen from every direction
     assert not kept.visibility["ground"] and not kept.flipped[:2].any()
 
 
@@ -82,36 +82,8 @@ def test_orient_on_a_ground_twice_is_once_and_the_cli_agrees(tmp_path):
     assert not orient(once.soup, seed=0, ground=None).flipped.any()
     path, out = tmp_path / "scene.stl", tmp_path / "oriented.stl"  # STL: z up
     save(soup, str(path))
-    for ground in ([], ["--ground", "auto"]):  # auto is the default
-        assert main(["orient", str(path), "-o", str(out), *ground, "--quiet", "--force"]) == 0
-        np.testing.assert_allclose(load(str(out)).normals, once.soup.normals, atol=1e-6)
-
-
-def _car() -> Soup:
-    """A box on four wheels (z up), a third of its faces turned over: it stands on no ground."""
-    body = trimesh.creation.box(extents=(4, 2, 1)).apply_translation((0, 0, 1.2))
-    turn = trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0))
-    wheels = [
-        trimesh.creation.cylinder(0.4, 0.3, sections=12).apply_transform(turn).apply_translation((x, y, 0.4))
-        for x, y in [(-1.5, -1), (-1.5, 1), (1.5, -1), (1.5, 1)]
-    ]
-    car = trimesh.util.concatenate([body, *wheels])
-    faces = np.asarray(car.faces).copy()
-    faces[::3] = faces[::3, ::-1]
-    return Soup(np.asarray(car.vertices), faces)
-
-
-@pytest.mark.parametrize("model", ["car", "courtyard along y"])
-def test_with_no_ground_found_the_default_is_seen_from_every_direction(model):
-    """Where no ground is found, the default (``ground=None``) gives the faces of
-    ``ground=False``, the model seen from every direction."""
-    soup, up = (_car(), None) if model == "car" else (_courtyard(0.1), "y")
-    found, everywhere = orient(soup, seed=0, up=up), orient(soup, seed=0, up=up, ground=False)
-    assert not found.visibility["ground"]
-    assert found.flipped.any()  # there is something to agree on
-    np.testing.assert_array_equal(found.flipped, everywhere.flipped)
-    np.testing.assert_array_equal(found.soup.faces, everywhere.soup.faces)
-    np.testing.assert_array_equal(found.status, everywhere.status)
+    assert main(["orient", str(path), "-o", str(out), "--ground", "auto", "--quiet"]) == 0
+    np.testing.assert_allclose(load(str(out)).normals, once.soup.normals, atol=1e-6)
 
 
 @pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6)])
@@ -173,11 +145,38 @@ def test_a_wall_seen_from_both_sides_above_the_ground_keeps_its_patch(gap, groun
 
 @pytest.mark.parametrize("ground, up", [(False, None), (None, "y")])
 def test_seen_from_every_direction_the_wall_takes_the_side_seen_more(ground, up):
-    """Seen from every direction, or where the scene stands on no ground (along y), viewers all around
+    """By default, or where the scene stands on no ground (along y), viewers all around
     see the back wall through the courtyard more than 4x as often: it is turned."""
     r = orient(_courtyard(0.1), seed=0, ground=ground, up=up)
     assert not r.visibility["ground"] and r.visibility["kept_seen_from_above"] == 0
     np.testing.assert_array_equal(np.flatnonzero(r.flipped), [4, 5])
+
+
+def _car() -> Soup:
+    """A box on four wheels (z up), a third of its faces turned over: it stands on no ground."""
+    body = trimesh.creation.box(extents=(4, 2, 1)).apply_translation((0, 0, 1.2))
+    turn = trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0))
+    wheels = [
+        trimesh.creation.cylinder(0.4, 0.3, sections=12).apply_transform(turn).apply_translation((x, y, 0.4))
+        for x, y in [(-1.5, -1), (-1.5, 1), (1.5, -1), (1.5, 1)]
+    ]
+    car = trimesh.util.concatenate([body, *wheels])
+    faces = np.asarray(car.faces).copy()
+    faces[::3] = faces[::3, ::-1]
+    return Soup(np.asarray(car.vertices), faces)
+
+
+@pytest.mark.parametrize("model", ["car", "courtyard along y"])
+def test_with_no_ground_found_auto_is_the_default(model):
+    """Where no ground is found, ``ground=None`` (``--ground auto``) gives the faces of the
+    default ``ground=False``, the model seen from every direction."""
+    soup, up = (_car(), None) if model == "car" else (_courtyard(0.1), "y")
+    auto, default = orient(soup, seed=0, up=up, ground=None), orient(soup, seed=0, up=up)
+    assert not auto.visibility["ground"]
+    assert auto.flipped.any()  # there is something to agree on
+    np.testing.assert_array_equal(auto.flipped, default.flipped)
+    np.testing.assert_array_equal(auto.soup.faces, default.soup.faces)
+    np.testing.assert_array_equal(auto.status, default.status)
 
 
 @pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6)])

@@ -25,7 +25,7 @@ machine, a table per input kind, the orientation targets checked on the numbers)
 
 ``meshvis bench orientation --out DIR --elevations 20 60 [--only A,B]`` measures what a
 viewer above a scene sees instead (no reference, no baselines): each model as it is,
-``orient``'s output at its defaults (``--ground auto``) and with ``--ground no``, rendered from each
+``orient``'s output at its defaults and with ``--ground auto``, rendered from each
 elevation above the model's up axis (azimuth 30, 512 x 512), and the share of the
 model's pixels that show a back side (``meshvis render --color-by side`` draws them
 orange).  Output: ``from_above.csv`` and ``from_above.md``.
@@ -238,16 +238,16 @@ class FromAbove:
     faces: int
     elevation: float
     input: float  # share of the model's pixels showing a back side
-    default: float  # after ``orient`` at its defaults (``ground=None``: where one is found)
-    ground_no: float  # after ``orient(ground=False)``: seen from every direction
+    default: float  # after ``orient`` at its defaults
+    ground_auto: float  # after ``orient(ground=None)``
     ground_found: bool
     seconds_default: float
-    seconds_ground_no: float
+    seconds_auto: float
     load1: float = 0.0
 
 
 def from_above(paths: list[str], elevations: list[float], *, seed: int, log=print) -> list[FromAbove]:
-    """Back-facing pixels seen from ``elevations`` before and after ``orient`` (default and ``ground=False``).
+    """Back-facing pixels seen from ``elevations`` before and after ``orient`` (default and ``ground=None``).
 
     Parameters
     ----------
@@ -276,14 +276,14 @@ def from_above(paths: list[str], elevations: list[float], *, seed: int, log=prin
         default = orient(soup, seed=seed)
         t_default = time.perf_counter() - t
         t = time.perf_counter()
-        everywhere = orient(soup, seed=seed, ground=False)
-        t_all = time.perf_counter() - t
-        found = bool(default.visibility and default.visibility["ground"])
+        auto = orient(soup, seed=seed, ground=None)
+        t_auto = time.perf_counter() - t
+        found = bool(auto.visibility and auto.visibility["ground"])
         for e in elevations:
-            shares = [back_facing(s, e, soup.up) for s in (soup, default.soup, everywhere.soup)]
+            shares = [back_facing(s, e, soup.up) for s in (soup, default.soup, auto.soup)]
             rows.append(
                 FromAbove(
-                    os.path.basename(path), soup.n_faces, e, *shares, found, t_default, t_all, C.load1()
+                    os.path.basename(path), soup.n_faces, e, *shares, found, t_default, t_auto, C.load1()
                 )
             )
             log(f"{rows[-1].model}: {e:g} degrees, back-facing " + ", ".join(f"{x:.3%}" for x in shares))
@@ -298,14 +298,14 @@ def from_above_markdown(rows: list[FromAbove], command: str) -> str:
         "",
         f"Command: `{command}`",
         "",
-        "| model | faces | elevation | input | `orient` (ground found) | `orient --ground no` | `orient` time, default / `--ground no` |",
+        "| model | faces | elevation | input | `orient` | `orient --ground auto` (ground found) | `orient` time, default / auto |",
         "|---|---:|---:|---:|---:|---:|---:|",
     ]
     for r in rows:
         lines.append(
-            f"| {r.model} | {r.faces} | {r.elevation:g}° | {r.input:.3%} | "
-            f"{r.default:.3%} ({'yes' if r.ground_found else 'no'}) | {r.ground_no:.3%} | "
-            f"{r.seconds_default:.1f} s / {r.seconds_ground_no:.1f} s (load {r.load1:.1f}) |"
+            f"| {r.model} | {r.faces} | {r.elevation:g}° | {r.input:.3%} | {r.default:.3%} | "
+            f"{r.ground_auto:.3%} ({'yes' if r.ground_found else 'no'}) | "
+            f"{r.seconds_default:.1f} s / {r.seconds_auto:.1f} s (load {r.load1:.1f}) |"
         )
     return "\n".join(lines)
 
@@ -524,7 +524,7 @@ def add_arguments(p: argparse.ArgumentParser) -> None:
         type=float,
         metavar="DEG",
         help="instead of the errors: back-facing pixels seen from these elevations above the up axis, "
-        "before and after orient (default and --ground no)",
+        "before and after orient (default and --ground auto)",
     )
     p.add_argument(
         "--confirm",
