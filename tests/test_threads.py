@@ -102,8 +102,9 @@ def _kernel_calls(rng: np.random.Generator) -> dict:
             np.abs(x),
             ru.astype(np.float32),
             rv.astype(np.float32),
-            np.array([0.1, 0.5, 0.3]),
-            np.array([0.2, 0.1, 0.6]),
+            (face % 3 + 1).astype(np.int64),
+            np.array([[0.3, 0.0, 0.0], [0.1, 0.5, 0.0], [0.1, 0.5, 0.3]]),
+            np.array([[0.3, 0.0, 0.0], [0.2, 0.1, 0.0], [0.2, 0.1, 0.6]]),
         ),
         "gather_normalised": lambda: geometry.gather_normalised(x, np.vstack([faces] * 40), center, 0.5),
     }

@@ -23,13 +23,14 @@ from meshvis.rays._kernels import einsum_dot3
 
 
 @numba.njit(cache=True, nogil=True, error_model="numpy")
-def _nearest_sample(metric, u, v, sample_u, sample_v, best):  # pragma: no cover - compiled
+def _nearest_sample(metric, u, v, count, sample_u, sample_v, best):  # pragma: no cover - compiled
     for k in range(len(u)):
         g0, g1, g2 = metric[k, 0], metric[k, 1], metric[k, 2]
         uk, vk = np.float64(u[k]), np.float64(v[k])
+        row = count[k] - 1
         best_d2 = 0.0
-        for s in range(len(sample_u)):
-            du, dv = uk - sample_u[s], vk - sample_v[s]
+        for s in range(count[k]):
+            du, dv = uk - sample_u[row, s], vk - sample_v[row, s]
             d2 = g0 * du * du + 2 * g1 * du * dv + g2 * dv * dv
             if s == 0 or d2 < best_d2:
                 best[k] = s
@@ -37,17 +38,24 @@ def _nearest_sample(metric, u, v, sample_u, sample_v, best):  # pragma: no cover
 
 
 def nearest_sample(
-    metric: np.ndarray, u: np.ndarray, v: np.ndarray, sample_u: np.ndarray, sample_v: np.ndarray
+    metric: np.ndarray,
+    u: np.ndarray,
+    v: np.ndarray,
+    count: np.ndarray,
+    sample_u: np.ndarray,
+    sample_v: np.ndarray,
 ) -> np.ndarray:
     """(n,) index of the sample nearest to each hit under the face metric ``Δᵀ G Δ``.
 
     ``metric[k] = (e1·e1, e1·e2, e2·e2)`` of hit k's face; ``u, v`` the hits' barycentric
-    coordinates; ``sample_u, sample_v`` the samples' (the same pattern on every face).
+    coordinates; ``count[k]`` the samples of hit k's face; ``sample_u[c - 1], sample_v[c - 1]``
+    the samples' of a face with ``c`` of them (the same pattern on every face of one count).
     Serial over slices of the hits, in threads (:func:`meshvis._threads.in_threads`).
     """
     best = np.zeros(len(u), np.int64)
     in_threads(
-        lambda a, b: _nearest_sample(metric[a:b], u[a:b], v[a:b], sample_u, sample_v, best[a:b]), len(u)
+        lambda a, b: _nearest_sample(metric[a:b], u[a:b], v[a:b], count[a:b], sample_u, sample_v, best[a:b]),
+        len(u),
     )
     return best
 
@@ -91,12 +99,14 @@ def pushed_origins(
     start,
     partner,
     duplicate_first,
-    samples,
+    point_start,
     offset,
     proximity,
     square_cos,
 ):  # pragma: no cover - compiled
     """(P, 3) origins of :func:`meshvis.graphcut.nodes._pushed_origins` on one side.
+
+    The sample points of flagged face ``flagged[q]`` are ``point_start[q] .. point_start[q + 1] - 1``.
 
     The partners of face ``f`` are ``partner[start[f] : start[f + 1]]``, in the numpy
     version's order (the pairs, then the pairs reversed); a copy of a face (``duplicate_first[f]
@@ -128,8 +138,8 @@ def pushed_origins(
                     continue
                 _push_past(
                     gg,
-                    q * samples,
-                    samples,
+                    point_start[q],
+                    point_start[q + 1] - point_start[q],
                     pos,
                     ns,
                     triangles,

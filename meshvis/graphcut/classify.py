@@ -150,6 +150,8 @@ class Classification:
             "nodes": self.graph.n,
             "cluster_nodes": self.nodes.n_cluster,
             "point_nodes": self.nodes.n - self.nodes.n_cluster,
+            # sample points a full count on every flagged face would have added
+            "sample_points_left_out": self.nodes.samples * len(self.nodes.flagged) - self.nodes.n_points,
             "clusters": int(self.pre.clustering.n_clusters),
             "edges": self.graph.n_edges,
             "flagged_faces": int(self.flagged.sum()),
@@ -204,10 +206,10 @@ def face_labels(nodes: NodeSet, node_outside: np.ndarray, m: int, degenerate: np
     clustered = nodes.side_node[:, 0] >= 0
     out[clustered] = node_outside[nodes.side_node[clustered]]
     if len(nodes.flagged):
-        k = nodes.samples
+        first, count = nodes.point_start[:-1], nodes.point_count
         for s in (0, 1):
-            lab = node_outside[nodes.n_cluster + 2 * np.arange(nodes.n_points) + s].reshape(-1, k)
-            out[nodes.flagged, s] = lab.mean(axis=1)
+            lab = node_outside[nodes.n_cluster + 2 * np.arange(nodes.n_points) + s].astype(np.float64)
+            out[nodes.flagged, s] = np.add.reduceat(lab, first) / count
     out[degenerate] = 0.0
     return out
 
@@ -319,6 +321,7 @@ def classify(
     seed: int = 0,
     hints: Hints | dict | None = None,
     samples_per_face: int = 4,
+    point_area: float | None = None,
     rays_per_point: int | None = None,
     sampling_scheme: int = 2,
     use_filter: bool = True,
@@ -344,7 +347,13 @@ def classify(
     hints : Hints or dict, optional
         Inside/outside points and boxes (:class:`~meshvis.graphcut.hints.Hints`).
     samples_per_face : int
-        Sample points per intersecting/coplanar face (appendix H §3.1).
+        The most sample points of an intersecting/coplanar face (appendix H §3.1).
+    point_area : float or None
+        None (default): every flagged face carries ``samples_per_face`` sample points.
+        A number: a flagged face carries one sample point per this many times the mean
+        face area, at least one and at most ``samples_per_face``
+        (:func:`meshvis.graphcut.nodes.sample_counts`); the report counts the points so
+        left out (``orient`` classifies so, :data:`meshvis.repair.orient.POINT_AREA`).
     rays_per_point : int, optional
         Ray budget of each sample-point node (default ``rays_per_node``).
         Most rays of a model with many intersecting faces come from their sample points;
@@ -403,6 +412,8 @@ def classify(
         rays_per_point=rays_per_point,
     )
     _validate.instance("caster", caster, RayCaster, optional=True)
+    if point_area is not None:
+        _validate.real("point_area", point_area, 0.0, open_lo=True)
     if rays_per_node < 1:
         raise ParameterError(f"rays_per_node must be at least 1, got {rays_per_node}")
     if samples_per_face < 1:
@@ -425,7 +436,7 @@ def classify(
     groups = _vertex_groups(soup, caster, stages)
     caster = _scene(soup, caster, offset, groups, stages, report)
     pre = _preprocess(soup, groups, stages, report)
-    nodes = _nodes(soup, pre, caster, samples_per_face, sampling_scheme, stages)
+    nodes = _nodes(soup, pre, caster, samples_per_face, point_area, sampling_scheme, stages)
     hint_out, hint_in, hint_rays = _hints(caster, nodes, hints, rng, stages)
     loop = _Sampling(
         caster, nodes, soup, pre.degenerate, rng, hint_out, hint_in, use_filter, opening, solver, report
@@ -437,6 +448,7 @@ def classify(
         "rays_per_node": rays_per_node,
         "seed": seed,
         "samples_per_face": samples_per_face,
+        "point_area": point_area,
         "rays_per_point": rays_per_point,
         "sampling_scheme": sampling_scheme,
         "use_filter": use_filter,
@@ -512,7 +524,13 @@ def _preprocess(soup: Soup, vertex_groups, stages: list[Stage], report) -> Prepr
 
 
 def _nodes(
-    soup: Soup, pre: Preprocessed, caster: RayCaster, samples: int, scheme: int, stages: list[Stage]
+    soup: Soup,
+    pre: Preprocessed,
+    caster: RayCaster,
+    samples: int,
+    point_area: float | None,
+    scheme: int,
+    stages: list[Stage],
 ) -> NodeSet:
     """Half-space nodes: cluster sides and the sample points of flagged faces."""
     t = time.perf_counter()
@@ -529,9 +547,13 @@ def _nodes(
         offset=off_abs,
         proximity=2 * off_abs,
         duplicate_first=pre.analysis.duplicate_first,
+        point_area=point_area,
     )
+    left_out = samples * len(nodes.flagged) - nodes.n_points
     point_note = (
-        f"{nodes.n_points} sample points" if nodes.n_points else "skipped point nodes: no flagged faces"
+        f"{nodes.n_points} sample points ({left_out} left out on small faces)"
+        if nodes.n_points
+        else "skipped point nodes: no flagged faces"
     )
     stages.append(Stage("nodes", True, time.perf_counter() - t, f"{nodes.n} nodes; {point_note}"))
     return nodes

@@ -6,6 +6,12 @@ Node ids are laid out as:
 * ``n_cluster + 2*p + s`` — point node of sample point ``p`` on side ``s`` of a flagged
   (intersecting / coplanar / too close) triangle.
 
+A flagged face carries ``samples`` sample points, or, given a ``point_area``, points by its
+size (:func:`sample_counts`): one per ``point_area`` times the model's mean face area, at
+least one and at most ``samples``.  Most flagged faces of a large assembly are small (on a
+city of real models four in five are below the mean face area), and their four points
+would vote alike.
+
 The two virtual terminals OUTSIDE and INSIDE are not stored here; the cut adds them.
 """
 
@@ -54,10 +60,12 @@ class NodeSet:
     node_start : (n_cluster + 1,) int64 array
         Offsets of each cluster node's entries.
     flagged : (k,) int64 array
-        The flagged faces; sample points of flagged face q are ``q*samples ..
-        q*samples+samples-1``.
+        The flagged faces; sample points of flagged face q are ``point_start[q] ..
+        point_start[q+1]-1``.
     samples : int
-        Sample points per flagged face.
+        The most sample points a flagged face carries.
+    point_start : (k + 1,) int64 array
+        Offsets of each flagged face's sample points.
     point_face : (P,) int64 array
         Face of each sample point.
     point_pos : (P, 3) float64 array
@@ -66,8 +74,9 @@ class NodeSet:
         Ray origin of each side, pushed off the surface.
     flagged_index : (m,) int64 array
         Position of a face in ``flagged`` or -1.
-    sample_bary : (samples, 3) float64 array
-        Barycentric pattern of the sample points (the same on every face).
+    sample_bary : (samples, samples, 3) float64 array
+        Barycentric patterns of the sample points: row ``c - 1`` holds the ``c`` points of a
+        face that carries ``c`` (the rest zero); every face of one count has the same.
     flagged_metric : (k, 3) float64 array
         Per flagged face ``(e1·e1, e1·e2, e2·e2)`` with ``e1 = b - a``, ``e2 = c - a``: the metric
         of its barycentric coordinates.
@@ -88,6 +97,7 @@ class NodeSet:
     node_start: np.ndarray
     flagged: np.ndarray
     samples: int
+    point_start: np.ndarray
     point_face: np.ndarray
     point_pos: np.ndarray
     point_origin: np.ndarray
@@ -100,6 +110,20 @@ class NodeSet:
     def n_points(self) -> int:
         """Number of sample points ``P``."""
         return len(self.point_face)
+
+    @property
+    def point_count(self) -> np.ndarray:
+        """(k,) int64: sample points of each flagged face."""
+        return np.diff(self.point_start)
+
+    def points_of(self, q: np.ndarray) -> np.ndarray:
+        """All sample points of the flagged faces ``q`` (positions in ``flagged``), face by face."""
+        q = np.asarray(q, np.int64)
+        count = self.point_start[q + 1] - self.point_start[q]
+        first = np.repeat(self.point_start[q], count)
+        # the rank of each point within its face: 0 .. count-1
+        rank = np.arange(len(first)) - np.repeat(np.cumsum(count) - count, count)
+        return first + rank
 
     @property
     def is_point(self) -> np.ndarray:
@@ -131,6 +155,7 @@ def build_nodes(
     offset: float,
     proximity: float,
     duplicate_first: np.ndarray | None = None,
+    point_area: float | None = None,
 ) -> NodeSet:
     """Create the half-space nodes.
 
@@ -150,7 +175,7 @@ def build_nodes(
         Pairs of faces flagged together (intersecting, coplanar, too close); used by the proximity
         adjustment of the sample points.
     samples : int
-        Sample points per flagged face.
+        The most sample points of a flagged face.
     scheme : {1, 2}
         Sample placement scheme (appendix H §3.1, see
         :func:`meshvis.rays.samples.sample_scheme_barycentric`).
@@ -164,6 +189,9 @@ def build_nodes(
         (:func:`meshvis.geometry.adjacency.duplicate_faces`): the pairs of a group's first
         face stand for those of its copies, as :func:`meshvis.geometry.intersect.intersection_flags`
         gives them.  Default: no copies.
+    point_area : float, optional
+        Area of the surface one sample point stands for, relative to the mean face area
+        (:func:`sample_counts`); None gives every flagged face ``samples`` points.
 
     Returns
     -------
@@ -173,11 +201,12 @@ def build_nodes(
     side_node = clustering.side_node
     n_cluster = clustering.n_nodes
     e_node, e_face, e_side, node_start, c_area, c_faces = _cluster_entries(side_node, n_cluster, areas)
+    count = sample_counts(areas, flagged, samples, point_area)
     pts = _point_nodes(
-        triangles, normals, areas, flagged, partner_pairs, samples, scheme, offset, proximity, duplicate_first
+        triangles, normals, flagged, partner_pairs, count, samples, scheme, offset, proximity, duplicate_first
     )
     n_points = len(pts["point_face"])
-    p_area = np.repeat(areas[pts["flagged"]] / samples, samples)
+    p_area = np.repeat(areas[pts["flagged"]] / count, count)
     return NodeSet(
         n=n_cluster + 2 * n_points,
         n_cluster=n_cluster,
@@ -214,17 +243,74 @@ def _cluster_entries(side_node: np.ndarray, n_cluster: int, areas: np.ndarray):
     return e_node, e_face, e_side, node_start, c_area, c_faces
 
 
+def sample_counts(
+    areas: np.ndarray, flagged: np.ndarray, samples: int, point_area: float | None
+) -> np.ndarray:
+    """(k,) int64: sample points of each flagged face, by its size.
+
+    A flagged face carries one point per ``point_area`` times the model's mean face area
+    (over the faces with an area), rounded up, at least one and at most ``samples``: a
+    small face is all on one side of what crosses it, or nearly so, and its one point (its
+    centroid) says which.  The mean face area follows the model's tessellation, not its
+    scale or extent, so a model and a city of its copies give their faces the same counts.
+
+    Parameters
+    ----------
+    areas : (m,) float64 array
+        Face areas.
+    flagged : (m,) bool array
+        Faces that get sample points.
+    samples : int
+        The most points of a face.
+    point_area : float or None
+        Area one point stands for, relative to the mean face area; None: ``samples`` for
+        every flagged face.
+
+    Returns
+    -------
+    (k,) int64 array
+        Points of each flagged face, in face order.
+
+    Examples
+    --------
+    >>> areas = np.array([1.0, 1.0, 0.1, 6.0])  # mean 2.025
+    >>> sample_counts(areas, np.array([False, True, True, True]), 4, 1.0).tolist()
+    [1, 1, 3]
+    >>> sample_counts(areas, np.array([False, True, True, True]), 4, None).tolist()
+    [4, 4, 4]
+    """
+    a = areas[np.asarray(flagged, bool)]
+    if point_area is None or len(a) == 0:
+        return np.full(len(a), samples, np.int64)
+    with_area = areas[areas > 0]
+    mean = with_area.mean() if len(with_area) else 1.0
+    count = np.ceil(a / (point_area * mean))
+    return np.clip(np.nan_to_num(count, nan=1.0), 1, samples).astype(np.int64)
+
+
+def sample_patterns(samples: int, scheme: int) -> np.ndarray:
+    """(samples, samples, 3) barycentric patterns: row ``c - 1`` holds the ``c`` points of a face that carries ``c``."""
+    table = np.zeros((samples, samples, 3))
+    for c in range(1, samples + 1):
+        table[c - 1, :c] = sample_scheme_barycentric(c, scheme)
+    return table
+
+
 def _point_nodes(
-    triangles, normals, areas, flagged, partner_pairs, samples, scheme, offset, proximity, duplicate_first
+    triangles, normals, flagged, partner_pairs, count, samples, scheme, offset, proximity, duplicate_first
 ) -> dict:
     """Sample points of the flagged faces with their pushed ray origins (NodeSet fields)."""
     m = len(triangles)
     flagged_faces = np.flatnonzero(flagged)
     flagged_index = np.full(m, -1, np.int64)
     flagged_index[flagged_faces] = np.arange(len(flagged_faces))
-    bary = sample_scheme_barycentric(samples, scheme)
-    pos = np.einsum("kc,fcd->fkd", bary, triangles[flagged_faces]).reshape(-1, 3)
-    point_face = np.repeat(flagged_faces, samples)
+    table = sample_patterns(samples, scheme)
+    point_start = np.concatenate([[0], np.cumsum(count)]).astype(np.int64)
+    point_face = np.repeat(flagged_faces, count)
+    rank = np.arange(len(point_face)) - np.repeat(point_start[:-1], count)
+    bary = table[np.repeat(count, count) - 1, rank]
+    tri = triangles[point_face]
+    pos = bary[:, 0, None] * tri[:, 0] + bary[:, 1, None] * tri[:, 1] + bary[:, 2, None] * tri[:, 2]
     origin = np.empty((len(point_face), 2, 3))
     for s in (0, 1):
         origin[:, s] = _pushed_origins(
@@ -235,7 +321,7 @@ def _point_nodes(
             normals,
             flagged_index,
             partner_pairs,
-            samples,
+            point_start,
             offset,
             proximity,
             duplicate_first,
@@ -247,11 +333,12 @@ def _point_nodes(
     )
     return {
         "flagged": flagged_faces,
+        "point_start": point_start,
         "point_face": point_face,
         "point_pos": pos,
         "point_origin": origin,
         "flagged_index": flagged_index,
-        "sample_bary": bary,
+        "sample_bary": table,
         "flagged_metric": metric,
     }
 
@@ -269,7 +356,7 @@ def _pushed_origins(
     normals,
     flagged_index,
     pairs,
-    samples,
+    point_start,
     offset,
     proximity,
     duplicate_first=None,
@@ -289,6 +376,11 @@ def _pushed_origins(
     a copy of a face (``duplicate_first``) meets the partners of its group's first face,
     whose pairs stand for the whole group's (:func:`meshvis.geometry.intersect.intersection_flags`).
     """
+    flagged = np.flatnonzero(flagged_index >= 0)
+    point_start = np.asarray(point_start, np.int64)
+    if point_start.shape != (len(flagged) + 1,) or point_start[-1] != len(pos):
+        # the kernel indexes by these offsets: a wrong layout would read out of bounds
+        raise ValueError("point_start must hold the offsets of every flagged face's points")
     # (face, partner) candidates: every pair both ways, grouped by face (stable: in that order)
     both = np.concatenate([pairs, pairs[:, ::-1]]) if len(pairs) else np.zeros((0, 2), np.int64)
     by_face = np.argsort(both[:, 0], kind="stable")
@@ -300,11 +392,11 @@ def _pushed_origins(
         int(side),
         np.ascontiguousarray(triangles, np.float64),
         np.ascontiguousarray(normals, np.float64),
-        np.ascontiguousarray(np.flatnonzero(flagged_index >= 0), np.int64),
+        np.ascontiguousarray(flagged, np.int64),
         np.ascontiguousarray(start, np.int64),
         np.ascontiguousarray(both[by_face, 1], np.int64),
         np.ascontiguousarray(first, np.int64),
-        int(samples),
+        np.ascontiguousarray(point_start, np.int64),
         float(offset),
         float(proximity),
         PERPENDICULAR_COS,

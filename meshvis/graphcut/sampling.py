@@ -51,21 +51,23 @@ def snap_to_points(nodes: NodeSet, face: np.ndarray, bary: np.ndarray) -> np.nda
     """Index of the sample point of ``face`` (a flagged face) nearest to each hit.
 
     Hits are given by their barycentric coordinates ``(u, v)`` on the face.  Every flagged
-    face carries the same barycentric sample pattern, so the squared 3D distance to sample
-    *k* is the quadratic form ``Δᵀ G Δ`` of the barycentric difference Δ = (u-u_k, v-v_k)
-    with the face's metric tensor ``G`` (dot products of its two edge vectors): no 3D
-    coordinates need to be gathered.
+    face with the same number of sample points carries the same barycentric pattern, so
+    the squared 3D distance to sample *k* is the quadratic form ``Δᵀ G Δ`` of the
+    barycentric difference Δ = (u-u_k, v-v_k) with the face's metric tensor ``G`` (dot
+    products of its two edge vectors): no 3D coordinates need to be gathered.
     """
     q = nodes.flagged_index[face]
-    bu, bv = nodes.sample_bary[:, 1], nodes.sample_bary[:, 2]
+    first = nodes.point_start[q]
+    bu, bv = nodes.sample_bary[:, :, 1], nodes.sample_bary[:, :, 2]
     best = _kernels.nearest_sample(
         nodes.flagged_metric[q],
         np.ascontiguousarray(bary[:, 0]),
         np.ascontiguousarray(bary[:, 1]),
-        bu.copy(),
-        bv.copy(),
+        nodes.point_start[q + 1] - first,
+        np.ascontiguousarray(bu),
+        np.ascontiguousarray(bv),
     )
-    return q * nodes.samples + best
+    return first + best
 
 
 def sample_round(

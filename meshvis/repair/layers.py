@@ -131,7 +131,7 @@ def face_nodes_mask(c: Classification, faces: np.ndarray) -> np.ndarray:
     q = c.nodes.flagged_index[faces]
     q = q[q >= 0]
     if len(q):
-        p = (q[:, None] * c.nodes.samples + np.arange(c.nodes.samples)).ravel()
+        p = c.nodes.points_of(q)
         mask[c.nodes.n_cluster + 2 * p] = True
         mask[c.nodes.n_cluster + 2 * p + 1] = True
     return mask

@@ -124,6 +124,13 @@ POOLED_DOMINANCE = 4.0
 #: :data:`~meshvis.repair.evidence.MIN_ESCAPES` of them escape upward (0.8 %; the walls of
 #: the monastery's courtyards let 1-5 % of the rays through their less seen side escape)
 ABOVE_RAYS = 1024
+#: orient's cut gives a flagged face one sample point per this many times the model's mean
+#: face area, at least one and at most ``samples_per_face``
+#: (:func:`meshvis.graphcut.nodes.sample_counts`): most flagged faces of a large assembly
+#: are small and their points vote alike, and orient's own rays test a face after the cut.
+#: The removals' cut keeps every point (``classify``'s default): there each small face's
+#: label decides whether it is removed, and fewer points showed more wrong faces.
+POINT_AREA = 1.0
 
 
 @dataclass
@@ -837,7 +844,8 @@ def classify_for_orient(model: Any, **classify_kw: Any) -> Classification:
     model : Soup, trimesh object, (vertices, faces) or path
         Anything :func:`meshvis.classify` accepts.
     **classify_kw
-        Passed to :func:`meshvis.classify`.
+        Passed to :func:`meshvis.classify`; ``point_area`` is :data:`POINT_AREA` unless
+        given.
 
     Returns
     -------
@@ -856,6 +864,7 @@ def classify_for_orient(model: Any, **classify_kw: Any) -> Classification:
     from meshvis.io import as_soup
 
     _validate.keywords(classify_kw, classify)
+    classify_kw.setdefault("point_area", POINT_AREA)
     return classify(canonically_wound(as_soup(model)), **classify_kw)
 
 

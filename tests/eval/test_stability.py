@@ -221,7 +221,16 @@ def test_sample_origin_next_to_a_perpendicular_wall_stays_on_its_side():
     offset = 1e-4
     for side in (0, 1):
         o = _pushed_origins(
-            pos, np.array([0]), side, tri, nrm, np.array([0, -1]), np.array([[0, 1]]), 1, offset, 2 * offset
+            pos,
+            np.array([0]),
+            side,
+            tri,
+            nrm,
+            np.array([0, -1]),
+            np.array([[0, 1]]),
+            np.array([0, 1]),
+            offset,
+            2 * offset,
         )
         assert o[0, 1] > 0  # still in front of the wall
         assert o[0, 0] == pytest.approx(offset if side == 0 else -offset)

@@ -19,16 +19,19 @@ MODELS = Path(__file__).resolve().parents[2] / "models"
 
 
 def _numpy_pushed_origins(
-    pos, point_face, side, triangles, normals, flagged_index, pairs, samples, offset, proximity
+    pos, point_face, side, triangles, normals, flagged_index, pairs, point_start, offset, proximity
 ):
-    """The numpy expression that :func:`meshvis.graphcut._kernels.pushed_origins` replaced."""
+    """The numpy expression that :func:`meshvis.graphcut._kernels.pushed_origins` replaced
+    (with each flagged face's sample points at ``point_start[q] .. point_start[q + 1] - 1``)."""
     n_s = side_normals(normals[point_face], np.full(len(point_face), side))
     origin = pos + offset * n_s
     both = np.concatenate([pairs, pairs[:, ::-1]])
     both = both[flagged_index[both[:, 0]] >= 0]
     f, g = both[:, 0], both[:, 1]
-    pt = (flagged_index[f][:, None] * samples + np.arange(samples)).ravel()
-    g = np.repeat(g, samples)
+    count = np.diff(point_start)[flagged_index[f]]
+    first = np.repeat(point_start[flagged_index[f]], count)
+    pt = first + np.arange(count.sum()) - np.repeat(np.cumsum(count) - count, count)
+    g = np.repeat(g, count)
     p = pos[pt]
     ng = normals[g]
     d = np.einsum("ij,ij->i", ng, p - triangles[g, 0])
@@ -96,15 +99,18 @@ def crossings():
     flagged = np.union1d(flagged, np.unique(pairs))[::2]  # some partners are not flagged themselves
     flagged_index = np.full(m, -1, np.int64)
     flagged_index[flagged] = np.arange(len(flagged))
-    pos = np.einsum("kc,fcd->fkd", bary, tri[flagged]).reshape(-1, 3)
-    point_face = np.repeat(flagged, samples)
-    return pos, point_face, tri, normals, flagged_index, pairs, samples, offset, proximity
+    # every face its own number of points (the first ``c`` of the pattern)
+    count = rng.integers(1, samples + 1, len(flagged))
+    point_start = np.concatenate([[0], np.cumsum(count)])
+    pos = np.concatenate([bary[:c] @ tri[f] for f, c in zip(flagged, count)])
+    point_face = np.repeat(flagged, count)
+    return pos, point_face, tri, normals, flagged_index, pairs, point_start, offset, proximity
 
 
 @pytest.mark.parametrize("side", [0, 1])
 def test_pushed_origins_are_the_numpy_expression(crossings, side):
-    pos, point_face, tri, normals, flagged_index, pairs, samples, offset, proximity = crossings
-    args = (pos, point_face, side, tri, normals, flagged_index, pairs, samples, offset, proximity)
+    pos, point_face, tri, normals, flagged_index, pairs, point_start, offset, proximity = crossings
+    args = (pos, point_face, side, tri, normals, flagged_index, pairs, point_start, offset, proximity)
     expected = _numpy_pushed_origins(*args)
     got = _pushed_origins(*args)
     moved = np.any(
@@ -115,9 +121,11 @@ def test_pushed_origins_are_the_numpy_expression(crossings, side):
 
 
 def test_pushed_origins_without_partners(crossings):
-    pos, point_face, tri, normals, flagged_index, _, samples, offset, proximity = crossings
+    pos, point_face, tri, normals, flagged_index, _, point_start, offset, proximity = crossings
     none = np.zeros((0, 2), np.int64)
-    got = _pushed_origins(pos, point_face, 1, tri, normals, flagged_index, none, samples, offset, proximity)
+    got = _pushed_origins(
+        pos, point_face, 1, tri, normals, flagged_index, none, point_start, offset, proximity
+    )
     assert np.array_equal(got, pos - offset * normals[point_face])
 
 

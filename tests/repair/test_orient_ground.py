@@ -152,6 +152,33 @@ def test_seen_from_every_direction_the_wall_takes_the_side_seen_more(ground, up)
     np.testing.assert_array_equal(np.flatnonzero(r.flipped), [4, 5])
 
 
+def _car() -> Soup:
+    """A box on four wheels (z up), a third of its faces turned over: it stands on no ground."""
+    body = trimesh.creation.box(extents=(4, 2, 1)).apply_translation((0, 0, 1.2))
+    turn = trimesh.transformations.rotation_matrix(np.pi / 2, (1, 0, 0))
+    wheels = [
+        trimesh.creation.cylinder(0.4, 0.3, sections=12).apply_transform(turn).apply_translation((x, y, 0.4))
+        for x, y in [(-1.5, -1), (-1.5, 1), (1.5, -1), (1.5, 1)]
+    ]
+    car = trimesh.util.concatenate([body, *wheels])
+    faces = np.asarray(car.faces).copy()
+    faces[::3] = faces[::3, ::-1]
+    return Soup(np.asarray(car.vertices), faces)
+
+
+@pytest.mark.parametrize("model", ["car", "courtyard along y"])
+def test_with_no_ground_found_auto_is_the_default(model):
+    """Where no ground is found, ``ground=None`` (``--ground auto``) gives the faces of the
+    default ``ground=False``, the model seen from every direction."""
+    soup, up = (_car(), None) if model == "car" else (_courtyard(0.1), "y")
+    auto, default = orient(soup, seed=0, up=up, ground=None), orient(soup, seed=0, up=up)
+    assert not auto.visibility["ground"]
+    assert auto.flipped.any()  # there is something to agree on
+    np.testing.assert_array_equal(auto.flipped, default.flipped)
+    np.testing.assert_array_equal(auto.soup.faces, default.soup.faces)
+    np.testing.assert_array_equal(auto.status, default.status)
+
+
 @pytest.mark.parametrize("scale, shift", [(1e-6, 0.0), (1e6, 0.0), (1.0, 1e6)])
 def test_the_courtyard_wall_keeps_its_patch_at_any_scale_and_far_away(scale, shift):
     soup = _courtyard(0.1)

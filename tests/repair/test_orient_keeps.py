@@ -489,3 +489,22 @@ def test_a_sliver_shows_the_side_its_patch_shows():
     out = r.soup.subset(np.arange(s.n_faces))
     bad = int((~edges(weld(out.vertices, out.faces)[1]).consistent).sum())
     assert bad == 0, f"{bad} manifold edges whose faces disagree on the winding"
+
+
+def test_capped_rounds_reach_the_faces_of_a_small_model():
+    """The third round's cap is a share of the first round's rays, or a floor where that is
+    less: on a model with a few faces tested, the share alone leaves its faces no round."""
+    import trimesh
+
+    from meshvis.rays.caster import RayCaster
+
+    box = trimesh.creation.box()
+    soup = Soup(np.asarray(box.vertices), np.asarray(box.faces))
+    caster, faces = RayCaster(soup), np.arange(soup.n_faces)
+    for floor, reached in ((0, 0), (evidence.RARE_MIN_BUDGET, soup.n_faces)):
+        escaped, cast = np.zeros((soup.n_faces, 2), np.int64), np.zeros(soup.n_faces, np.int64)
+        stream = evidence.RayStream(0, soup.n_faces)
+        got = evidence.more_rays(
+            soup, caster, faces, escaped, cast, faces, evidence.LAST_RAYS, evidence.LAST_SHARE, stream, floor
+        )
+        assert len(got) == reached and (cast == (evidence.LAST_RAYS if floor else 0)).all()

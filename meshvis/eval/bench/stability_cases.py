@@ -369,7 +369,7 @@ def _side_nodes(c: Classification, faces: np.ndarray, side: int) -> np.ndarray:
     cl = cl[cl >= 0]
     q = nodes.flagged_index[faces]
     q = q[q >= 0]
-    pts = (q[:, None] * nodes.samples + np.arange(nodes.samples)).ravel()
+    pts = nodes.points_of(q)
     return np.unique(np.concatenate([cl, nodes.point_node(pts, np.full(len(pts), side))]))
 
 
