@@ -107,7 +107,8 @@ def hint_weights(
             h = caster.intersect(origins, dirs)
             n_cast += len(origins)
             hit = h.face >= 0
-            f, s = h.face[hit], h.side[hit].astype(np.int64)
+            hit[hit] = (nodes.side_node[h.face[hit], 0] >= 0) | (nodes.flagged_index[h.face[hit]] >= 0)
+            f, s = h.face[hit], h.side[hit].astype(np.int64)  # faces with no node are passed over
             dst = nodes.side_node[f, s]
             flag = dst < 0
             if flag.any():

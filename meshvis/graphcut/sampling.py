@@ -111,11 +111,17 @@ def sample_round(
         p, blocked = np.zeros(0, np.int64), np.zeros(0, bool)
         if len(flagged_at):  # hits on flagged faces: snap to a sample point, check the way back
             assert h.bary is not None  # intersect always fills it
-            p = snap_to_points(nodes, f[flagged_at], h.bary[ray_at])
+            # a face with no node (degenerate after welding, yet thick enough for Embree to
+            # hit) tells nothing about either side: its hits are discarded as blocked ones
+            real = nodes.flagged_index[f[flagged_at]] >= 0
+            p, blocked = np.zeros(len(flagged_at), np.int64), np.ones(len(flagged_at), bool)
+            p[real] = snap_to_points(nodes, f[flagged_at[real]], h.bary[ray_at[real]])
             t0 = time.perf_counter()
-            blocked = caster.occluded(nodes.point_origin[p, s[flagged_at]], origins[ray_at])
+            blocked[real] = caster.occluded(
+                nodes.point_origin[p[real], s[flagged_at[real]]], origins[ray_at[real]]
+            )
             counts.time_embree += time.perf_counter() - t0
-            counts.reverse_rays += len(flagged_at)
+            counts.reverse_rays += int(real.sum())
         r, c = _kernels.kept_hits(sr, s, dst, flagged_at, p, blocked, nodes.n_cluster, counts.discarded)
         rows.append(r)
         cols.append(c)

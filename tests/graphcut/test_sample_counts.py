@@ -106,3 +106,29 @@ def test_classify_keeps_every_point_by_default():
     assert classify_for_orient((v, f), seed=0).nodes.n_points == by_size.nodes.n_points
     assert classify_for_orient((v, f), seed=0, point_area=None).nodes.n_points == default.nodes.n_points
     assert orient((v, f), seed=0).flipped.shape == (len(f),)
+
+
+def test_hits_on_a_face_with_no_node_are_discarded():
+    """A face that has neither a cluster node nor sample points (degenerate after welding,
+    yet thick enough for Embree to hit) tells nothing: rays that hit it are discarded, not
+    linked to another face's sample point."""
+    import dataclasses
+
+    from meshvis.graphcut.sampling import VisibilityCounts, sample_round
+    from meshvis.rays.caster import RayCaster
+
+    v, f, _ = _coarse_through_fine()
+    c = classify((v, f), seed=0)
+    nodes = c.nodes
+    clustered = np.flatnonzero(nodes.side_node[:, 0] >= 0)
+    lost = clustered[np.argmax(c.soup.areas[clustered])]
+    side_node = nodes.side_node.copy()
+    side_node[lost] = -1
+    without = dataclasses.replace(nodes, side_node=side_node)
+    caster = RayCaster(c.soup)
+    per = np.full(nodes.n, 8, np.int64)
+    before = sample_round(caster, nodes, per, np.random.default_rng(1), VisibilityCounts(nodes.n))
+    after = sample_round(caster, without, per, np.random.default_rng(1), VisibilityCounts(nodes.n))
+    assert after.discarded.sum() > before.discarded.sum()
+    assert after.escaped.sum() == before.escaped.sum()
+    assert after.hits.sum() + after.discarded.sum() + after.escaped.sum() == after.cast.sum()
